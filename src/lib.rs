@@ -1,0 +1,7 @@
+//! A progressive-refinement radiosity renderer with ray-traced form factors.
+
+pub mod color;
+pub mod mesh;
+pub mod output;
+pub mod render;
+pub mod scene;

@@ -1,0 +1,1 @@
+//! Pictures of a solution: a z-buffered Gouraud rasterizer and tone mapping.

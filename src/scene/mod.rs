@@ -1,0 +1,179 @@
+//! The scene: world-space planar polygons, their diffuse materials, and the
+//! camera that looks at them.
+//!
+//! A [`Scene`] is what the loaders produce and what every later stage reads.
+//! It knows nothing of meshing or light transport. Loading validates
+//! everything the format promises (planar, convex, non-degenerate polygons;
+//! reflectance below one), so later stages may rely on it.
+
+mod error;
+mod polygon;
+mod sc;
+
+pub use error::{Diagnostic, LoadError};
+pub use polygon::{PolygonError, Shape};
+pub use sc::parse_str;
+
+use crate::color::Rgb;
+use glam::Vec3;
+use std::path::Path;
+
+/// Index of a material in [`Scene::materials`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MaterialId(pub u32);
+
+impl MaterialId {
+    /// The index as a `usize`, for slice access.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Index of a polygon in [`Scene::polygons`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PolygonId(pub u32);
+
+impl PolygonId {
+    /// The index as a `usize`, for slice access.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A diffuse material as written in the scene file.
+///
+/// Invariants (checked by the loader): `color` channels, `k_diffrefl` and
+/// `k_emission` are finite and `>= 0`, and every channel of
+/// [`Material::reflectance`] is `< 1`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// The name the scene file gave it.
+    pub name: String,
+    /// Base colour, per channel `>= 0`.
+    pub color: Rgb,
+    /// Diffuse reflection coefficient, `>= 0`.
+    pub k_diffrefl: f64,
+    /// Emission coefficient, `>= 0`.
+    pub k_emission: f64,
+}
+
+impl Material {
+    /// Emitted radiosity `e = k_emission * color`, in the scene's radiosity
+    /// units (exitance), from the front side only.
+    pub fn emission(&self) -> Rgb {
+        self.color * self.k_emission
+    }
+
+    /// Diffuse reflectance `rho = k_diffrefl * color`, dimensionless, every
+    /// channel in `[0, 1)`.
+    pub fn reflectance(&self) -> Rgb {
+        self.color * self.k_diffrefl
+    }
+}
+
+/// Where something was written in a source file (both 1-based; columns
+/// count Unicode characters).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SourcePos {
+    /// Line, from 1.
+    pub line: u32,
+    /// Column in characters, from 1.
+    pub col: u32,
+}
+
+/// One planar convex polygon in world space.
+///
+/// Invariants (checked by [`Polygon::new`]): at least three vertices, no two
+/// equal consecutive vertices, planar within the format's tolerance, convex,
+/// non-zero area, counter-clockwise seen from the front (so `normal` is the
+/// direction of the area vector).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Polygon {
+    /// Its material.
+    pub material: MaterialId,
+    /// Vertices in scene units, counter-clockwise seen from the front.
+    pub vertices: Vec<Vec3>,
+    /// Unit normal pointing to the front (emitting, reflecting) side.
+    pub normal: Vec3,
+    /// Area in square scene units (from Newell's area vector, in `f64`).
+    pub area: f64,
+    /// What kind of polygon it is, which decides how it is meshed.
+    pub shape: Shape,
+    /// Where the statement that made it starts in its source file.
+    pub origin: SourcePos,
+}
+
+/// The viewpoint of the picture.
+///
+/// Invariants: `eye != lookat`, `up` not parallel to `lookat - eye`,
+/// `0 < fov_y < pi`, `width >= 1`, `height >= 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Viewpoint, in scene units.
+    pub eye: Vec3,
+    /// Point looked at, in scene units.
+    pub lookat: Vec3,
+    /// Approximate up direction (need not be orthogonal to the view).
+    pub up: Vec3,
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    /// Picture width in pixels.
+    pub width: u32,
+    /// Picture height in pixels.
+    pub height: u32,
+}
+
+/// Default picture size when the scene gives none, in pixels.
+pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
+/// Default vertical field of view when the scene gives none, in degrees.
+pub const DEFAULT_FOV_DEG: f32 = 45.0;
+
+/// Whether the camera came from the file or was made to frame the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraSource {
+    /// The file had a `camera` block.
+    File,
+    /// No `camera` block: see [`Camera::frame`].
+    AutoFramed,
+}
+
+/// A loaded, validated scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Every polygon, in file order.
+    pub polygons: Vec<Polygon>,
+    /// Every material, in file order (including unused ones).
+    pub materials: Vec<Material>,
+    /// The camera, from the file or auto-framed.
+    pub camera: Camera,
+    /// Where the camera came from.
+    pub camera_source: CameraSource,
+}
+
+impl Scene {
+    /// The material of a polygon.
+    pub fn material_of(&self, p: PolygonId) -> &Material {
+        &self.materials[self.polygons[p.index()].material.index()]
+    }
+
+    /// Axis-aligned bounds `(min, max)` of all vertices, in scene units.
+    /// For an empty scene both are zero.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut it = self.polygons.iter().flat_map(|p| p.vertices.iter().copied());
+        match it.next() {
+            None => (Vec3::ZERO, Vec3::ZERO),
+            Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),
+        }
+    }
+
+    /// Length of the diagonal of [`Scene::bounds`], in scene units.
+    pub fn extent(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        (hi - lo).length()
+    }
+}
+
+/// Reads and parses a `.sc` file. Errors carry the file name, line and column.
+pub fn load(path: &Path) -> Result<Scene, LoadError> {
+    sc::load_file(path)
+}
