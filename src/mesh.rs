@@ -1,11 +1,58 @@
 //! Meshing: each polygon becomes a grid of small elements whose corners
 //! (element vertices) carry the radiosity.
 //!
-//! MESH TYPES ONLY: the builder is being written.
+//! How each polygon is cut, with `lenmax` the longest allowed element edge:
+//!
+//! - a **parallelogram** becomes `nu × nv` congruent parallelograms,
+//!   `nu = ⌊|v1 − v0| / lenmax⌋ + 1` and `nv = ⌊|v3 − v0| / lenmax⌋ + 1`;
+//! - any other convex **quadrilateral** becomes a bilinear `nu × nv` grid,
+//!   `nu` from the longer of its two `u` edges and `nv` from the longer `v`
+//!   edge, so every interior grid line (a blend of the two) is short enough;
+//! - a **triangle** becomes `n²` triangles by a regular subdivision of each
+//!   edge into `n` parts, `n` from its longest edge;
+//! - a **convex polygon** of five or more vertices is first split into a fan
+//!   of triangles around its centroid (collinear vertices dropped), and every
+//!   fan triangle is subdivided with the same `n`, so the fan's shared edges
+//!   carry the same vertices.
+//!
+//! Element vertices are shared between neighbouring elements of the same
+//! polygon, never between polygons: each polygon's radiosity is discontinuous
+//! at its boundary, as a diffuse polygon's is across a crease.
+//!
+//! **Inset.** Vertices on a polygon's boundary are evaluated (not drawn) at a
+//! point moved inward by `inset × h` along the in-plane inward normal of each
+//! boundary edge they lie on, where `h` is the polygon's shortest element
+//! edge. A vertex exactly on a room's corner line lies in the plane of the
+//! neighbouring wall, where its shadow rays graze that wall and its form
+//! factors to it vanish; moved a little inward it sees what the surface near
+//! the corner sees, so corners do not come out dark.
 
-use crate::scene::PolygonId;
-use glam::Vec3;
+use crate::scene::{Polygon, PolygonId, Scene, Shape};
+use glam::{DVec3, Vec3};
+use std::collections::HashMap;
 use std::ops::Range;
+
+/// Default inset of boundary vertices, as a fraction of the polygon's
+/// shortest element edge (see the module docs). Five percent moves the
+/// sample far above `f32` rounding yet leaves it inside its elements.
+pub const DEFAULT_INSET: f32 = 0.05;
+
+/// Default `lenmax` as a fraction of the scene's bounding-box diagonal.
+/// For `rtable` this gives elements of about 0.2 units and a mesh of about
+/// 20,000 vertices, which solves in seconds.
+pub const DEFAULT_LENMAX_FRACTION: f32 = 1.0 / 40.0;
+
+/// Most elements a mesh may have. A mesh this large needs gigabytes for the
+/// solver's arrays; asking for more is almost always a `lenmax` typo.
+pub const MAX_ELEMENTS: u64 = 20_000_000;
+
+/// A vertex counts as lying on a polygon edge when it is closer to the
+/// edge's line than this fraction of the polygon's extent.
+const ON_EDGE_TOLERANCE: f32 = 1e-5;
+
+/// Relative tolerance for dropping a vertex of a 5+-gon as collinear with
+/// its neighbours (cross product against the product of edge lengths).
+const COLLINEAR_TOLERANCE: f64 = 1e-9;
 
 /// Index of an element vertex in the [`Mesh`] arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -29,12 +76,18 @@ pub struct Element {
 impl Element {
     /// A triangular element.
     pub fn triangle(a: VertexId, b: VertexId, c: VertexId) -> Self {
-        Element { corners: [a, b, c, c], len: 3 }
+        Element {
+            corners: [a, b, c, c],
+            len: 3,
+        }
     }
 
     /// A quadrilateral element.
     pub fn quad(a: VertexId, b: VertexId, c: VertexId, d: VertexId) -> Self {
-        Element { corners: [a, b, c, d], len: 4 }
+        Element {
+            corners: [a, b, c, d],
+            len: 4,
+        }
     }
 
     /// Its corners, 3 or 4 of them, counter-clockwise from the front.
@@ -55,7 +108,7 @@ impl Element {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PolygonMesh {
     /// Elements along the first parametric direction (edge `v0→v1` for
-    /// quads; the subdivision count of every edge for triangles).
+    /// quads; the subdivision count of every edge for triangles and fans).
     pub nu: u32,
     /// Elements along the second direction (edge `v0→v3` for quads; equal
     /// to `nu` for triangles and polygons of five or more vertices).
@@ -68,9 +121,22 @@ pub struct PolygonMesh {
     pub normal: Vec3,
     /// Area of the polygon in square scene units.
     pub area: f64,
+    /// Length of its shortest element edge, in scene units.
+    pub min_edge: f32,
+}
+
+impl PolygonMesh {
+    /// Number of element vertices of this polygon.
+    pub fn vertex_count(&self) -> u32 {
+        self.vertices.end - self.vertices.start
+    }
 }
 
 /// The element mesh of a whole scene, as flat arrays.
+///
+/// Invariants (checked by [`Mesh::validate`]): the per-vertex arrays have one
+/// entry per vertex; each polygon's vertices and elements are contiguous and
+/// in scene order; every element's corners belong to its own polygon.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     /// Element vertex positions on the polygon, in scene units: where the
@@ -89,9 +155,735 @@ pub struct Mesh {
     pub polygons: Vec<PolygonMesh>,
 }
 
+/// How to mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshOptions {
+    /// Every element edge is shorter than this, in scene units; `> 0`.
+    pub lenmax: f32,
+    /// Inset of boundary vertices as a fraction of the polygon's shortest
+    /// element edge, in `[0, 0.5)`; 0 disables it.
+    pub inset: f32,
+}
+
+impl MeshOptions {
+    /// The default options for a scene: `lenmax` a fixed fraction
+    /// ([`DEFAULT_LENMAX_FRACTION`]) of its bounding-box diagonal.
+    pub fn for_scene(scene: &Scene) -> Self {
+        let extent = scene.extent();
+        MeshOptions {
+            lenmax: if extent > 0.0 {
+                extent * DEFAULT_LENMAX_FRACTION
+            } else {
+                1.0
+            },
+            inset: DEFAULT_INSET,
+        }
+    }
+}
+
+/// Why a mesh could not be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// `lenmax` is not a positive finite number.
+    #[error("lenmax must be a positive number of scene units, got {0}")]
+    BadLenmax(f32),
+    /// The inset is outside `[0, 0.5)`.
+    #[error("inset must be at least 0 and below 0.5 (a fraction of an element edge), got {0}")]
+    BadInset(f32),
+    /// The mesh would be too large to hold.
+    #[error(
+        "lenmax {lenmax} would make {elements} elements (at most {max} are allowed); \
+         try lenmax {suggested:.4} or larger"
+    )]
+    TooManyElements {
+        /// The requested lenmax.
+        lenmax: f32,
+        /// The estimated element count.
+        elements: u64,
+        /// The limit.
+        max: u64,
+        /// A lenmax that would fit.
+        suggested: f32,
+    },
+}
+
+/// Builds the element mesh of every polygon of `scene`.
+pub fn build(scene: &Scene, options: &MeshOptions) -> Result<Mesh, MeshError> {
+    if !(options.lenmax.is_finite() && options.lenmax > 0.0) {
+        return Err(MeshError::BadLenmax(options.lenmax));
+    }
+    if !(options.inset.is_finite() && (0.0..0.5).contains(&options.inset)) {
+        return Err(MeshError::BadInset(options.inset));
+    }
+    let plans: Vec<Plan> = scene
+        .polygons
+        .iter()
+        .map(|p| Plan::new(p, options.lenmax))
+        .collect();
+    let elements: u64 = plans.iter().map(Plan::element_count).sum();
+    if elements > MAX_ELEMENTS {
+        // Element count scales with 1/lenmax², so this factor brings it under.
+        let factor = (elements as f64 / MAX_ELEMENTS as f64).sqrt() as f32 * 1.05;
+        return Err(MeshError::TooManyElements {
+            lenmax: options.lenmax,
+            elements,
+            max: MAX_ELEMENTS,
+            suggested: options.lenmax * factor,
+        });
+    }
+
+    let mut mesh = Mesh {
+        positions: Vec::new(),
+        sample_positions: Vec::new(),
+        vertex_polygon: Vec::new(),
+        elements: Vec::with_capacity(elements as usize),
+        element_polygon: Vec::with_capacity(elements as usize),
+        polygons: Vec::with_capacity(scene.polygons.len()),
+    };
+    for (index, (polygon, plan)) in scene.polygons.iter().zip(&plans).enumerate() {
+        let id = PolygonId(index as u32);
+        let v_start = mesh.positions.len() as u32;
+        let e_start = mesh.elements.len() as u32;
+        let mut builder = PolygonBuilder {
+            mesh: &mut mesh,
+            polygon: id,
+            first_vertex: v_start,
+        };
+        let (nu, nv, min_edge) = plan.emit(&mut builder);
+        let v_end = mesh.positions.len() as u32;
+        mesh.sample_positions
+            .extend(inset_positions(polygon, &mesh.positions[v_start as usize..], options.inset * min_edge));
+        mesh.polygons.push(PolygonMesh {
+            nu,
+            nv,
+            vertices: v_start..v_end,
+            elements: e_start..mesh.elements.len() as u32,
+            normal: polygon.normal,
+            area: polygon.area,
+            min_edge,
+        });
+    }
+    Ok(mesh)
+}
+
+/// How one polygon will be cut: its shape after simplification and the
+/// subdivision counts.
+enum Plan {
+    /// Parallelogram `v0 + u (v1 − v0) + v (v3 − v0)`.
+    Parallelogram { v: [Vec3; 4], nu: u32, nv: u32 },
+    /// Bilinear quad.
+    Bilinear { v: [Vec3; 4], nu: u32, nv: u32 },
+    /// A single triangle subdivided `n` times per edge.
+    Triangle { v: [Vec3; 3], n: u32 },
+    /// A fan of triangles `(apex, rim[k], rim[k+1])` around a closed rim.
+    Fan { apex: Vec3, rim: Vec<Vec3>, n: u32 },
+}
+
+/// Subdivisions so that `length / n < lenmax`.
+fn divisions(length: f32, lenmax: f32) -> u32 {
+    let n = (length / lenmax).floor() + 1.0;
+    // Saturate absurd counts; `MAX_ELEMENTS` then refuses the mesh.
+    if n >= u32::MAX as f32 / 4.0 {
+        u32::MAX / 4
+    } else {
+        n as u32
+    }
+}
+
+impl Plan {
+    fn new(polygon: &Polygon, lenmax: f32) -> Plan {
+        let v = &polygon.vertices;
+        match polygon.shape {
+            Shape::Parallelogram | Shape::Quad => {
+                let q = [v[0], v[1], v[2], v[3]];
+                if polygon.shape == Shape::Parallelogram {
+                    Plan::Parallelogram {
+                        v: q,
+                        nu: divisions(q[0].distance(q[1]), lenmax),
+                        nv: divisions(q[0].distance(q[3]), lenmax),
+                    }
+                } else {
+                    Plan::Bilinear {
+                        v: q,
+                        nu: divisions(q[0].distance(q[1]).max(q[3].distance(q[2])), lenmax),
+                        nv: divisions(q[0].distance(q[3]).max(q[1].distance(q[2])), lenmax),
+                    }
+                }
+            }
+            Shape::Triangle => {
+                let t = [v[0], v[1], v[2]];
+                let longest = t[0].distance(t[1]).max(t[1].distance(t[2])).max(t[2].distance(t[0]));
+                Plan::Triangle {
+                    v: t,
+                    n: divisions(longest, lenmax),
+                }
+            }
+            Shape::Convex => {
+                let rim = drop_collinear(v);
+                if rim.len() == 3 {
+                    return Plan::new(
+                        &Polygon {
+                            vertices: rim,
+                            shape: Shape::Triangle,
+                            ..polygon.clone()
+                        },
+                        lenmax,
+                    );
+                }
+                let apex = area_centroid(&rim);
+                let mut longest = 0.0f32;
+                for k in 0..rim.len() {
+                    let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
+                    longest = longest.max(a.distance(b)).max(apex.distance(a));
+                }
+                Plan::Fan {
+                    apex,
+                    rim,
+                    n: divisions(longest, lenmax),
+                }
+            }
+        }
+    }
+
+    fn element_count(&self) -> u64 {
+        match self {
+            Plan::Parallelogram { nu, nv, .. } | Plan::Bilinear { nu, nv, .. } => {
+                *nu as u64 * *nv as u64
+            }
+            Plan::Triangle { n, .. } => *n as u64 * *n as u64,
+            Plan::Fan { rim, n, .. } => rim.len() as u64 * *n as u64 * *n as u64,
+        }
+    }
+
+    /// Emits the vertices and elements; returns `(nu, nv, min_edge)`.
+    fn emit(&self, b: &mut PolygonBuilder) -> (u32, u32, f32) {
+        match self {
+            Plan::Parallelogram { v, nu, nv } => {
+                let (eu, ev) = (v[1] - v[0], v[3] - v[0]);
+                b.grid(*nu, *nv, |u, w| v[0] + u * eu + w * ev);
+                let min_edge = (eu.length() / *nu as f32).min(ev.length() / *nv as f32);
+                (*nu, *nv, min_edge)
+            }
+            Plan::Bilinear { v, nu, nv } => {
+                let bilinear = |u: f32, w: f32| {
+                    (1.0 - u) * (1.0 - w) * v[0] + u * (1.0 - w) * v[1] + u * w * v[2] + (1.0 - u) * w * v[3]
+                };
+                b.grid(*nu, *nv, bilinear);
+                let shortest_u = v[0].distance(v[1]).min(v[3].distance(v[2])) / *nu as f32;
+                let shortest_v = v[0].distance(v[3]).min(v[1].distance(v[2])) / *nv as f32;
+                (*nu, *nv, shortest_u.min(shortest_v))
+            }
+            Plan::Triangle { v, n } => {
+                b.triangle(*n, v[0], v[1], v[2]);
+                let shortest = v[0].distance(v[1]).min(v[1].distance(v[2])).min(v[2].distance(v[0]));
+                (*n, *n, shortest / *n as f32)
+            }
+            Plan::Fan { apex, rim, n } => {
+                b.fan(*n, *apex, rim);
+                let mut shortest = f32::INFINITY;
+                for k in 0..rim.len() {
+                    let (a, c) = (rim[k], rim[(k + 1) % rim.len()]);
+                    shortest = shortest.min(a.distance(c)).min(apex.distance(a));
+                }
+                (*n, *n, shortest / *n as f32)
+            }
+        }
+    }
+}
+
+/// Appends one polygon's vertices and elements to the mesh.
+struct PolygonBuilder<'a> {
+    mesh: &'a mut Mesh,
+    polygon: PolygonId,
+    first_vertex: u32,
+}
+
+impl PolygonBuilder<'_> {
+    fn vertex(&mut self, p: Vec3) -> VertexId {
+        let id = VertexId(self.mesh.positions.len() as u32);
+        self.mesh.positions.push(p);
+        self.mesh.vertex_polygon.push(self.polygon);
+        id
+    }
+
+    fn element(&mut self, e: Element) {
+        self.mesh.elements.push(e);
+        self.mesh.element_polygon.push(self.polygon);
+    }
+
+    /// A `(nu + 1) × (nv + 1)` grid of vertices at `at(a / nu, b / nv)`,
+    /// with the `u` index running fastest, and its `nu × nv` quads.
+    fn grid(&mut self, nu: u32, nv: u32, at: impl Fn(f32, f32) -> Vec3) {
+        for b in 0..=nv {
+            for a in 0..=nu {
+                self.vertex(at(a as f32 / nu as f32, b as f32 / nv as f32));
+            }
+        }
+        let first = self.first_vertex;
+        let id = |a: u32, b: u32| VertexId(first + b * (nu + 1) + a);
+        for b in 0..nv {
+            for a in 0..nu {
+                let e = Element::quad(id(a, b), id(a + 1, b), id(a + 1, b + 1), id(a, b + 1));
+                self.element(e);
+            }
+        }
+    }
+
+    /// The regular subdivision of one triangle: vertices at
+    /// `v0 + (i/n)(v1 − v0) + (j/n)(v2 − v0)` for `i + j <= n`.
+    fn triangle(&mut self, n: u32, v0: Vec3, v1: Vec3, v2: Vec3) {
+        let (e1, e2) = (v1 - v0, v2 - v0);
+        let mut ids = HashMap::new();
+        for j in 0..=n {
+            for i in 0..=(n - j) {
+                let p = v0 + (i as f32 / n as f32) * e1 + (j as f32 / n as f32) * e2;
+                ids.insert((i, j), self.vertex(p));
+            }
+        }
+        self.subdivide(n, |i, j| ids[&(i, j)]);
+    }
+
+    /// Emits the `n²` elements of a subdivided triangle whose lattice
+    /// point `(i, j)` is the vertex `id(i, j)`.
+    fn subdivide(&mut self, n: u32, id: impl Fn(u32, u32) -> VertexId) {
+        for j in 0..n {
+            for i in 0..(n - j) {
+                self.element(Element::triangle(id(i, j), id(i + 1, j), id(i, j + 1)));
+                if i + j + 1 < n {
+                    self.element(Element::triangle(id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)));
+                }
+            }
+        }
+    }
+
+    /// A fan of subdivided triangles `(apex, rim[k], rim[k+1])`. Points on
+    /// the spokes `apex → rim[k]` are shared by the two triangles that
+    /// meet there, and computed once from the spoke so they are identical.
+    fn fan(&mut self, n: u32, apex: Vec3, rim: &[Vec3]) {
+        #[derive(Hash, PartialEq, Eq, Clone, Copy)]
+        enum Key {
+            Apex,
+            Spoke(usize, u32),
+            Inner(usize, u32, u32),
+        }
+        let m = rim.len();
+        let mut ids: HashMap<Key, VertexId> = HashMap::new();
+        let key = |k: usize, i: u32, j: u32| match (i, j) {
+            (0, 0) => Key::Apex,
+            (_, 0) => Key::Spoke(k, i),
+            (0, _) => Key::Spoke((k + 1) % m, j),
+            _ => Key::Inner(k, i, j),
+        };
+        for k in 0..m {
+            let (a, c) = (rim[k], rim[(k + 1) % m]);
+            for j in 0..=n {
+                for i in 0..=(n - j) {
+                    let kk = key(k, i, j);
+                    if ids.contains_key(&kk) {
+                        continue;
+                    }
+                    let p = match kk {
+                        Key::Apex => apex,
+                        Key::Spoke(s, t) => apex + (t as f32 / n as f32) * (rim[s] - apex),
+                        Key::Inner(..) => {
+                            apex + (i as f32 / n as f32) * (a - apex) + (j as f32 / n as f32) * (c - apex)
+                        }
+                    };
+                    let id = self.vertex(p);
+                    ids.insert(kk, id);
+                }
+            }
+            self.subdivide(n, |i, j| ids[&key(k, i, j)]);
+        }
+    }
+}
+
+/// The vertices of a convex polygon without those collinear with their
+/// neighbours (which would make zero-area fan triangles).
+fn drop_collinear(v: &[Vec3]) -> Vec<Vec3> {
+    let n = v.len();
+    let kept: Vec<Vec3> = (0..n)
+        .filter(|&k| {
+            let prev = v[(k + n - 1) % n].as_dvec3();
+            let here = v[k].as_dvec3();
+            let next = v[(k + 1) % n].as_dvec3();
+            let (a, b) = (here - prev, next - here);
+            a.cross(b).length() > COLLINEAR_TOLERANCE * a.length() * b.length()
+        })
+        .map(|k| v[k])
+        .collect();
+    if kept.len() >= 3 {
+        kept
+    } else {
+        v.to_vec()
+    }
+}
+
+/// Area centroid of a planar convex polygon (inside it, unlike the vertex
+/// mean's failure cases it is robust to uneven vertex spacing).
+fn area_centroid(v: &[Vec3]) -> Vec3 {
+    let origin = v[0].as_dvec3();
+    let mut weighted = DVec3::ZERO;
+    let mut total = 0.0;
+    let normal = {
+        let mut n = DVec3::ZERO;
+        for k in 0..v.len() {
+            n += v[k].as_dvec3().cross(v[(k + 1) % v.len()].as_dvec3());
+        }
+        n.normalize_or_zero()
+    };
+    for k in 1..v.len() - 1 {
+        let (a, b) = (v[k].as_dvec3(), v[k + 1].as_dvec3());
+        let area = (a - origin).cross(b - origin).dot(normal) * 0.5;
+        weighted += (origin + a + b) / 3.0 * area;
+        total += area;
+    }
+    if total > 0.0 {
+        (weighted / total).as_vec3()
+    } else {
+        v.iter().copied().sum::<Vec3>() / v.len() as f32
+    }
+}
+
+/// Evaluation points of one polygon's vertices: each vertex that lies on a
+/// polygon edge moves `distance` along that edge's inward normal (a corner
+/// vertex moves along both).
+fn inset_positions<'a>(
+    polygon: &'a Polygon,
+    positions: &'a [Vec3],
+    distance: f32,
+) -> impl Iterator<Item = Vec3> + 'a {
+    let v = &polygon.vertices;
+    let extent = polygon
+        .vertices
+        .iter()
+        .flat_map(|a| v.iter().map(move |b| a.distance(*b)))
+        .fold(0.0f32, f32::max);
+    let tolerance = ON_EDGE_TOLERANCE * extent;
+    let edges: Vec<(Vec3, Vec3, Vec3)> = (0..v.len())
+        .filter_map(|k| {
+            let (a, b) = (v[k], v[(k + 1) % v.len()]);
+            let dir = (b - a).normalize_or_zero();
+            // For a counter-clockwise polygon, normal × edge points inside.
+            let inward = polygon.normal.cross(dir).normalize_or_zero();
+            (dir != Vec3::ZERO).then_some((a, dir, inward))
+        })
+        .collect();
+    positions.iter().map(move |&p| {
+        if distance == 0.0 {
+            return p;
+        }
+        let mut moved = p;
+        for &(a, dir, inward) in &edges {
+            let rel = p - a;
+            let off_line = rel - rel.dot(dir) * dir;
+            if off_line.length() <= tolerance {
+                moved += inward * distance;
+            }
+        }
+        moved
+    })
+}
+
 impl Mesh {
     /// Number of element vertices.
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
+    }
+
+    /// Area of an element in square scene units (exact for planar
+    /// triangles and quads).
+    pub fn element_area(&self, e: &Element) -> f64 {
+        e.triangles()
+            .map(|[a, b, c]| {
+                let (a, b, c) = (
+                    self.positions[a.index()].as_dvec3(),
+                    self.positions[b.index()].as_dvec3(),
+                    self.positions[c.index()].as_dvec3(),
+                );
+                (b - a).cross(c - a).length() * 0.5
+            })
+            .sum()
+    }
+
+    /// The area each vertex stands for: every element gives an equal share
+    /// of its area to each of its corners. Sums to the polygon's area over
+    /// the polygon's vertices, so `Σ area × radiosity` is a polygon's power.
+    pub fn vertex_areas(&self) -> Vec<f64> {
+        let mut areas = vec![0.0; self.vertex_count()];
+        for e in &self.elements {
+            let share = self.element_area(e) / e.corners().len() as f64;
+            for c in e.corners() {
+                areas[c.index()] += share;
+            }
+        }
+        areas
+    }
+
+    /// Checks the structural invariants; returns the first broken one.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.vertex_count();
+        if self.sample_positions.len() != n || self.vertex_polygon.len() != n {
+            return Err("per-vertex arrays differ in length".into());
+        }
+        if self.element_polygon.len() != self.elements.len() {
+            return Err("per-element arrays differ in length".into());
+        }
+        let (mut next_v, mut next_e) = (0u32, 0u32);
+        for (index, pm) in self.polygons.iter().enumerate() {
+            let id = PolygonId(index as u32);
+            if pm.vertices.start != next_v || pm.elements.start != next_e {
+                return Err(format!("polygon {index}: ranges are not contiguous"));
+            }
+            next_v = pm.vertices.end;
+            next_e = pm.elements.end;
+            for v in pm.vertices.clone() {
+                if self.vertex_polygon[v as usize] != id {
+                    return Err(format!("vertex {v} is not marked as polygon {index}'s"));
+                }
+            }
+            for e in pm.elements.clone() {
+                if self.element_polygon[e as usize] != id {
+                    return Err(format!("element {e} is not marked as polygon {index}'s"));
+                }
+                for c in self.elements[e as usize].corners() {
+                    if !pm.vertices.contains(&c.0) {
+                        return Err(format!("element {e} uses vertex {} of another polygon", c.0));
+                    }
+                }
+            }
+        }
+        if next_v as usize != n || next_e as usize != self.elements.len() {
+            return Err("polygon ranges do not cover the arrays".into());
+        }
+        if self.positions.iter().chain(&self.sample_positions).any(|p| !p.is_finite()) {
+            return Err("a vertex position is not finite".into());
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Rgb;
+    use crate::scene::{Camera, CameraSource, Material, MaterialId, SourcePos};
+
+    /// A polygon built without the parser: Newell normal and area.
+    fn polygon(vertices: &[[f32; 3]], shape: Shape) -> Polygon {
+        let v: Vec<Vec3> = vertices.iter().map(|a| Vec3::from_array(*a)).collect();
+        let mut n = DVec3::ZERO;
+        for k in 0..v.len() {
+            n += v[k].as_dvec3().cross(v[(k + 1) % v.len()].as_dvec3());
+        }
+        Polygon {
+            material: MaterialId(0),
+            vertices: v,
+            normal: n.normalize().as_vec3(),
+            area: n.length() * 0.5,
+            shape,
+            origin: SourcePos::default(),
+        }
+    }
+
+    fn scene(polygons: Vec<Polygon>) -> Scene {
+        Scene {
+            polygons,
+            materials: vec![Material {
+                name: "m".into(),
+                color: Rgb::WHITE,
+                k_diffrefl: 0.5,
+                k_emission: 0.0,
+            }],
+            camera: Camera {
+                eye: Vec3::new(0.0, 0.0, 5.0),
+                lookat: Vec3::ZERO,
+                up: Vec3::Y,
+                fov_y: 1.0,
+                width: 8,
+                height: 8,
+            },
+            camera_source: CameraSource::File,
+        }
+    }
+
+    fn all_shapes() -> Vec<Polygon> {
+        vec![
+            polygon(&[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]], Shape::Parallelogram),
+            polygon(&[[0., 0., 1.], [2., 0., 1.], [1.5, 1., 1.], [0.2, 1.3, 1.]], Shape::Quad),
+            polygon(&[[0., 0., 2.], [1., 0., 2.], [0.3, 1.7, 2.]], Shape::Triangle),
+            polygon(
+                &[[1., 0., 3.], [0.5, 0.87, 3.], [-0.5, 0.87, 3.], [-1., 0., 3.], [-0.5, -0.87, 3.], [0.5, -0.87, 3.]],
+                Shape::Convex,
+            ),
+            // A pentagon with a collinear vertex (allowed by the format).
+            polygon(&[[0., 0., 4.], [1., 0., 4.], [2., 0., 4.], [2., 1., 4.], [0., 1., 4.]], Shape::Convex),
+        ]
+    }
+
+    fn opts(lenmax: f32, inset: f32) -> MeshOptions {
+        MeshOptions { lenmax, inset }
+    }
+
+    #[test]
+    fn parallelogram_grid_counts() {
+        let s = scene(vec![all_shapes().remove(0)]);
+        let m = build(&s, &opts(0.3, 0.0)).unwrap();
+        let pm = &m.polygons[0];
+        assert_eq!((pm.nu, pm.nv), (7, 4)); // ⌊2/0.3⌋+1, ⌊1/0.3⌋+1
+        assert_eq!(m.vertex_count(), 8 * 5);
+        assert_eq!(m.elements.len(), 28);
+        m.validate().unwrap();
+    }
+
+    #[test]
+    fn exact_multiple_of_lenmax_still_gives_shorter_edges() {
+        let s = scene(vec![all_shapes().remove(0)]);
+        let m = build(&s, &opts(0.5, 0.0)).unwrap();
+        assert_eq!((m.polygons[0].nu, m.polygons[0].nv), (5, 3));
+    }
+
+    #[test]
+    fn triangle_subdivision_counts() {
+        let s = scene(vec![all_shapes().remove(2)]);
+        let m = build(&s, &opts(0.25, 0.0)).unwrap();
+        let n = m.polygons[0].nu as usize;
+        assert!(n >= 2);
+        assert_eq!(m.vertex_count(), (n + 1) * (n + 2) / 2);
+        assert_eq!(m.elements.len(), n * n);
+    }
+
+    #[test]
+    fn every_edge_is_shorter_than_lenmax() {
+        for lenmax in [0.07f32, 0.2, 0.33, 1.0, 5.0] {
+            let m = build(&scene(all_shapes()), &opts(lenmax, 0.0)).unwrap();
+            for e in &m.elements {
+                let c = e.corners();
+                for k in 0..c.len() {
+                    let (a, b) = (m.positions[c[k].index()], m.positions[c[(k + 1) % c.len()].index()]);
+                    assert!(a.distance(b) < lenmax, "edge {} >= lenmax {lenmax}", a.distance(b));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn element_areas_sum_to_polygon_area() {
+        let s = scene(all_shapes());
+        let m = build(&s, &opts(0.13, 0.0)).unwrap();
+        for (p, pm) in s.polygons.iter().zip(&m.polygons) {
+            let sum: f64 = pm.elements.clone().map(|e| m.element_area(&m.elements[e as usize])).sum();
+            assert!((sum - p.area).abs() < 1e-5 * p.area, "{sum} vs {}", p.area);
+        }
+        let shares = m.vertex_areas();
+        for (p, pm) in s.polygons.iter().zip(&m.polygons) {
+            let sum: f64 = pm.vertices.clone().map(|v| shares[v as usize]).sum();
+            assert!((sum - p.area).abs() < 1e-5 * p.area);
+        }
+    }
+
+    #[test]
+    fn elements_face_the_polygons_front() {
+        let s = scene(all_shapes());
+        let m = build(&s, &opts(0.2, 0.0)).unwrap();
+        for (e, p) in m.elements.iter().zip(&m.element_polygon) {
+            for [a, b, c] in e.triangles() {
+                let (a, b, c) = (m.positions[a.index()], m.positions[b.index()], m.positions[c.index()]);
+                let n = (b - a).cross(c - a);
+                assert!(n.dot(s.polygons[p.index()].normal) > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn vertices_are_shared_not_duplicated() {
+        let s = scene(all_shapes());
+        let m = build(&s, &opts(0.2, 0.0)).unwrap();
+        m.validate().unwrap();
+        for pm in &m.polygons {
+            let vs = &m.positions[pm.vertices.start as usize..pm.vertices.end as usize];
+            for (i, a) in vs.iter().enumerate() {
+                for b in &vs[i + 1..] {
+                    assert!(a.distance(*b) > 1e-6, "duplicate vertex at {a}");
+                }
+            }
+            // Every vertex is a corner of some element.
+            let mut used = vec![false; vs.len()];
+            for e in pm.elements.clone() {
+                for c in m.elements[e as usize].corners() {
+                    used[(c.0 - pm.vertices.start) as usize] = true;
+                }
+            }
+            assert!(used.iter().all(|&u| u));
+        }
+        // Interior vertices of a quad grid are shared by four elements.
+        let pm = &m.polygons[0];
+        let mut uses = vec![0; pm.vertex_count() as usize];
+        for e in pm.elements.clone() {
+            for c in m.elements[e as usize].corners() {
+                uses[c.index()] += 1;
+            }
+        }
+        let corner_uses = uses.iter().filter(|&&u| u == 1).count();
+        let interior_uses = uses.iter().filter(|&&u| u == 4).count();
+        assert_eq!(corner_uses, 4);
+        assert_eq!(interior_uses, ((pm.nu - 1) * (pm.nv - 1)) as usize);
+    }
+
+    #[test]
+    fn inset_moves_boundary_vertices_inward_only() {
+        let s = scene(vec![all_shapes().remove(0)]);
+        let m = build(&s, &opts(0.5, 0.1)).unwrap();
+        let d = 0.1 * m.polygons[0].min_edge;
+        for (p, q) in m.positions.iter().zip(&m.sample_positions) {
+            let on_x_edge = p.x == 0.0 || p.x == 2.0;
+            let on_y_edge = p.y == 0.0 || p.y == 1.0;
+            let expect_dx = if p.x == 0.0 { d } else if p.x == 2.0 { -d } else { 0.0 };
+            let expect_dy = if p.y == 0.0 { d } else if p.y == 1.0 { -d } else { 0.0 };
+            assert!((q.x - p.x - expect_dx).abs() < 1e-6, "{p} -> {q}");
+            assert!((q.y - p.y - expect_dy).abs() < 1e-6, "{p} -> {q}");
+            assert_eq!(q.z, p.z);
+            if !on_x_edge && !on_y_edge {
+                assert_eq!(p, q);
+            }
+        }
+        // The corner at the origin moved diagonally.
+        assert!((m.sample_positions[0] - Vec3::new(d, d, 0.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn zero_inset_leaves_samples_on_the_vertices() {
+        let m = build(&scene(all_shapes()), &opts(0.3, 0.0)).unwrap();
+        assert_eq!(m.positions, m.sample_positions);
+    }
+
+    #[test]
+    fn inset_samples_stay_inside_the_polygon() {
+        let s = scene(all_shapes());
+        let m = build(&s, &opts(0.3, DEFAULT_INSET)).unwrap();
+        for (q, pid) in m.sample_positions.iter().zip(&m.vertex_polygon) {
+            let p = &s.polygons[pid.index()];
+            let v = &p.vertices;
+            for k in 0..v.len() {
+                let edge = v[(k + 1) % v.len()] - v[k];
+                let inward = p.normal.cross(edge);
+                assert!(inward.dot(*q - v[k]) > 0.0, "sample {q} is not strictly inside");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_options_and_huge_meshes_are_refused() {
+        let s = scene(all_shapes());
+        assert!(matches!(build(&s, &opts(0.0, 0.0)), Err(MeshError::BadLenmax(_))));
+        assert!(matches!(build(&s, &opts(f32::NAN, 0.0)), Err(MeshError::BadLenmax(_))));
+        assert!(matches!(build(&s, &opts(1.0, 0.6)), Err(MeshError::BadInset(_))));
+        match build(&s, &opts(1e-5, 0.0)) {
+            Err(MeshError::TooManyElements { suggested, .. }) => {
+                let m = build(&s, &opts(suggested, 0.0)).unwrap();
+                assert!(m.elements.len() as u64 <= MAX_ELEMENTS);
+            }
+            other => panic!("expected TooManyElements, got {other:?}"),
+        }
     }
 }
