@@ -5,3 +5,8 @@ pub mod mesh;
 pub mod output;
 pub mod render;
 pub mod scene;
+pub mod solver;
+pub mod visibility;
+
+#[cfg(test)]
+mod testutil;

@@ -251,8 +251,11 @@ pub fn build(scene: &Scene, options: &MeshOptions) -> Result<Mesh, MeshError> {
         };
         let (nu, nv, min_edge) = plan.emit(&mut builder);
         let v_end = mesh.positions.len() as u32;
-        mesh.sample_positions
-            .extend(inset_positions(polygon, &mesh.positions[v_start as usize..], options.inset * min_edge));
+        mesh.sample_positions.extend(inset_positions(
+            polygon,
+            &mesh.positions[v_start as usize..],
+            options.inset * min_edge,
+        ));
         mesh.polygons.push(PolygonMesh {
             nu,
             nv,
@@ -312,7 +315,10 @@ impl Plan {
             }
             Shape::Triangle => {
                 let t = [v[0], v[1], v[2]];
-                let longest = t[0].distance(t[1]).max(t[1].distance(t[2])).max(t[2].distance(t[0]));
+                let longest = t[0]
+                    .distance(t[1])
+                    .max(t[1].distance(t[2]))
+                    .max(t[2].distance(t[0]));
                 Plan::Triangle {
                     v: t,
                     n: divisions(longest, lenmax),
@@ -366,7 +372,10 @@ impl Plan {
             }
             Plan::Bilinear { v, nu, nv } => {
                 let bilinear = |u: f32, w: f32| {
-                    (1.0 - u) * (1.0 - w) * v[0] + u * (1.0 - w) * v[1] + u * w * v[2] + (1.0 - u) * w * v[3]
+                    (1.0 - u) * (1.0 - w) * v[0]
+                        + u * (1.0 - w) * v[1]
+                        + u * w * v[2]
+                        + (1.0 - u) * w * v[3]
                 };
                 b.grid(*nu, *nv, bilinear);
                 let shortest_u = v[0].distance(v[1]).min(v[3].distance(v[2])) / *nu as f32;
@@ -375,7 +384,10 @@ impl Plan {
             }
             Plan::Triangle { v, n } => {
                 b.triangle(*n, v[0], v[1], v[2]);
-                let shortest = v[0].distance(v[1]).min(v[1].distance(v[2])).min(v[2].distance(v[0]));
+                let shortest = v[0]
+                    .distance(v[1])
+                    .min(v[1].distance(v[2]))
+                    .min(v[2].distance(v[0]));
                 (*n, *n, shortest / *n as f32)
             }
             Plan::Fan { apex, rim, n } => {
@@ -450,7 +462,11 @@ impl PolygonBuilder<'_> {
             for i in 0..(n - j) {
                 self.element(Element::triangle(id(i, j), id(i + 1, j), id(i, j + 1)));
                 if i + j + 1 < n {
-                    self.element(Element::triangle(id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)));
+                    self.element(Element::triangle(
+                        id(i + 1, j),
+                        id(i + 1, j + 1),
+                        id(i, j + 1),
+                    ));
                 }
             }
         }
@@ -486,7 +502,8 @@ impl PolygonBuilder<'_> {
                         Key::Apex => apex,
                         Key::Spoke(s, t) => apex + (t as f32 / n as f32) * (rim[s] - apex),
                         Key::Inner(..) => {
-                            apex + (i as f32 / n as f32) * (a - apex) + (j as f32 / n as f32) * (c - apex)
+                            apex + (i as f32 / n as f32) * (a - apex)
+                                + (j as f32 / n as f32) * (c - apex)
                         }
                     };
                     let id = self.vertex(p);
@@ -500,7 +517,7 @@ impl PolygonBuilder<'_> {
 
 /// The vertices of a convex polygon without those collinear with their
 /// neighbours (which would make zero-area fan triangles).
-fn drop_collinear(v: &[Vec3]) -> Vec<Vec3> {
+pub(crate) fn drop_collinear(v: &[Vec3]) -> Vec<Vec3> {
     let n = v.len();
     let kept: Vec<Vec3> = (0..n)
         .filter(|&k| {
@@ -521,7 +538,7 @@ fn drop_collinear(v: &[Vec3]) -> Vec<Vec3> {
 
 /// Area centroid of a planar convex polygon (inside it, unlike the vertex
 /// mean's failure cases it is robust to uneven vertex spacing).
-fn area_centroid(v: &[Vec3]) -> Vec3 {
+pub(crate) fn area_centroid(v: &[Vec3]) -> Vec3 {
     let origin = v[0].as_dvec3();
     let mut weighted = DVec3::ZERO;
     let mut total = 0.0;
@@ -648,7 +665,10 @@ impl Mesh {
                 }
                 for c in self.elements[e as usize].corners() {
                     if !pm.vertices.contains(&c.0) {
-                        return Err(format!("element {e} uses vertex {} of another polygon", c.0));
+                        return Err(format!(
+                            "element {e} uses vertex {} of another polygon",
+                            c.0
+                        ));
                     }
                 }
             }
@@ -656,7 +676,12 @@ impl Mesh {
         if next_v as usize != n || next_e as usize != self.elements.len() {
             return Err("polygon ranges do not cover the arrays".into());
         }
-        if self.positions.iter().chain(&self.sample_positions).any(|p| !p.is_finite()) {
+        if self
+            .positions
+            .iter()
+            .chain(&self.sample_positions)
+            .any(|p| !p.is_finite())
+        {
             return Err("a vertex position is not finite".into());
         }
         Ok(())
@@ -709,15 +734,40 @@ mod tests {
 
     fn all_shapes() -> Vec<Polygon> {
         vec![
-            polygon(&[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]], Shape::Parallelogram),
-            polygon(&[[0., 0., 1.], [2., 0., 1.], [1.5, 1., 1.], [0.2, 1.3, 1.]], Shape::Quad),
-            polygon(&[[0., 0., 2.], [1., 0., 2.], [0.3, 1.7, 2.]], Shape::Triangle),
             polygon(
-                &[[1., 0., 3.], [0.5, 0.87, 3.], [-0.5, 0.87, 3.], [-1., 0., 3.], [-0.5, -0.87, 3.], [0.5, -0.87, 3.]],
+                &[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]],
+                Shape::Parallelogram,
+            ),
+            polygon(
+                &[[0., 0., 1.], [2., 0., 1.], [1.5, 1., 1.], [0.2, 1.3, 1.]],
+                Shape::Quad,
+            ),
+            polygon(
+                &[[0., 0., 2.], [1., 0., 2.], [0.3, 1.7, 2.]],
+                Shape::Triangle,
+            ),
+            polygon(
+                &[
+                    [1., 0., 3.],
+                    [0.5, 0.87, 3.],
+                    [-0.5, 0.87, 3.],
+                    [-1., 0., 3.],
+                    [-0.5, -0.87, 3.],
+                    [0.5, -0.87, 3.],
+                ],
                 Shape::Convex,
             ),
             // A pentagon with a collinear vertex (allowed by the format).
-            polygon(&[[0., 0., 4.], [1., 0., 4.], [2., 0., 4.], [2., 1., 4.], [0., 1., 4.]], Shape::Convex),
+            polygon(
+                &[
+                    [0., 0., 4.],
+                    [1., 0., 4.],
+                    [2., 0., 4.],
+                    [2., 1., 4.],
+                    [0., 1., 4.],
+                ],
+                Shape::Convex,
+            ),
         ]
     }
 
@@ -760,8 +810,15 @@ mod tests {
             for e in &m.elements {
                 let c = e.corners();
                 for k in 0..c.len() {
-                    let (a, b) = (m.positions[c[k].index()], m.positions[c[(k + 1) % c.len()].index()]);
-                    assert!(a.distance(b) < lenmax, "edge {} >= lenmax {lenmax}", a.distance(b));
+                    let (a, b) = (
+                        m.positions[c[k].index()],
+                        m.positions[c[(k + 1) % c.len()].index()],
+                    );
+                    assert!(
+                        a.distance(b) < lenmax,
+                        "edge {} >= lenmax {lenmax}",
+                        a.distance(b)
+                    );
                 }
             }
         }
@@ -772,7 +829,11 @@ mod tests {
         let s = scene(all_shapes());
         let m = build(&s, &opts(0.13, 0.0)).unwrap();
         for (p, pm) in s.polygons.iter().zip(&m.polygons) {
-            let sum: f64 = pm.elements.clone().map(|e| m.element_area(&m.elements[e as usize])).sum();
+            let sum: f64 = pm
+                .elements
+                .clone()
+                .map(|e| m.element_area(&m.elements[e as usize]))
+                .sum();
             assert!((sum - p.area).abs() < 1e-5 * p.area, "{sum} vs {}", p.area);
         }
         let shares = m.vertex_areas();
@@ -788,7 +849,11 @@ mod tests {
         let m = build(&s, &opts(0.2, 0.0)).unwrap();
         for (e, p) in m.elements.iter().zip(&m.element_polygon) {
             for [a, b, c] in e.triangles() {
-                let (a, b, c) = (m.positions[a.index()], m.positions[b.index()], m.positions[c.index()]);
+                let (a, b, c) = (
+                    m.positions[a.index()],
+                    m.positions[b.index()],
+                    m.positions[c.index()],
+                );
                 let n = (b - a).cross(c - a);
                 assert!(n.dot(s.polygons[p.index()].normal) > 0.0);
             }
@@ -838,8 +903,20 @@ mod tests {
         for (p, q) in m.positions.iter().zip(&m.sample_positions) {
             let on_x_edge = p.x == 0.0 || p.x == 2.0;
             let on_y_edge = p.y == 0.0 || p.y == 1.0;
-            let expect_dx = if p.x == 0.0 { d } else if p.x == 2.0 { -d } else { 0.0 };
-            let expect_dy = if p.y == 0.0 { d } else if p.y == 1.0 { -d } else { 0.0 };
+            let expect_dx = if p.x == 0.0 {
+                d
+            } else if p.x == 2.0 {
+                -d
+            } else {
+                0.0
+            };
+            let expect_dy = if p.y == 0.0 {
+                d
+            } else if p.y == 1.0 {
+                -d
+            } else {
+                0.0
+            };
             assert!((q.x - p.x - expect_dx).abs() < 1e-6, "{p} -> {q}");
             assert!((q.y - p.y - expect_dy).abs() < 1e-6, "{p} -> {q}");
             assert_eq!(q.z, p.z);
@@ -867,7 +944,10 @@ mod tests {
             for k in 0..v.len() {
                 let edge = v[(k + 1) % v.len()] - v[k];
                 let inward = p.normal.cross(edge);
-                assert!(inward.dot(*q - v[k]) > 0.0, "sample {q} is not strictly inside");
+                assert!(
+                    inward.dot(*q - v[k]) > 0.0,
+                    "sample {q} is not strictly inside"
+                );
             }
         }
     }
@@ -875,9 +955,18 @@ mod tests {
     #[test]
     fn bad_options_and_huge_meshes_are_refused() {
         let s = scene(all_shapes());
-        assert!(matches!(build(&s, &opts(0.0, 0.0)), Err(MeshError::BadLenmax(_))));
-        assert!(matches!(build(&s, &opts(f32::NAN, 0.0)), Err(MeshError::BadLenmax(_))));
-        assert!(matches!(build(&s, &opts(1.0, 0.6)), Err(MeshError::BadInset(_))));
+        assert!(matches!(
+            build(&s, &opts(0.0, 0.0)),
+            Err(MeshError::BadLenmax(_))
+        ));
+        assert!(matches!(
+            build(&s, &opts(f32::NAN, 0.0)),
+            Err(MeshError::BadLenmax(_))
+        ));
+        assert!(matches!(
+            build(&s, &opts(1.0, 0.6)),
+            Err(MeshError::BadInset(_))
+        ));
         match build(&s, &opts(1e-5, 0.0)) {
             Err(MeshError::TooManyElements { suggested, .. }) => {
                 let m = build(&s, &opts(suggested, 0.0)).unwrap();

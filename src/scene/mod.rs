@@ -159,7 +159,10 @@ impl Scene {
     /// Axis-aligned bounds `(min, max)` of all vertices, in scene units.
     /// For an empty scene both are zero.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut it = self.polygons.iter().flat_map(|p| p.vertices.iter().copied());
+        let mut it = self
+            .polygons
+            .iter()
+            .flat_map(|p| p.vertices.iter().copied());
         match it.next() {
             None => (Vec3::ZERO, Vec3::ZERO),
             Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),

@@ -1,0 +1,421 @@
+//! Form factors from a shooting polygon to a receiving point, after
+//! Wallace, Elmquist and Haines (SIGGRAPH '89).
+//!
+//! The shooter is represented by sample points `k`, each standing for an
+//! area `a_k` of it. The form factor from a differential area at a receiver
+//! point `x` to the shooter is estimated as
+//!
+//! ```text
+//! F ≈ Σ_k  v_k · cosθ_i cosθ_j · a_k / (π r² + a_k)
+//! ```
+//!
+//! the exact form factor of a disc of area `a_k` seen head-on, applied to
+//! each sample. With equal areas `a_k = A_i / n_i` this is the textbook
+//! `cosθ_i cosθ_j / (1 + π n_i r² / A_i)`; the `+ a_k` keeps it bounded
+//! (never above 1 per sample) when a receiver is close to the shooter.
+//! A negative cosine counts as occluded and casts no ray.
+//!
+//! **Near field.** The disc approximation assumes the receiver is far
+//! compared with the sample's size. Where a receiver is within
+//! [`NEAR_FIELD_RATIO`] cell diameters of a grid sample (two walls meeting
+//! at a corner, a lamp just below the ceiling), the sample's term is
+//! replaced by the exact form factor from the point to the sample's cell
+//! (Lambert's contour integral over the cell clipped to the receiver's
+//! front half-space), still times the one ray's visibility. Far from every
+//! cell nothing changes. Without it the form factor between two unit
+//! squares sharing an edge comes out 8 % low at 64 samples, and a closed
+//! room loses that much energy at every bounce.
+
+use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
+use crate::scene::{Polygon, Shape};
+use glam::{DVec3, Vec3};
+use std::f64::consts::PI;
+
+/// A receiver closer to a grid sample than this many cell diameters gets
+/// the exact point-to-cell form factor instead of the disc approximation.
+/// At three diameters the disc sum is close enough that a closed box
+/// balances its energy within 1 % (two gave 1.1 %).
+pub const NEAR_FIELD_RATIO: f32 = 3.0;
+
+/// A point of a shooting polygon and the area it stands for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShooterSample {
+    /// Position on the shooter, in scene units.
+    pub position: Vec3,
+    /// Area it stands for, in square scene units; the samples of one
+    /// shooter sum to its area.
+    pub area: f64,
+    /// The cell it stands for (3 or 4 corners, counter-clockwise from the
+    /// front; a triangle repeats its last corner), for grid samples.
+    pub cell: Option<[Vec3; 4]>,
+    /// Squared distance within which the near-field form factor is used,
+    /// in square scene units (0 without a cell).
+    pub near_r2: f32,
+}
+
+impl ShooterSample {
+    /// A sample without a cell: always the disc approximation.
+    pub fn point(position: Vec3, area: f64) -> Self {
+        ShooterSample {
+            position,
+            area,
+            cell: None,
+            near_r2: 0.0,
+        }
+    }
+
+    /// A sample at the centre of a cell.
+    pub fn cell(position: Vec3, area: f64, cell: [Vec3; 4]) -> Self {
+        let diameter2 = cell[0]
+            .distance_squared(cell[2])
+            .max(cell[1].distance_squared(cell[3]));
+        ShooterSample {
+            position,
+            area,
+            cell: Some(cell),
+            near_r2: NEAR_FIELD_RATIO * NEAR_FIELD_RATIO * diameter2,
+        }
+    }
+}
+
+/// Which points of a shooter carry its power.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleSet {
+    /// Its element vertices (evaluation positions), each standing for
+    /// `A / n`: the scheme of the original algorithm.
+    Vertices,
+    /// A regular grid of at most this many points over the polygon, each
+    /// at the centre of its cell and standing for that cell's area. Used
+    /// only when the polygon has more element vertices than this.
+    AtMost(u32),
+    /// One point at the area centroid standing for the whole polygon: the
+    /// cheap point-to-disc approximation.
+    Centre,
+}
+
+/// The shooter samples of one polygon.
+pub fn shooter_samples(
+    polygon: &Polygon,
+    pm: &PolygonMesh,
+    mesh: &Mesh,
+    set: SampleSet,
+) -> Vec<ShooterSample> {
+    match set {
+        SampleSet::Centre => vec![ShooterSample::point(
+            area_centroid(&polygon.vertices),
+            polygon.area,
+        )],
+        SampleSet::AtMost(n) if pm.vertex_count() > n.max(1) => grid_samples(polygon, n.max(1)),
+        SampleSet::Vertices | SampleSet::AtMost(_) => {
+            let each = polygon.area / pm.vertex_count() as f64;
+            mesh.sample_positions[pm.vertices.start as usize..pm.vertices.end as usize]
+                .iter()
+                .map(|&position| ShooterSample::point(position, each))
+                .collect()
+        }
+    }
+}
+
+/// At most `n` (`>= 1`) cell-centre samples over a polygon.
+fn grid_samples(polygon: &Polygon, n: u32) -> Vec<ShooterSample> {
+    let v = &polygon.vertices;
+    match polygon.shape {
+        Shape::Parallelogram | Shape::Quad => {
+            // Cells about square: su / sv follows the polygon's aspect.
+            let lu = v[0]
+                .distance(v[1])
+                .max(v[3].distance(v[2]))
+                .max(f32::MIN_POSITIVE);
+            let lv = v[0]
+                .distance(v[3])
+                .max(v[1].distance(v[2]))
+                .max(f32::MIN_POSITIVE);
+            let su = ((n as f32 * lu / lv).sqrt().round() as u32).clamp(1, n);
+            let sv = (n / su).max(1);
+            let at = |u: f32, w: f32| {
+                (1.0 - u) * (1.0 - w) * v[0]
+                    + u * (1.0 - w) * v[1]
+                    + u * w * v[2]
+                    + (1.0 - u) * w * v[3]
+            };
+            let mut samples = Vec::with_capacity((su * sv) as usize);
+            for b in 0..sv {
+                for a in 0..su {
+                    let (u0, u1) = (a as f32 / su as f32, (a + 1) as f32 / su as f32);
+                    let (w0, w1) = (b as f32 / sv as f32, (b + 1) as f32 / sv as f32);
+                    let corners = [at(u0, w0), at(u1, w0), at(u1, w1), at(u0, w1)];
+                    let area = triangle_area(corners[0], corners[1], corners[2])
+                        + triangle_area(corners[0], corners[2], corners[3]);
+                    samples.push(ShooterSample::cell(
+                        at((u0 + u1) * 0.5, (w0 + w1) * 0.5),
+                        area,
+                        corners,
+                    ));
+                }
+            }
+            normalise_areas(&mut samples, polygon.area);
+            samples
+        }
+        Shape::Triangle => {
+            let m = ((n as f64).sqrt() as u32).max(1);
+            triangle_cells(v[0], v[1], v[2], m)
+        }
+        Shape::Convex => {
+            let rim = drop_collinear(v);
+            let apex = area_centroid(&rim);
+            let m = ((n as f64 / rim.len() as f64).sqrt() as u32).max(1);
+            let mut samples: Vec<ShooterSample> = (0..rim.len())
+                .flat_map(|k| triangle_cells(apex, rim[k], rim[(k + 1) % rim.len()], m))
+                .collect();
+            normalise_areas(&mut samples, polygon.area);
+            samples
+        }
+    }
+}
+
+/// Centroids of the `m²` congruent triangles of the regular subdivision of
+/// a triangle, each standing for `1/m²` of its area.
+fn triangle_cells(v0: Vec3, v1: Vec3, v2: Vec3, m: u32) -> Vec<ShooterSample> {
+    let area = triangle_area(v0, v1, v2) / (m * m) as f64;
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    let at = |i: f32, j: f32| v0 + (i / m as f32) * e1 + (j / m as f32) * e2;
+    let mut samples = Vec::with_capacity((m * m) as usize);
+    for j in 0..m {
+        for i in 0..(m - j) {
+            let (fi, fj) = (i as f32, j as f32);
+            let (a, b, c) = (at(fi, fj), at(fi + 1.0, fj), at(fi, fj + 1.0));
+            samples.push(ShooterSample::cell((a + b + c) / 3.0, area, [a, b, c, c]));
+            if i + j + 1 < m {
+                let d = at(fi + 1.0, fj + 1.0);
+                samples.push(ShooterSample::cell((b + d + c) / 3.0, area, [b, d, c, c]));
+            }
+        }
+    }
+    samples
+}
+
+fn triangle_area(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+    (b.as_dvec3() - a.as_dvec3())
+        .cross(c.as_dvec3() - a.as_dvec3())
+        .length()
+        * 0.5
+}
+
+/// Scales the sample areas to sum to exactly `total` (the polygon's area
+/// from the scene), removing `f32` rounding in the cell corners.
+fn normalise_areas(samples: &mut [ShooterSample], total: f64) {
+    let sum: f64 = samples.iter().map(|s| s.area).sum();
+    if sum > 0.0 {
+        for s in samples {
+            s.area *= total / sum;
+        }
+    }
+}
+
+/// The form factor from a differential area at `x` (unit normal `nx`) to a
+/// shooter (unit normal `ns`) represented by `samples`, and the number of
+/// shadow rays cast. `occluded(sample, x)` answers visibility; it is asked
+/// only for samples that can contribute. `near_field` enables the exact
+/// near-field term (see the module docs).
+#[inline]
+pub fn point_to_samples(
+    x: Vec3,
+    nx: Vec3,
+    ns: Vec3,
+    samples: &[ShooterSample],
+    near_field: bool,
+    mut occluded: impl FnMut(Vec3) -> bool,
+) -> (f64, u64) {
+    let mut sum = 0.0f64;
+    let mut rays = 0u64;
+    for s in samples {
+        let d = x - s.position;
+        let r2 = d.length_squared();
+        let cos_s = ns.dot(d);
+        let cos_x = -nx.dot(d);
+        if cos_s < 0.0 || r2 <= 0.0 {
+            continue;
+        }
+        let term = match s.cell {
+            // A receiver in the shooter's plane at its edge still sees it
+            // (half of its hemisphere, at a right-angled corner).
+            Some(cell) if near_field && r2 < s.near_r2 => point_to_polygon(x, nx, &cell),
+            _ if cos_s <= 0.0 || cos_x <= 0.0 => continue,
+            _ => {
+                let r2 = r2 as f64;
+                // (cos_s / r)(cos_x / r) with d unnormalised.
+                let cosines = cos_s as f64 * cos_x as f64 / r2;
+                cosines * s.area / (PI * r2 + s.area)
+            }
+        };
+        if term <= 0.0 {
+            continue;
+        }
+        rays += 1;
+        if !occluded(s.position) {
+            sum += term;
+        }
+    }
+    (sum, rays)
+}
+
+/// Exact unoccluded form factor from a differential area at `x` with unit
+/// normal `n` to a planar polygon (a triangle may repeat its last corner),
+/// by Lambert's contour integral `F = |Σ θ_k n·γ_k| / 2π` over the part of
+/// the polygon in front of `x`'s tangent plane.
+pub fn point_to_polygon(x: Vec3, n: Vec3, corners: &[Vec3]) -> f64 {
+    let (x, n) = (x.as_dvec3(), n.as_dvec3());
+    // Clip to the receiver's front half-space (Sutherland–Hodgman).
+    let mut clipped: [DVec3; 8] = [DVec3::ZERO; 8];
+    let mut len = 0;
+    let m = corners.len();
+    for k in 0..m {
+        let a = corners[k].as_dvec3() - x;
+        let b = corners[(k + 1) % m].as_dvec3() - x;
+        let (da, db) = (n.dot(a), n.dot(b));
+        if da > 0.0 {
+            clipped[len] = a;
+            len += 1;
+        }
+        if (da > 0.0) != (db > 0.0) && da != db {
+            clipped[len] = a + (b - a) * (da / (da - db));
+            len += 1;
+        }
+    }
+    if len < 3 {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for k in 0..len {
+        let a = clipped[k].normalize_or_zero();
+        let b = clipped[(k + 1) % len].normalize_or_zero();
+        let c = a.cross(b);
+        let sin = c.length();
+        if sin > 0.0 {
+            sum += sin.atan2(a.dot(b)) * n.dot(c) / sin;
+        }
+    }
+    (sum / (2.0 * PI)).abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `F` from a point to a coaxial facing disc of radius `R` at distance
+    /// `h` is `R² / (h² + R²)`; the single-sample formula with the disc's
+    /// area reproduces it exactly.
+    #[test]
+    fn single_sample_is_the_point_to_disc_form_factor() {
+        for (radius, h) in [(1.0f64, 1.0f64), (0.1, 2.0), (3.0, 0.5)] {
+            let samples = [ShooterSample::point(Vec3::ZERO, PI * radius * radius)];
+            let (f, rays) = point_to_samples(
+                Vec3::new(0.0, 0.0, h as f32),
+                -Vec3::Z,
+                Vec3::Z,
+                &samples,
+                true,
+                |_| false,
+            );
+            let exact = radius * radius / (h * h + radius * radius);
+            assert!((f - exact).abs() < 1e-6 * exact, "{f} vs {exact}");
+            assert_eq!(rays, 1);
+        }
+    }
+
+    #[test]
+    fn back_facing_pairs_cast_no_rays() {
+        let samples = [ShooterSample::point(Vec3::ZERO, 1.0)];
+        // Receiver behind the shooter, and a receiver facing away.
+        let (f, rays) = point_to_samples(
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::Z,
+            Vec3::Z,
+            &samples,
+            true,
+            |_| false,
+        );
+        assert_eq!((f, rays), (0.0, 0));
+        let (f, rays) = point_to_samples(
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::Z,
+            Vec3::Z,
+            &samples,
+            true,
+            |_| false,
+        );
+        assert_eq!((f, rays), (0.0, 0));
+    }
+
+    #[test]
+    fn occluded_samples_contribute_nothing() {
+        let samples = [ShooterSample::point(Vec3::ZERO, 1.0)];
+        let (f, rays) = point_to_samples(
+            Vec3::new(0.0, 0.0, 1.0),
+            -Vec3::Z,
+            Vec3::Z,
+            &samples,
+            true,
+            |_| true,
+        );
+        assert_eq!((f, rays), (0.0, 1));
+    }
+
+    /// Exact point-to-square values: a unit square seen from a point one
+    /// unit above its corner, normal facing it: `F = (1/2π)(2·(1/√2)·atan(1/√2))`...
+    /// computed here as the quarter of the 2×2 square centred below the
+    /// point, whose value is `(2/π)(x/√(1+x²)·atan(1/√(1+x²)) ·2)/4` with
+    /// the standard formula `F = (2/π)[a/√(1+a²)·atan(b/√(1+a²)) + b/√(1+b²)·atan(a/√(1+b²))]/4·...`.
+    #[test]
+    fn point_to_polygon_matches_closed_forms() {
+        // Point at height h above the centre of a coaxial square of half
+        // side s: F = (2/π)·[2·a/√(1+a²)·atan(a/√(1+a²))] with a = s/h.
+        for (s, h) in [(0.5f64, 1.0f64), (1.0, 0.3), (0.1, 2.0)] {
+            let a = s / h;
+            let q = a / (1.0 + a * a).sqrt();
+            let exact = 2.0 / PI * 2.0 * q * (a / (1.0 + a * a).sqrt()).atan();
+            let sq = [
+                Vec3::new(-s as f32, -s as f32, 0.0),
+                Vec3::new(s as f32, -s as f32, 0.0),
+                Vec3::new(s as f32, s as f32, 0.0),
+                Vec3::new(-s as f32, s as f32, 0.0),
+            ];
+            let f = point_to_polygon(Vec3::new(0.0, 0.0, h as f32), -Vec3::Z, &sq);
+            assert!((f - exact).abs() < 1e-5, "{f} vs {exact}");
+        }
+        // A point on the edge of a perpendicular half-plane sees half of
+        // its hemisphere's projected area filled: F → 0.5 for a huge square.
+        let big = 1.0e3f32;
+        let wall = [
+            Vec3::new(0.0, -big, 0.0),
+            Vec3::new(big, -big, 0.0),
+            Vec3::new(big, big, 0.0),
+            Vec3::new(0.0, big, 0.0),
+        ];
+        let f = point_to_polygon(Vec3::new(0.0, 0.0, 1e-3), Vec3::X, &wall);
+        assert!((f - 0.5).abs() < 1e-3, "{f}");
+        // Entirely behind the receiver: nothing.
+        assert_eq!(
+            point_to_polygon(Vec3::new(2e3, 0.0, 1.0), Vec3::X, &wall),
+            0.0
+        );
+    }
+
+    #[test]
+    fn triangle_cells_cover_the_triangle_evenly() {
+        let (a, b, c) = (
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        for m in 1..6 {
+            let cells = triangle_cells(a, b, c, m);
+            assert_eq!(cells.len() as u32, m * m);
+            let total: f64 = cells.iter().map(|s| s.area).sum();
+            assert!((total - 1.0).abs() < 1e-6);
+            // The mean of the cell centroids is the triangle's centroid.
+            let mean = cells.iter().map(|s| s.position).sum::<Vec3>() / cells.len() as f32;
+            assert!(mean.distance((a + b + c) / 3.0) < 1e-5);
+        }
+    }
+}

@@ -1,0 +1,402 @@
+//! Progressive refinement radiosity with substructuring.
+//!
+//! Radiosity is kept at element vertices; unshot radiosity per polygon.
+//! Each [`Progressive::step`] picks the polygon with the most unshot power
+//! `‖Δb_i‖·A_i` (‖·‖ the channel mean) and shoots it to every element
+//! vertex `l` of every other polygon `j`:
+//!
+//! ```text
+//! Δrad_l = rho_j · Δb_i · F(l → i)        (F from `formfactor`)
+//! b_l  += Δrad_l
+//! Δb_j += Δrad_l / n_j                     (n_j: vertices of j)
+//! Δb_i  = 0
+//! ```
+//!
+//! Emission and reflection are from the front only. Receivers are
+//! processed in parallel; each vertex's sum is independent and the
+//! per-polygon sums run in a fixed order, so the result is bit-identical
+//! whatever the thread count.
+
+pub mod formfactor;
+
+use crate::color::Rgb;
+use crate::mesh::Mesh;
+use crate::scene::{PolygonId, Scene};
+use crate::visibility::Visibility;
+use formfactor::{point_to_samples, shooter_samples, SampleSet, ShooterSample};
+use rayon::prelude::*;
+
+/// Default fraction of the initial unshot power at which solving stops.
+pub const DEFAULT_THRESHOLD: f64 = 1e-3;
+
+/// Default cap on shooter sample points (see [`ShooterSamples::AtMost`]).
+/// 64 points (an 8 × 8 grid on a square) put the form factor of the unit
+/// parallel squares within 0.1 % of the exact value while keeping a step
+/// on a 20,000-vertex mesh at about a million rays.
+pub const DEFAULT_SHOOTER_SAMPLES: u32 = 64;
+
+/// How form factors are estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FormFactorMethod {
+    /// Wallace's ray-traced sum over shooter sample points.
+    Wallace,
+    /// One ray from the shooter's centre with the point-to-disc form factor:
+    /// cheap, with blocky shadows.
+    Center,
+}
+
+/// Which points of a shooter are used by [`FormFactorMethod::Wallace`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShooterSamples {
+    /// Every element vertex of the shooter.
+    All,
+    /// The element vertices while there are at most this many (`>= 1`),
+    /// else a regular grid of at most this many points over the polygon.
+    AtMost(u32),
+}
+
+/// Solver settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverOptions {
+    /// Form factor estimate.
+    pub form_factor: FormFactorMethod,
+    /// Shooter samples for the Wallace estimate.
+    pub shooter_samples: ShooterSamples,
+    /// Stop when the unshot power falls to this fraction of the initial
+    /// unshot power, in `[0, 1]`.
+    pub threshold: f64,
+    /// Stop after this many steps at most.
+    pub max_steps: Option<u64>,
+    /// Use the exact point-to-cell form factor for receivers close to a
+    /// grid sample (see [`formfactor`]); off gives the plain disc sum.
+    pub near_field: bool,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            form_factor: FormFactorMethod::Wallace,
+            shooter_samples: ShooterSamples::AtMost(DEFAULT_SHOOTER_SAMPLES),
+            threshold: DEFAULT_THRESHOLD,
+            max_steps: None,
+            near_field: true,
+        }
+    }
+}
+
+/// What one shooting step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepReport {
+    /// Which step this was, from 1.
+    pub step: u64,
+    /// The polygon that shot.
+    pub shooter: PolygonId,
+    /// The power it shot: `A_i · mean(Δb_i)`, in radiosity × area units.
+    pub shot_power: f64,
+    /// Unshot power left after the step, as a fraction of the initial.
+    pub unshot_fraction: f64,
+    /// Shadow rays cast in this step.
+    pub rays: u64,
+}
+
+/// Why the solver stops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// The unshot power fell below the threshold (or there was none).
+    Converged,
+    /// The step limit was reached first.
+    MaxSteps,
+}
+
+/// The state of a progressive solve: a value that is advanced one shooting
+/// step at a time.
+///
+/// Invariants (checked by [`Progressive::validate`]): every radiosity and
+/// unshot value is finite and non-negative; one radiosity per mesh vertex
+/// and one unshot value per polygon.
+pub struct Progressive<'a> {
+    mesh: &'a Mesh,
+    visibility: &'a Visibility,
+    options: SolverOptions,
+    /// Per polygon: front emission `e`.
+    emission: Vec<Rgb>,
+    /// Per polygon: front reflectance `rho`.
+    reflectance: Vec<Rgb>,
+    /// Per polygon: shooter samples.
+    samples: Vec<Vec<ShooterSample>>,
+    /// Per vertex: radiosity `b`.
+    radiosity: Vec<Rgb>,
+    /// Per polygon: unshot radiosity `Δb`.
+    unshot: Vec<Rgb>,
+    /// Per vertex: scratch for the step's `Δrad`.
+    delta: Vec<Rgb>,
+    /// Per polygon: scratch, whether it receives in this step.
+    receives: Vec<bool>,
+    initial_unshot_power: f64,
+    steps: u64,
+    rays: u64,
+}
+
+impl<'a> Progressive<'a> {
+    /// Starts a solve: every vertex at `b = e`, every polygon's unshot
+    /// radiosity at `Δb = e`. `mesh` and `visibility` must be built from
+    /// `scene`.
+    pub fn new(
+        scene: &Scene,
+        mesh: &'a Mesh,
+        visibility: &'a Visibility,
+        options: SolverOptions,
+    ) -> Self {
+        let set = match (options.form_factor, options.shooter_samples) {
+            (FormFactorMethod::Center, _) => SampleSet::Centre,
+            (FormFactorMethod::Wallace, ShooterSamples::All) => SampleSet::Vertices,
+            (FormFactorMethod::Wallace, ShooterSamples::AtMost(n)) => SampleSet::AtMost(n),
+        };
+        let emission: Vec<Rgb> = scene
+            .polygons
+            .iter()
+            .map(|p| scene.materials[p.material.index()].emission())
+            .collect();
+        let reflectance = scene
+            .polygons
+            .iter()
+            .map(|p| scene.materials[p.material.index()].reflectance())
+            .collect();
+        let samples = scene
+            .polygons
+            .iter()
+            .zip(&mesh.polygons)
+            .map(|(p, pm)| shooter_samples(p, pm, mesh, set))
+            .collect();
+        let radiosity = mesh
+            .vertex_polygon
+            .iter()
+            .map(|p| emission[p.index()])
+            .collect();
+        let unshot = emission.clone();
+        let mut solver = Progressive {
+            mesh,
+            visibility,
+            options,
+            emission,
+            reflectance,
+            samples,
+            radiosity,
+            unshot,
+            delta: vec![Rgb::BLACK; mesh.vertex_count()],
+            receives: vec![false; mesh.polygons.len()],
+            initial_unshot_power: 0.0,
+            steps: 0,
+            rays: 0,
+        };
+        solver.initial_unshot_power = solver.unshot_power();
+        solver
+    }
+
+    /// Radiosity per mesh vertex, in the scene's emission units.
+    pub fn radiosity(&self) -> &[Rgb] {
+        &self.radiosity
+    }
+
+    /// Unshot radiosity per polygon.
+    pub fn unshot(&self) -> &[Rgb] {
+        &self.unshot
+    }
+
+    /// Emission per polygon.
+    pub fn emission(&self) -> &[Rgb] {
+        &self.emission
+    }
+
+    /// Reflectance per polygon.
+    pub fn reflectance(&self) -> &[Rgb] {
+        &self.reflectance
+    }
+
+    /// The options it runs with.
+    pub fn options(&self) -> &SolverOptions {
+        &self.options
+    }
+
+    /// Total unshot power `Σ A_i · mean(Δb_i)`.
+    pub fn unshot_power(&self) -> f64 {
+        self.unshot
+            .iter()
+            .zip(&self.mesh.polygons)
+            .map(|(u, pm)| u.mean() * pm.area)
+            .sum()
+    }
+
+    /// Unshot power at the start (the emitted power).
+    pub fn initial_unshot_power(&self) -> f64 {
+        self.initial_unshot_power
+    }
+
+    /// Unshot power as a fraction of the initial; 0 when nothing emits.
+    pub fn unshot_fraction(&self) -> f64 {
+        if self.initial_unshot_power > 0.0 {
+            self.unshot_power() / self.initial_unshot_power
+        } else {
+            0.0
+        }
+    }
+
+    /// Steps taken so far.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Shadow rays cast so far.
+    pub fn rays(&self) -> u64 {
+        self.rays
+    }
+
+    /// Why the solve should stop now, or `None` to go on.
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        if self.unshot_fraction() <= self.options.threshold || self.unshot_power() <= 0.0 {
+            Some(StopReason::Converged)
+        } else if self.options.max_steps.is_some_and(|m| self.steps >= m) {
+            Some(StopReason::MaxSteps)
+        } else {
+            None
+        }
+    }
+
+    /// True when [`Progressive::stop_reason`] says to stop.
+    pub fn is_done(&self) -> bool {
+        self.stop_reason().is_some()
+    }
+
+    /// The polygon with the most unshot power (the lowest index on ties),
+    /// or `None` when nothing is left to shoot.
+    pub fn next_shooter(&self) -> Option<PolygonId> {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, (u, pm)) in self.unshot.iter().zip(&self.mesh.polygons).enumerate() {
+            let power = u.mean() * pm.area;
+            if power > 0.0 && best.is_none_or(|(_, b)| power > b) {
+                best = Some((i, power));
+            }
+        }
+        best.map(|(i, _)| PolygonId(i as u32))
+    }
+
+    /// One shooting step from the polygon with the most unshot power.
+    /// Returns `None` (and does nothing) when no polygon has unshot power.
+    /// Does not look at the threshold or step limit: see
+    /// [`Progressive::is_done`].
+    pub fn step(&mut self) -> Option<StepReport> {
+        let shooter = self.next_shooter()?;
+        let i = shooter.index();
+        let shot = self.unshot[i];
+        let shot_power = shot.mean() * self.mesh.polygons[i].area;
+        self.mark_receivers(i);
+
+        let mesh = self.mesh;
+        let visibility = self.visibility;
+        let samples = &self.samples[i];
+        let shooter_normal = mesh.polygons[i].normal;
+        let receives = &self.receives;
+        let reflectance = &self.reflectance;
+        let near_field = self.options.near_field;
+        let rays: u64 = self
+            .delta
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(l, delta)| {
+                let j = mesh.vertex_polygon[l];
+                if !receives[j.index()] {
+                    *delta = Rgb::BLACK;
+                    return 0;
+                }
+                let x = mesh.sample_positions[l];
+                let (f, rays) = point_to_samples(
+                    x,
+                    mesh.polygons[j.index()].normal,
+                    shooter_normal,
+                    samples,
+                    near_field,
+                    |s| visibility.occluded(s, x, (shooter, j)),
+                );
+                *delta = reflectance[j.index()] * shot * f;
+                rays
+            })
+            .sum();
+
+        for (j, pm) in mesh.polygons.iter().enumerate() {
+            if !self.receives[j] {
+                continue;
+            }
+            let mut gathered = Rgb::BLACK;
+            for l in pm.vertices.clone() {
+                let d = self.delta[l as usize];
+                self.radiosity[l as usize] += d;
+                gathered += d;
+            }
+            self.unshot[j] += gathered / pm.vertex_count() as f64;
+        }
+        self.unshot[i] = Rgb::BLACK;
+        self.steps += 1;
+        self.rays += rays;
+        Some(StepReport {
+            step: self.steps,
+            shooter,
+            shot_power,
+            unshot_fraction: self.unshot_fraction(),
+            rays,
+        })
+    }
+
+    /// Marks the polygons that can receive from shooter `i`: not `i`
+    /// itself, with some reflectance, some vertex in front of `i`'s plane
+    /// and some sample of `i` in front of their own plane. The others get
+    /// nothing and need no per-vertex work.
+    fn mark_receivers(&mut self, i: usize) {
+        let mesh = self.mesh;
+        let shooter = &mesh.polygons[i];
+        let origin = self.samples[i]
+            .first()
+            .map(|s| s.position)
+            .unwrap_or_default();
+        for (j, pm) in mesh.polygons.iter().enumerate() {
+            let visible_side = || {
+                let range = pm.vertices.start as usize..pm.vertices.end as usize;
+                let in_front = mesh.sample_positions[range.clone()]
+                    .iter()
+                    .any(|&x| shooter.normal.dot(x - origin) > 0.0);
+                let x0 = mesh.sample_positions[range.start];
+                in_front
+                    && self.samples[i]
+                        .iter()
+                        .any(|s| pm.normal.dot(s.position - x0) > 0.0)
+            };
+            self.receives[j] = j != i
+                && !self.reflectance[j].is_black()
+                && pm.vertex_count() > 0
+                && visible_side();
+        }
+    }
+
+    /// Checks the invariants; returns the first broken one.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.radiosity.len() != self.mesh.vertex_count()
+            || self.unshot.len() != self.mesh.polygons.len()
+        {
+            return Err("array sizes do not match the mesh".into());
+        }
+        let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
+        if let Some(l) = self.radiosity.iter().position(bad) {
+            return Err(format!("vertex {l} has radiosity {:?}", self.radiosity[l]));
+        }
+        if let Some(j) = self.unshot.iter().position(bad) {
+            return Err(format!(
+                "polygon {j} has unshot radiosity {:?}",
+                self.unshot[j]
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests;

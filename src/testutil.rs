@@ -1,0 +1,106 @@
+//! Small scenes built in code for unit tests, independent of the parser.
+
+use crate::color::Rgb;
+use crate::scene::{Camera, CameraSource, Material, MaterialId, Polygon, Scene, Shape, SourcePos};
+use glam::{DVec3, Vec3};
+
+/// A polygon with its Newell normal and area; the shape is inferred.
+pub fn polygon(material: u32, vertices: &[[f32; 3]]) -> Polygon {
+    let v: Vec<Vec3> = vertices.iter().map(|a| Vec3::from_array(*a)).collect();
+    let mut n = DVec3::ZERO;
+    for k in 0..v.len() {
+        n += v[k].as_dvec3().cross(v[(k + 1) % v.len()].as_dvec3());
+    }
+    let shape = match v.len() {
+        3 => Shape::Triangle,
+        4 if (v[0] + v[2] - v[1] - v[3]).length() < 1e-6 => Shape::Parallelogram,
+        4 => Shape::Quad,
+        _ => Shape::Convex,
+    };
+    Polygon {
+        material: MaterialId(material),
+        vertices: v,
+        normal: n.normalize().as_vec3(),
+        area: n.length() * 0.5,
+        shape,
+        origin: SourcePos::default(),
+    }
+}
+
+/// A grey material with emission `e` and reflectance `rho` in every channel.
+pub fn grey(name: &str, e: f64, rho: f64) -> Material {
+    Material {
+        name: name.into(),
+        color: Rgb::WHITE,
+        k_diffrefl: rho,
+        k_emission: e,
+    }
+}
+
+/// A scene of these polygons and materials with a camera at +z.
+pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
+    Scene {
+        polygons,
+        materials,
+        camera: Camera {
+            eye: Vec3::new(0.5, 0.5, 5.0),
+            lookat: Vec3::new(0.5, 0.5, 0.0),
+            up: Vec3::Y,
+            fov_y: 1.0,
+            width: 32,
+            height: 24,
+        },
+        camera_source: CameraSource::File,
+    }
+}
+
+/// The six inward-facing walls of the box `[0, s]³`, wall `k` with
+/// material `materials[k]`, in the order -x, +x, -y, +y, -z, +z.
+pub fn closed_box(s: f32, materials: [u32; 6]) -> Vec<Polygon> {
+    let walls: [(u32, [[f32; 3]; 4]); 6] = [
+        (
+            materials[0],
+            [[0., 0., 0.], [0., 0., s], [0., s, s], [0., s, 0.]],
+        ),
+        (
+            materials[1],
+            [[s, 0., 0.], [s, s, 0.], [s, s, s], [s, 0., s]],
+        ),
+        (
+            materials[2],
+            [[0., 0., 0.], [s, 0., 0.], [s, 0., s], [0., 0., s]],
+        ),
+        (
+            materials[3],
+            [[0., s, 0.], [0., s, s], [s, s, s], [s, s, 0.]],
+        ),
+        (
+            materials[4],
+            [[0., 0., 0.], [0., s, 0.], [s, s, 0.], [s, 0., 0.]],
+        ),
+        (
+            materials[5],
+            [[0., 0., s], [s, 0., s], [s, s, s], [0., s, s]],
+        ),
+    ];
+    // Listed counter-clockwise from outside; reversed to face inward.
+    walls
+        .iter()
+        .map(|(m, v)| {
+            let mut v = *v;
+            v.reverse();
+            polygon(*m, &v)
+        })
+        .collect()
+}
+
+#[test]
+fn closed_box_faces_inward() {
+    let walls = closed_box(2.0, [0; 6]);
+    let centre = Vec3::splat(1.0);
+    for w in &walls {
+        assert!(w.normal.dot(centre - w.vertices[0]) > 0.0);
+        assert!((w.area - 4.0).abs() < 1e-9);
+        assert_eq!(w.shape, Shape::Parallelogram);
+    }
+}
