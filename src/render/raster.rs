@@ -1,7 +1,7 @@
 //! A software z-buffer rasterizer that draws the element mesh with Gouraud
 //! shading of the per-vertex radiosity.
 //!
-//! Each element is split into its triangles ([`Element::triangles`]). A
+//! Each element is split into its triangles ([`Element::triangles`](crate::mesh::Element::triangles)). A
 //! triangle is taken to camera space, clipped (Sutherland–Hodgman) against
 //! the near plane and a guard band around the picture, projected, snapped to
 //! a grid of `1 / 2^SUBPIXEL_BITS` pixel, and filled with exact integer edge
