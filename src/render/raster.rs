@@ -1,8 +1,9 @@
 //! A software z-buffer rasterizer that draws the element mesh with Gouraud
 //! shading of the per-vertex radiosity.
 //!
-//! Each element is split into its triangles ([`Element::triangles`](crate::mesh::Element::triangles)). A
-//! triangle is taken to camera space, clipped (Sutherland–Hodgman) against
+//! Each element is split into its triangles
+//! ([`Element::triangles`](crate::mesh::Element::triangles)). A triangle is
+//! taken to camera space, clipped (Sutherland–Hodgman) against
 //! the near plane and a guard band around the picture, projected, snapped to
 //! a grid of `1 / 2^SUBPIXEL_BITS` pixel, and filled with exact integer edge
 //! functions at pixel centres under the top-left rule, so triangles that
@@ -802,6 +803,65 @@ mod tests {
         let counts = coverage_counts(b.mesh.as_ref().unwrap(), &b.radiosity);
         assert!(counts.iter().all(|&n| n <= 1));
         assert_eq!(counts.iter().filter(|&&n| n == 1).count(), 20 * 20);
+    }
+
+    #[test]
+    fn shared_edge_crossing_the_eye_plane_stays_watertight() {
+        // A floor quad reaching behind the eye, split along its 0–2 diagonal,
+        // which crosses the near plane off-centre: the two clipped halves
+        // must meet exactly.
+        let floor = [
+            Vec3::new(-30.0, -1.0, 7.0),
+            Vec3::new(40.0, -1.0, 9.0),
+            Vec3::new(33.0, -1.0, -50.0),
+            Vec3::new(-45.0, -1.0, -41.0),
+        ];
+        let mut b = Builder::default();
+        b.polygon(&floor, &[1.0; 4]);
+        let counts = coverage_counts(b.mesh.as_ref().unwrap(), &b.radiosity);
+        assert!(counts.iter().all(|&n| n <= 1), "a pixel drawn twice");
+        // Everything well below the horizon is floor.
+        for y in 60..100 {
+            for x in 0..100 {
+                assert_eq!(counts[y * 100 + x], 1, "gap at ({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn camera_inside_a_room_sees_walls_everywhere() {
+        // A box around an off-centre eye, every wall facing inwards with its
+        // own radiosity: every pixel is covered and lit, none is a back face.
+        let (lo, hi) = (Vec3::new(-2.0, -1.5, -4.0), Vec3::new(3.0, 2.5, 1.0));
+        let corner = |i: usize| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
+        // Each face counter-clockwise seen from inside the box.
+        let faces = [
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+        ];
+        let mut b = Builder::default();
+        for (k, f) in faces.iter().enumerate() {
+            let quad = f.map(corner);
+            b.polygon(&quad, &[k as f64 + 1.0; 4]);
+        }
+        let frame = b.render();
+        assert_eq!(covered_count(&frame), 100 * 100);
+        assert!(
+            frame.pixels.iter().all(|p| p[0] >= 1.0 - VALUE_TOLERANCE),
+            "a black pixel"
+        );
+        // The eye looks down -z, so the centre shows the far wall (face 4).
+        assert_eq!(frame.pixel(50, 50), Some([5.0; 3]));
     }
 
     #[test]
