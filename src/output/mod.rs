@@ -1,1 +1,233 @@
-//! Writing results to files.
+//! Writing results to files: pictures (png, tiff, exr, pfm), and the
+//! atomic-write helper every other output shares.
+//!
+//! Every file is written to a temporary file in its destination directory
+//! and renamed into place once complete ([`write_atomically`]), so a failed
+//! or interrupted run never leaves a partial file behind, and an existing
+//! file is either fully replaced or untouched.
+//!
+//! Errors are [`OutputError`]s; each names the path it is about and, when
+//! the operating system or an encoder failed, says why in the same message.
+
+pub mod image;
+
+pub use self::image::{write_picture, PictureFormat, SUPPORTED_EXTENSIONS};
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use tempfile::NamedTempFile;
+use thiserror::Error;
+
+/// Why an output file could not be written. Every message names the path.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    /// The directory the file should go in does not exist.
+    #[error("cannot write {}: directory {} does not exist", path.display(), dir.display())]
+    MissingDirectory {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// Its parent directory.
+        dir: PathBuf,
+    },
+    /// The path's parent exists but is not a directory.
+    #[error("cannot write {}: {} is not a directory", path.display(), dir.display())]
+    NotADirectory {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// Its parent, which is something else than a directory.
+        dir: PathBuf,
+    },
+    /// The picture format cannot be told from the path's extension.
+    #[error(
+        "cannot write {}: {reason}; supported picture formats are {}",
+        path.display(),
+        SUPPORTED_EXTENSIONS
+    )]
+    UnknownFormat {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// What is wrong with its extension.
+        reason: String,
+    },
+    /// The frame's buffers disagree with its size (a bug in its producer).
+    #[error("cannot write {}: the frame's buffers do not hold {width}x{height} pixels", path.display())]
+    InvalidFrame {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// Frame width in pixels.
+        width: u32,
+        /// Frame height in pixels.
+        height: u32,
+    },
+    /// Creating, writing or renaming the file failed. The message includes
+    /// the operating system's reason.
+    #[error("cannot write {}: {error}", path.display())]
+    Io {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// What the operating system said.
+        error: io::Error,
+    },
+    /// The image encoder failed. The message includes its reason.
+    #[error("cannot encode {}: {error}", path.display())]
+    Encode {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// What the encoder said.
+        error: ::image::ImageError,
+    },
+}
+
+impl OutputError {
+    /// The path of the file the error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            OutputError::MissingDirectory { path, .. }
+            | OutputError::NotADirectory { path, .. }
+            | OutputError::UnknownFormat { path, .. }
+            | OutputError::InvalidFrame { path, .. }
+            | OutputError::Io { path, .. }
+            | OutputError::Encode { path, .. } => path,
+        }
+    }
+
+    fn io(path: &Path, error: io::Error) -> OutputError {
+        OutputError::Io {
+            path: path.to_path_buf(),
+            error,
+        }
+    }
+}
+
+/// Writes the file at `path` through `write`, atomically: the bytes go to a
+/// temporary file in the same directory, which is flushed, synced and then
+/// renamed over `path`. If `write` or any step fails, the temporary file is
+/// removed and `path` is left as it was.
+///
+/// The writer is buffered; `write` need not buffer or flush.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<(), OutputError> {
+    write_atomically_seekable(path, |w| {
+        write(w).map_err(|error| OutputError::io(path, error))
+    })
+}
+
+/// [`write_atomically`] for writers that need to seek (some image encoders
+/// patch their headers at the end) and may fail with any [`OutputError`].
+pub fn write_atomically_seekable(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<&File>) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    let dir = destination_dir(path)?;
+    // Same directory as the destination, so the final rename stays on one
+    // file system and is atomic.
+    let tmp = NamedTempFile::new_in(&dir).map_err(|e| OutputError::io(path, e))?;
+    {
+        let mut writer = BufWriter::new(tmp.as_file());
+        write(&mut writer)?;
+        writer.flush().map_err(|e| OutputError::io(path, e))?;
+    }
+    // Sync before the rename so that after a crash the name points either
+    // to the old file or to the complete new one.
+    tmp.as_file()
+        .sync_all()
+        .map_err(|e| OutputError::io(path, e))?;
+    tmp.persist(path)
+        .map_err(|e| OutputError::io(path, e.error))?;
+    Ok(())
+}
+
+/// The directory `path` goes in, which must exist.
+fn destination_dir(path: &Path) -> Result<PathBuf, OutputError> {
+    let dir = match path.parent() {
+        // A bare file name is relative to the working directory.
+        Some(p) if p.as_os_str().is_empty() => PathBuf::from("."),
+        Some(p) => p.to_path_buf(),
+        None => {
+            return Err(OutputError::io(
+                path,
+                io::Error::new(io::ErrorKind::InvalidInput, "not a file path"),
+            ))
+        }
+    };
+    if dir.is_dir() {
+        Ok(dir)
+    } else if dir.exists() {
+        Err(OutputError::NotADirectory {
+            path: path.to_path_buf(),
+            dir,
+        })
+    } else {
+        Err(OutputError::MissingDirectory {
+            path: path.to_path_buf(),
+            dir,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entries(dir: &Path) -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn writes_and_replaces() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("stats.json");
+        write_atomically(&path, |w| w.write_all(b"first")).unwrap();
+        write_atomically(&path, |w| w.write_all(b"second")).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"second");
+        assert_eq!(entries(dir.path()), vec![path]);
+    }
+
+    #[test]
+    fn failure_leaves_the_old_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("stats.json");
+        std::fs::write(&path, b"old").unwrap();
+        let err = write_atomically(&path, |w| {
+            w.write_all(b"partial")?;
+            Err(io::Error::other("disk on fire"))
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("stats.json"), "{err}");
+        assert!(err.to_string().contains("disk on fire"), "{err}");
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(entries(dir.path()), vec![path]);
+    }
+
+    #[test]
+    fn missing_directory_is_a_clear_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("nowhere").join("out.json");
+        let err = write_atomically(&path, |w| w.write_all(b"x")).unwrap_err();
+        assert!(matches!(err, OutputError::MissingDirectory { .. }));
+        let msg = err.to_string();
+        assert!(
+            msg.contains("does not exist") && msg.contains("nowhere"),
+            "{msg}"
+        );
+        assert_eq!(err.path(), path);
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn parent_that_is_a_file_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("plain");
+        std::fs::write(&file, b"").unwrap();
+        let err = write_atomically(&file.join("out.json"), |w| w.write_all(b"x")).unwrap_err();
+        assert!(matches!(err, OutputError::NotADirectory { .. }), "{err}");
+    }
+}

@@ -1,1 +1,25 @@
-//! Pictures of a solution: a z-buffered Gouraud rasterizer and tone mapping.
+//! Pictures of a solution: the camera's view, a z-buffered Gouraud
+//! rasterizer and tone mapping.
+//!
+//! The pipeline of a picture is
+//!
+//! 1. [`View::new`] turns the scene's [`Camera`](crate::scene::Camera) into
+//!    an orthonormal camera frame and a perspective projection (row 0 at the
+//!    top, world-right is picture-right);
+//! 2. [`Rasterizer::render`] draws the element mesh with the per-vertex
+//!    radiosity, Gouraud-shaded and z-buffered, into a linear [`Frame`]
+//!    (front faces lit, back faces black, background black);
+//! 3. [`to_srgb8`] scales the frame by an exposure ([`Exposure`], automatic
+//!    with [`auto_exposure`]) and encodes it with the sRGB curve for 8-bit
+//!    pictures. High-dynamic-range outputs take the linear [`Frame`] as it is.
+//!
+//! The module knows nothing of files or windows: the viewer shows and the
+//! batch command writes the very same frames.
+
+pub mod camera;
+pub mod raster;
+pub mod tonemap;
+
+pub use camera::{View, ViewError};
+pub use raster::{Frame, Rasterizer, RenderError};
+pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};

@@ -1,0 +1,280 @@
+//! Picture files of a rendered [`Frame`].
+//!
+//! The format follows the file name's extension (case-insensitive):
+//!
+//! | extension        | format | contents                                         |
+//! |------------------|--------|--------------------------------------------------|
+//! | `.png`           | PNG    | 8-bit sRGB, tone-mapped with the given exposure  |
+//! | `.tif`, `.tiff`  | TIFF   | 8-bit sRGB, tone-mapped with the given exposure  |
+//! | `.exr`           | OpenEXR| 32-bit float linear RGB radiosity, as rendered   |
+//! | `.pfm`           | PFM    | 32-bit float linear RGB radiosity, as rendered   |
+//!
+//! The float formats ignore the exposure: they hold the frame's values
+//! bit for bit, in the scene's radiosity units, for later processing.
+
+use super::{write_atomically_seekable, OutputError};
+use crate::render::{to_srgb8, Exposure, Frame};
+use ::image::{ImageFormat, Rgb32FImage};
+use std::io::Write;
+use std::path::Path;
+
+/// The picture extensions [`PictureFormat::from_path`] understands, for
+/// messages.
+pub const SUPPORTED_EXTENSIONS: &str = ".png, .tif, .tiff, .exr, .pfm";
+
+/// A picture file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PictureFormat {
+    /// PNG, 8-bit sRGB.
+    Png,
+    /// TIFF, 8-bit sRGB.
+    Tiff,
+    /// OpenEXR, 32-bit float linear RGB (uncompressed).
+    Exr,
+    /// Portable float map, 32-bit float linear RGB, little-endian.
+    Pfm,
+}
+
+impl PictureFormat {
+    /// The format named by the path's extension, case-insensitive. A missing
+    /// or unknown extension is an error listing [`SUPPORTED_EXTENSIONS`].
+    pub fn from_path(path: &Path) -> Result<PictureFormat, OutputError> {
+        let unknown = |reason: String| OutputError::UnknownFormat {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let ext = path
+            .extension()
+            .ok_or_else(|| unknown("the file name has no extension".to_string()))?;
+        let lower = ext.to_string_lossy().to_ascii_lowercase();
+        match lower.as_str() {
+            "png" => Ok(PictureFormat::Png),
+            "tif" | "tiff" => Ok(PictureFormat::Tiff),
+            "exr" => Ok(PictureFormat::Exr),
+            "pfm" => Ok(PictureFormat::Pfm),
+            _ => Err(unknown(format!(
+                "unknown extension .{}",
+                ext.to_string_lossy()
+            ))),
+        }
+    }
+
+    /// True for the formats that store linear floats rather than tone-mapped
+    /// 8-bit values.
+    pub fn is_linear(self) -> bool {
+        matches!(self, PictureFormat::Exr | PictureFormat::Pfm)
+    }
+}
+
+/// Writes `frame` to `path` in the format its extension names (see the
+/// module docs), atomically (see [`write_atomically`](super::write_atomically)).
+///
+/// `exposure` applies to the 8-bit formats only; the float formats store the
+/// linear values exactly.
+pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(), OutputError> {
+    let format = PictureFormat::from_path(path)?;
+    if !frame.is_consistent() {
+        return Err(OutputError::InvalidFrame {
+            path: path.to_path_buf(),
+            width: frame.width,
+            height: frame.height,
+        });
+    }
+    let encode = |error| OutputError::Encode {
+        path: path.to_path_buf(),
+        error,
+    };
+    match format {
+        PictureFormat::Png | PictureFormat::Tiff => {
+            let img = to_srgb8(frame, exposure.resolve(frame));
+            let kind = if format == PictureFormat::Png {
+                ImageFormat::Png
+            } else {
+                ImageFormat::Tiff
+            };
+            write_atomically_seekable(path, |w| img.write_to(w, kind).map_err(encode))
+        }
+        PictureFormat::Exr => {
+            let raw: Vec<f32> = frame.pixels.iter().flatten().copied().collect();
+            let img = Rgb32FImage::from_raw(frame.width, frame.height, raw).ok_or_else(|| {
+                OutputError::InvalidFrame {
+                    path: path.to_path_buf(),
+                    width: frame.width,
+                    height: frame.height,
+                }
+            })?;
+            write_atomically_seekable(path, |w| {
+                img.write_to(w, ImageFormat::OpenExr).map_err(encode)
+            })
+        }
+        PictureFormat::Pfm => write_atomically_seekable(path, |w| {
+            write_pfm(w, frame).map_err(|error| OutputError::Io {
+                path: path.to_path_buf(),
+                error,
+            })
+        }),
+    }
+}
+
+/// Writes the portable float map: a text header (`PF` for colour, the size,
+/// and a negative scale meaning little-endian), then the rows from the
+/// BOTTOM of the picture to the top, each pixel three `f32`s.
+fn write_pfm(w: &mut dyn Write, frame: &Frame) -> std::io::Result<()> {
+    write!(w, "PF\n{} {}\n-1.0\n", frame.width, frame.height)?;
+    let width = frame.width as usize;
+    if width == 0 {
+        return Ok(());
+    }
+    for row in frame.pixels.chunks_exact(width).rev() {
+        for p in row {
+            for c in p {
+                w.write_all(&c.to_le_bytes())?;
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::srgb8;
+    use std::path::PathBuf;
+
+    /// A 5x3 frame with a distinct value in every channel, some above one,
+    /// some tiny, so the row order and exact bits are checked.
+    fn frame() -> Frame {
+        let mut f = Frame::new(5, 3);
+        for (i, p) in f.pixels.iter_mut().enumerate() {
+            let i = i as f32;
+            *p = [i * 0.1, 1.0 / (i + 3.0), (i * 0.37).sin().abs() * 3.0];
+        }
+        f.pixels[0] = [1e-7, 0.0, 123.456];
+        f.covered.fill(true);
+        f
+    }
+
+    fn only_file(dir: &Path) -> PathBuf {
+        let v: Vec<PathBuf> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        assert_eq!(v.len(), 1, "{v:?}");
+        v[0].clone()
+    }
+
+    #[test]
+    fn formats_from_extensions() {
+        let f = |p: &str| PictureFormat::from_path(Path::new(p)).ok();
+        assert_eq!(f("a.png"), Some(PictureFormat::Png));
+        assert_eq!(f("dir.x/a.PNG"), Some(PictureFormat::Png));
+        assert_eq!(f("a.tif"), Some(PictureFormat::Tiff));
+        assert_eq!(f("a.TiFF"), Some(PictureFormat::Tiff));
+        assert_eq!(f("a.exr"), Some(PictureFormat::Exr));
+        assert_eq!(f("a.Pfm"), Some(PictureFormat::Pfm));
+        assert_eq!(f("a.jpg"), None);
+        assert_eq!(f("png"), None);
+    }
+
+    #[test]
+    fn unknown_extension_names_the_supported_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["out.jpg", "out"] {
+            let path = dir.path().join(name);
+            let err = write_picture(&path, &frame(), Exposure::Auto).unwrap_err();
+            let msg = err.to_string();
+            assert!(matches!(err, OutputError::UnknownFormat { .. }));
+            assert!(
+                msg.contains(name) && msg.contains(SUPPORTED_EXTENSIONS),
+                "{msg}"
+            );
+        }
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+    }
+
+    #[test]
+    fn png_holds_the_tone_mapped_frame_top_row_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.png");
+        let f = frame();
+        write_picture(&path, &f, Exposure::Fixed(0.5)).unwrap();
+        assert_eq!(only_file(dir.path()), path);
+        let img = ::image::open(&path).unwrap().into_rgb8();
+        assert_eq!(img, to_srgb8(&f, 0.5));
+        // Top-left pixel of the file is the frame's pixel 0.
+        let p = f.pixels[0];
+        assert_eq!(
+            img.get_pixel(0, 0).0,
+            [srgb8(p[0], 0.5), srgb8(p[1], 0.5), srgb8(p[2], 0.5)]
+        );
+    }
+
+    #[test]
+    fn tiff_holds_the_tone_mapped_frame() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.TIF");
+        let f = frame();
+        write_picture(&path, &f, Exposure::Auto).unwrap();
+        let img = ::image::open(&path).unwrap().into_rgb8();
+        assert_eq!(img, to_srgb8(&f, Exposure::Auto.resolve(&f)));
+    }
+
+    #[test]
+    fn exr_holds_the_linear_values_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.exr");
+        let f = frame();
+        write_picture(&path, &f, Exposure::Fixed(7.0)).unwrap();
+        let img = ::image::open(&path).unwrap().into_rgb32f();
+        assert_eq!(img.dimensions(), (5, 3));
+        for (got, want) in img.pixels().zip(&f.pixels) {
+            assert_eq!(got.0.map(f32::to_bits), want.map(f32::to_bits));
+        }
+    }
+
+    #[test]
+    fn pfm_holds_the_linear_values_bottom_row_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.pfm");
+        let f = frame();
+        write_picture(&path, &f, Exposure::Auto).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let header = b"PF\n5 3\n-1.0\n";
+        assert_eq!(&bytes[..header.len()], header);
+        let floats: Vec<f32> = bytes[header.len()..]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        assert_eq!(floats.len(), 5 * 3 * 3);
+        for (k, px) in floats.chunks_exact(3).enumerate() {
+            let (file_row, x) = (k / 5, k % 5);
+            let y = 2 - file_row;
+            let want = f.pixels[y * 5 + x];
+            assert_eq!(
+                [px[0], px[1], px[2]].map(f32::to_bits),
+                want.map(f32::to_bits)
+            );
+        }
+    }
+
+    #[test]
+    fn missing_directory_leaves_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("absent").join("out.png");
+        let err = write_picture(&path, &frame(), Exposure::Auto).unwrap_err();
+        assert!(err.to_string().contains("does not exist"), "{err}");
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+    }
+
+    #[test]
+    fn inconsistent_frame_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut f = frame();
+        f.pixels.pop();
+        for name in ["a.png", "a.exr", "a.pfm"] {
+            let err = write_picture(&dir.path().join(name), &f, Exposure::Auto).unwrap_err();
+            assert!(matches!(err, OutputError::InvalidFrame { .. }), "{err}");
+        }
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+    }
+}

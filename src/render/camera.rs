@@ -1,0 +1,332 @@
+//! The pinhole view: where the camera is, which way it looks, and how a
+//! point in the scene lands on a pixel.
+//!
+//! Three spaces appear here:
+//!
+//! - **world space**: the scene's coordinates, in scene units;
+//! - **camera space**: origin at the eye, `x` to the right of the picture,
+//!   `y` up the picture, `z` the depth along the viewing direction (positive
+//!   in front of the eye), in scene units;
+//! - **pixel space**: continuous picture coordinates in pixels, `x` to the
+//!   right and `y` down, origin at the top-left corner of the picture. Pixel
+//!   `(i, j)` (column `i`, row `j`, row 0 at the top) covers
+//!   `[i, i + 1) × [j, j + 1)`; its centre, where the rasterizer samples, is
+//!   `(i + 0.5, j + 0.5)`.
+//!
+//! Pixels are square: the vertical field of view is the camera's and the
+//! horizontal one follows from the aspect ratio `width / height`.
+
+use crate::scene::Camera;
+use glam::{DVec2, DVec3, Vec2, Vec3};
+use thiserror::Error;
+
+/// Below this sine of the angle between the up vector and the viewing
+/// direction, up is taken to be parallel to the view and no picture
+/// orientation can be derived from it.
+pub const MIN_UP_SINE: f32 = 1e-6;
+
+/// The default near-plane distance as a fraction of the distance from the
+/// eye to the look-at point.
+///
+/// Scenes are rooms with the camera inside, so many polygons cross the plane
+/// of the eye and have to be cut by a near plane. The cut is invisible as
+/// long as nothing in view is closer than this: with the look-at point in the
+/// middle of a room, that is a thousandth of half the room's size. Callers
+/// that know the scene's extent can choose their own with [`View::with_near`].
+pub const DEFAULT_NEAR_FRACTION: f32 = 1e-3;
+
+/// The largest picture side the renderer accepts, in pixels.
+///
+/// It bounds the fixed-point screen coordinates of the rasterizer so that its
+/// exact integer edge tests cannot overflow.
+pub const MAX_PICTURE_SIDE: u32 = 1 << 16;
+
+/// Why a [`Camera`] does not make a usable [`View`].
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum ViewError {
+    /// A camera vector or the field of view is NaN or infinite.
+    #[error("the camera has a non-finite eye, look-at point, up vector or field of view")]
+    NotFinite,
+    /// The eye and the look-at point coincide, so there is no viewing direction.
+    #[error("the camera's eye and look-at point coincide")]
+    NoViewDirection,
+    /// Up is zero or parallel to the viewing direction.
+    #[error("the camera's up vector is zero or parallel to the viewing direction")]
+    UpParallel,
+    /// The vertical field of view is not in `(0, pi)` radians.
+    #[error("the vertical field of view {0} rad is not strictly between 0 and pi")]
+    FovOutOfRange(f32),
+    /// A picture side is zero or larger than [`MAX_PICTURE_SIDE`].
+    #[error("picture size {width}x{height} is not between 1 and {MAX_PICTURE_SIDE} pixels a side")]
+    BadSize {
+        /// Requested width in pixels.
+        width: u32,
+        /// Requested height in pixels.
+        height: u32,
+    },
+    /// The near distance is not finite and positive.
+    #[error("the near-plane distance {0} is not finite and positive")]
+    BadNear(f32),
+}
+
+/// A validated pinhole view made from a [`Camera`]: an orthonormal camera
+/// frame, a perspective projection and a picture size.
+///
+/// Invariants: `right`, `up` and `forward` are unit length and mutually
+/// orthogonal with `right = forward × up` (a right-handed world looks
+/// right-handed in the picture: world-right is picture-right); `0 < fov_y <
+/// pi`; `1 <= width, height <= MAX_PICTURE_SIDE`; `near` finite and `> 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    eye: Vec3,
+    right: Vec3,
+    up: Vec3,
+    forward: Vec3,
+    fov_y: f32,
+    width: u32,
+    height: u32,
+    near: f32,
+}
+
+impl View {
+    /// The view of a camera at the camera's own picture size, with the near
+    /// plane at [`DEFAULT_NEAR_FRACTION`] of the eye–look-at distance.
+    pub fn new(camera: &Camera) -> Result<View, ViewError> {
+        View::with_size(camera, camera.width, camera.height)
+    }
+
+    /// The view of a camera rendered at another picture size (for example a
+    /// resized window). The vertical field of view is kept; the horizontal one
+    /// follows the new aspect ratio.
+    pub fn with_size(camera: &Camera, width: u32, height: u32) -> Result<View, ViewError> {
+        let finite = camera.eye.is_finite()
+            && camera.lookat.is_finite()
+            && camera.up.is_finite()
+            && camera.fov_y.is_finite();
+        if !finite {
+            return Err(ViewError::NotFinite);
+        }
+        let forward = (camera.lookat - camera.eye)
+            .try_normalize()
+            .ok_or(ViewError::NoViewDirection)?;
+        let up_dir = camera.up.try_normalize().ok_or(ViewError::UpParallel)?;
+        // Gram–Schmidt through the cross product: the given up only has to
+        // say which way is up, it need not be orthogonal to the view.
+        let side = forward.cross(up_dir);
+        if side.length() < MIN_UP_SINE {
+            return Err(ViewError::UpParallel);
+        }
+        let right = side.normalize();
+        let up = right.cross(forward);
+        if !(camera.fov_y > 0.0 && camera.fov_y < std::f32::consts::PI) {
+            return Err(ViewError::FovOutOfRange(camera.fov_y));
+        }
+        if width == 0 || height == 0 || width > MAX_PICTURE_SIDE || height > MAX_PICTURE_SIDE {
+            return Err(ViewError::BadSize { width, height });
+        }
+        let distance = (camera.lookat - camera.eye).length();
+        View {
+            eye: camera.eye,
+            right,
+            up,
+            forward,
+            fov_y: camera.fov_y,
+            width,
+            height,
+            near: 1.0,
+        }
+        .with_near(distance * DEFAULT_NEAR_FRACTION)
+    }
+
+    /// The same view with the near plane at `near` scene units in front of
+    /// the eye. Everything closer is cut away.
+    pub fn with_near(mut self, near: f32) -> Result<View, ViewError> {
+        if !(near.is_finite() && near > 0.0) {
+            return Err(ViewError::BadNear(near));
+        }
+        self.near = near;
+        Ok(self)
+    }
+
+    /// The eye position, in scene units.
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// Unit vector pointing to the right of the picture, in world space.
+    pub fn right(&self) -> Vec3 {
+        self.right
+    }
+
+    /// Unit vector pointing up the picture, in world space (the camera's up
+    /// made orthogonal to the view).
+    pub fn up(&self) -> Vec3 {
+        self.up
+    }
+
+    /// Unit viewing direction, in world space.
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+
+    /// Vertical field of view in radians.
+    pub fn fov_y(&self) -> f32 {
+        self.fov_y
+    }
+
+    /// Picture width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Picture height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Picture width over height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// Near-plane distance in scene units, `> 0`.
+    pub fn near(&self) -> f32 {
+        self.near
+    }
+
+    /// Focal length in pixels: the distance from the eye to a picture plane
+    /// on which one scene unit is one pixel. The same horizontally and
+    /// vertically, because pixels are square.
+    pub fn focal_px(&self) -> f64 {
+        f64::from(self.height) / (2.0 * (f64::from(self.fov_y) / 2.0).tan())
+    }
+
+    /// A world-space point in camera space: `x` right, `y` up, `z` depth in
+    /// front of the eye, all in scene units.
+    pub fn to_camera(&self, p: Vec3) -> Vec3 {
+        let d = p - self.eye;
+        Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.forward))
+    }
+
+    /// A camera-space point projected to pixel space, in `f64` because the
+    /// rasterizer snaps it to a sub-pixel grid. `None` when the point is not
+    /// in front of the eye (`z <= 0`).
+    pub fn camera_to_pixel(&self, c: DVec3) -> Option<DVec2> {
+        if c.z.is_nan() || c.z <= 0.0 {
+            return None;
+        }
+        let f = self.focal_px();
+        let x = f64::from(self.width) / 2.0 + f * c.x / c.z;
+        let y = f64::from(self.height) / 2.0 - f * c.y / c.z;
+        Some(DVec2::new(x, y))
+    }
+
+    /// A world-space point projected to pixel space (see the module docs).
+    /// `None` when the point is not in front of the eye. Points outside the
+    /// field of view give coordinates outside `[0, width] × [0, height]`.
+    pub fn project(&self, p: Vec3) -> Option<Vec2> {
+        self.camera_to_pixel(self.to_camera(p).as_dvec3())
+            .map(|v| v.as_vec2())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Pixel-space tolerance of the projection tests, in pixels.
+    const PIXEL_TOLERANCE: f32 = 1e-3;
+
+    fn camera() -> Camera {
+        Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            lookat: Vec3::new(1.0, 2.0, -7.0),
+            up: Vec3::Y,
+            fov_y: 60f32.to_radians(),
+            width: 200,
+            height: 100,
+        }
+    }
+
+    fn close(a: Vec2, b: Vec2) -> bool {
+        (a - b).abs().max_element() < PIXEL_TOLERANCE
+    }
+
+    #[test]
+    fn straight_ahead_is_the_centre() {
+        let v = View::new(&camera()).unwrap();
+        let p = v.project(Vec3::new(1.0, 2.0, -20.0)).unwrap();
+        assert!(close(p, Vec2::new(100.0, 50.0)), "{p}");
+    }
+
+    #[test]
+    fn right_is_right_and_up_is_up() {
+        let v = View::new(&camera()).unwrap();
+        let right = v.project(Vec3::new(1.0, 2.0, -7.0) + v.right()).unwrap();
+        assert!(right.x > 100.0 && (right.y - 50.0).abs() < PIXEL_TOLERANCE);
+        let above = v.project(Vec3::new(1.0, 3.0, -7.0)).unwrap();
+        assert!(above.y < 50.0 && (above.x - 100.0).abs() < PIXEL_TOLERANCE);
+        // Looking down -z with +y up, world +x is to the right.
+        assert!((v.right() - Vec3::X).length() < 1e-6);
+    }
+
+    #[test]
+    fn fov_edges_are_the_picture_edges() {
+        let c = camera();
+        let v = View::new(&c).unwrap();
+        let t = (c.fov_y / 2.0).tan();
+        let top = v.project(Vec3::new(1.0, 2.0 + 10.0 * t, -7.0)).unwrap();
+        let bottom = v.project(Vec3::new(1.0, 2.0 - 10.0 * t, -7.0)).unwrap();
+        assert!(close(top, Vec2::new(100.0, 0.0)), "{top}");
+        assert!(close(bottom, Vec2::new(100.0, 100.0)), "{bottom}");
+        // Square pixels: the horizontal edge is aspect times further out.
+        let side = v.project(Vec3::new(1.0 + 20.0 * t, 2.0, -7.0)).unwrap();
+        assert!(close(side, Vec2::new(200.0, 50.0)), "{side}");
+    }
+
+    #[test]
+    fn up_need_not_be_orthogonal() {
+        let mut c = camera();
+        c.up = Vec3::new(0.0, 1.0, 0.7);
+        let v = View::new(&c).unwrap();
+        assert!((v.up() - Vec3::Y).length() < 1e-6);
+        assert!(v.up().dot(v.forward()).abs() < 1e-6);
+        assert!(v.right().dot(v.forward()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn size_override_keeps_vertical_fov() {
+        let v = View::with_size(&camera(), 50, 100).unwrap();
+        assert_eq!((v.width(), v.height()), (50, 100));
+        let p = v.project(Vec3::new(1.0, 2.0, -20.0)).unwrap();
+        assert!(close(p, Vec2::new(25.0, 50.0)));
+    }
+
+    #[test]
+    fn behind_the_eye_does_not_project() {
+        let v = View::new(&camera()).unwrap();
+        assert!(v.project(Vec3::new(1.0, 2.0, 5.0)).is_none());
+    }
+
+    #[test]
+    fn bad_cameras_are_errors() {
+        let mut c = camera();
+        c.up = Vec3::Z;
+        assert_eq!(View::new(&c), Err(ViewError::UpParallel));
+        let mut c = camera();
+        c.lookat = c.eye;
+        assert_eq!(View::new(&c), Err(ViewError::NoViewDirection));
+        let mut c = camera();
+        c.fov_y = 4.0;
+        assert_eq!(View::new(&c), Err(ViewError::FovOutOfRange(4.0)));
+        let mut c = camera();
+        c.width = 0;
+        assert!(matches!(View::new(&c), Err(ViewError::BadSize { .. })));
+        let mut c = camera();
+        c.eye.x = f32::NAN;
+        assert_eq!(View::new(&c), Err(ViewError::NotFinite));
+        let v = View::new(&camera()).unwrap();
+        assert_eq!(v.with_near(0.0), Err(ViewError::BadNear(0.0)));
+        assert!((v.near() - 10.0 * DEFAULT_NEAR_FRACTION).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,986 @@
+//! A software z-buffer rasterizer that draws the element mesh with Gouraud
+//! shading of the per-vertex radiosity.
+//!
+//! Each element is split into its triangles
+//! ([`Element::triangles`](crate::mesh::Element::triangles)). A triangle is
+//! taken to camera space, clipped (Sutherland–Hodgman) against
+//! the near plane and a guard band around the picture, projected, snapped to
+//! a grid of `1 / 2^SUBPIXEL_BITS` pixel, and filled with exact integer edge
+//! functions at pixel centres under the top-left rule, so triangles that
+//! share an edge cover each pixel along it exactly once. Radiosity and depth
+//! are interpolated perspective-correctly (linear in `1 / z`), and the
+//! nearest surface wins the depth test.
+//!
+//! Only the front of a polygon reflects or emits light: triangles seen from
+//! the back are drawn black but still hide what is behind them.
+//!
+//! The picture is filled in bands of rows in parallel. Every band draws all
+//! triangles in mesh order, and no pixel belongs to two bands, so the result
+//! is the same bits whatever the number of threads.
+
+use super::camera::View;
+use crate::color::Rgb;
+use crate::mesh::{Mesh, VertexId};
+use glam::DVec3;
+use rayon::prelude::*;
+use thiserror::Error;
+
+/// Bits of sub-pixel precision of the snapped screen coordinates.
+///
+/// Vertices are snapped to `1 / 256` pixel so the edge tests can be done in
+/// exact integer arithmetic: a shared edge then gives exactly opposite edge
+/// values in its two triangles, which is what makes the fill rule watertight.
+pub const SUBPIXEL_BITS: u32 = 8;
+
+/// How far beyond the picture triangles are kept before they are clipped
+/// at the sides, in half picture sizes measured from the picture centre.
+///
+/// With `2.0` the clip planes lie one picture width (height) beyond each
+/// edge, so the extra vertices clipping makes are never inside the picture,
+/// while screen coordinates stay small enough for exact `i64` edge tests.
+pub const GUARD_BAND: f64 = 2.0;
+
+/// Rows of pixels per parallel work item.
+const BAND_ROWS: usize = 16;
+
+/// Most vertices a triangle can have after clipping against five planes
+/// (each plane adds at most one).
+const MAX_CLIPPED: usize = 8;
+
+/// Sub-pixel grid steps per pixel.
+const SUBPIXEL: i64 = 1 << SUBPIXEL_BITS;
+
+/// A rendered picture of linear radiosity.
+///
+/// Invariants: `pixels.len() == covered.len() == width * height`, both
+/// row-major with row 0 at the top of the picture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear RGB radiosity seen at each pixel centre, in the scene's
+    /// radiosity units (exitance). Background and back faces are `0`.
+    pub pixels: Vec<[f32; 3]>,
+    /// Whether any surface (front or back) covers the pixel centre.
+    pub covered: Vec<bool>,
+}
+
+impl Frame {
+    /// An empty (all background) frame of the given size.
+    pub fn new(width: u32, height: u32) -> Frame {
+        let n = width as usize * height as usize;
+        Frame {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; n],
+            covered: vec![false; n],
+        }
+    }
+
+    /// Number of pixels, `width * height`.
+    pub fn len(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// True when the frame has no pixels.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// True when the buffers have the length the size promises.
+    pub fn is_consistent(&self) -> bool {
+        self.pixels.len() == self.len() && self.covered.len() == self.len()
+    }
+
+    /// The pixel at column `x`, row `y` (row 0 at the top); `None` outside
+    /// the frame.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<[f32; 3]> {
+        self.index(x, y).and_then(|i| self.pixels.get(i).copied())
+    }
+
+    /// Whether the pixel at column `x`, row `y` is covered; `false` outside
+    /// the frame.
+    pub fn is_covered(&self, x: u32, y: u32) -> bool {
+        self.index(x, y)
+            .and_then(|i| self.covered.get(i).copied())
+            .unwrap_or(false)
+    }
+
+    fn index(&self, x: u32, y: u32) -> Option<usize> {
+        (x < self.width && y < self.height).then(|| y as usize * self.width as usize + x as usize)
+    }
+
+    fn reset(&mut self, width: u32, height: u32) {
+        let n = width as usize * height as usize;
+        self.width = width;
+        self.height = height;
+        self.pixels.clear();
+        self.pixels.resize(n, [0.0; 3]);
+        self.covered.clear();
+        self.covered.resize(n, false);
+    }
+}
+
+/// Why a mesh and its radiosities cannot be drawn.
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+pub enum RenderError {
+    /// There must be one radiosity per mesh vertex.
+    #[error("{found} radiosity values for a mesh of {expected} vertices")]
+    RadiosityCount {
+        /// Number of mesh vertices.
+        expected: usize,
+        /// Number of radiosity values given.
+        found: usize,
+    },
+    /// The mesh's arrays disagree (a bug in whoever built it).
+    #[error("inconsistent mesh: {0}")]
+    BadMesh(String),
+}
+
+/// The z-buffer rasterizer. It owns the colour, coverage and depth buffers
+/// and the triangle list, and reuses them from one picture to the next (the
+/// viewer redraws after every solver step).
+#[derive(Clone, Debug)]
+pub struct Rasterizer {
+    frame: Frame,
+    /// Per pixel, `1 / z` of the nearest surface so far (`0` = nothing).
+    inv_depth: Vec<f64>,
+    triangles: Vec<ScreenTriangle>,
+}
+
+impl Default for Rasterizer {
+    fn default() -> Self {
+        Rasterizer::new()
+    }
+}
+
+impl Rasterizer {
+    /// A rasterizer with empty buffers; they are sized by the first view.
+    pub fn new() -> Rasterizer {
+        Rasterizer {
+            frame: Frame::new(0, 0),
+            inv_depth: Vec::new(),
+            triangles: Vec::new(),
+        }
+    }
+
+    /// The last picture drawn (empty before the first).
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+
+    /// Draws `mesh` seen through `view`, shading every element vertex with
+    /// its linear `radiosity` (one per mesh vertex, in the scene's radiosity
+    /// units), and returns the picture, sized as the view.
+    ///
+    /// Front faces show the Gouraud-interpolated radiosity, back faces are
+    /// black, uncovered pixels are black and not `covered`.
+    pub fn render(
+        &mut self,
+        mesh: &Mesh,
+        radiosity: &[Rgb],
+        view: &View,
+    ) -> Result<&Frame, RenderError> {
+        check_mesh(mesh, radiosity)?;
+        let (width, height) = (view.width(), view.height());
+        self.frame.reset(width, height);
+        self.inv_depth.clear();
+        self.inv_depth.resize(self.frame.len(), 0.0);
+
+        let setup = Setup::new(view);
+        self.triangles.clear();
+        for (e, element) in mesh.elements.iter().enumerate() {
+            // Checked by `check_mesh`: every index below is in range.
+            let polygon = &mesh.polygons[mesh.element_polygon[e].index()];
+            for tri in element.triangles() {
+                let corner = |v: VertexId| ClipVertex {
+                    p: view.to_camera(mesh.positions[v.index()]).as_dvec3(),
+                    c: radiosity[v.index()].to_array(),
+                };
+                // Which side the eye is on decides lit or black: the
+                // polygon's plane is the same for all its triangles, so
+                // a polygon is never half lit.
+                let front = polygon
+                    .normal
+                    .dot(view.eye() - mesh.positions[tri[0].index()])
+                    > 0.0;
+                setup.push(
+                    [corner(tri[0]), corner(tri[1]), corner(tri[2])],
+                    front,
+                    &mut self.triangles,
+                );
+            }
+        }
+
+        let w = width as usize;
+        let triangles = &self.triangles;
+        self.frame
+            .pixels
+            .par_chunks_mut(BAND_ROWS * w)
+            .zip(self.frame.covered.par_chunks_mut(BAND_ROWS * w))
+            .zip(self.inv_depth.par_chunks_mut(BAND_ROWS * w))
+            .enumerate()
+            .for_each(|(band, ((pixels, covered), depth))| {
+                let mut target = Band {
+                    width: w,
+                    first_row: band * BAND_ROWS,
+                    rows: pixels.len() / w,
+                    pixels,
+                    covered,
+                    depth,
+                };
+                for t in triangles {
+                    target.draw(t);
+                }
+            });
+        Ok(&self.frame)
+    }
+}
+
+/// Checks that every index the rasterizer follows is in range, so that
+/// drawing cannot panic on a malformed mesh.
+fn check_mesh(mesh: &Mesh, radiosity: &[Rgb]) -> Result<(), RenderError> {
+    let n = mesh.positions.len();
+    if radiosity.len() != n {
+        return Err(RenderError::RadiosityCount {
+            expected: n,
+            found: radiosity.len(),
+        });
+    }
+    if mesh.element_polygon.len() != mesh.elements.len() {
+        return Err(RenderError::BadMesh(format!(
+            "{} elements but {} element polygons",
+            mesh.elements.len(),
+            mesh.element_polygon.len()
+        )));
+    }
+    for (e, (element, polygon)) in mesh.elements.iter().zip(&mesh.element_polygon).enumerate() {
+        if polygon.index() >= mesh.polygons.len() {
+            return Err(RenderError::BadMesh(format!(
+                "element {e} belongs to polygon {} of {}",
+                polygon.index(),
+                mesh.polygons.len()
+            )));
+        }
+        if let Some(v) = element.corners().iter().find(|v| v.index() >= n) {
+            return Err(RenderError::BadMesh(format!(
+                "element {e} uses vertex {} of {n}",
+                v.index()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A vertex during clipping: camera-space position and linear radiosity.
+#[derive(Clone, Copy, Debug, Default)]
+struct ClipVertex {
+    p: DVec3,
+    c: [f64; 3],
+}
+
+/// A convex polygon of at most [`MAX_CLIPPED`] vertices, on the stack.
+#[derive(Clone, Copy)]
+struct ClipPolygon {
+    v: [ClipVertex; MAX_CLIPPED],
+    len: usize,
+}
+
+impl ClipPolygon {
+    fn push(&mut self, v: ClipVertex) {
+        // Each plane adds at most one vertex to a convex polygon, so a
+        // triangle never exceeds the capacity; the guard keeps a numerically
+        // odd case from panicking.
+        if self.len < MAX_CLIPPED {
+            self.v[self.len] = v;
+            self.len += 1;
+        }
+    }
+}
+
+/// The edge from `inside` to `outside` cut where the plane distance is zero.
+///
+/// Always computed from the inside vertex, whichever way the polygon walks
+/// the edge, so two triangles sharing an edge get bit-identical cut points.
+fn cut(inside: &ClipVertex, d_in: f64, outside: &ClipVertex, d_out: f64) -> ClipVertex {
+    let t = d_in / (d_in - d_out);
+    let lerp = |a: f64, b: f64| a + (b - a) * t;
+    ClipVertex {
+        p: inside.p + (outside.p - inside.p) * t,
+        c: [
+            lerp(inside.c[0], outside.c[0]),
+            lerp(inside.c[1], outside.c[1]),
+            lerp(inside.c[2], outside.c[2]),
+        ],
+    }
+}
+
+/// One Sutherland–Hodgman pass: keeps the part where `distance >= 0`.
+fn clip(poly: &ClipPolygon, distance: impl Fn(DVec3) -> f64) -> ClipPolygon {
+    let mut out = ClipPolygon {
+        v: [ClipVertex::default(); MAX_CLIPPED],
+        len: 0,
+    };
+    if poly.len == 0 {
+        return out;
+    }
+    let mut prev = poly.v[poly.len - 1];
+    let mut d_prev = distance(prev.p);
+    for &cur in &poly.v[..poly.len] {
+        let d_cur = distance(cur.p);
+        // NaN distances fail both tests: such a vertex is dropped.
+        if d_cur >= 0.0 {
+            if d_prev < 0.0 {
+                out.push(cut(&cur, d_cur, &prev, d_prev));
+            }
+            out.push(cur);
+        } else if d_prev >= 0.0 {
+            out.push(cut(&prev, d_prev, &cur, d_cur));
+        }
+        prev = cur;
+        d_prev = d_cur;
+    }
+    out
+}
+
+/// A projected vertex: snapped pixel position and the values interpolated
+/// linearly in screen space.
+#[derive(Clone, Copy, Debug)]
+struct ScreenVertex {
+    /// Position in `1 / SUBPIXEL` pixels.
+    x: i64,
+    y: i64,
+    /// `1 / z`, z the camera-space depth.
+    inv_z: f64,
+    /// Radiosity divided by z.
+    c_over_z: [f64; 3],
+}
+
+/// A triangle ready to fill: positive area (clockwise on screen, y down),
+/// per-edge fill-rule bias and a pixel bounding box inside the picture.
+#[derive(Clone, Copy, Debug)]
+struct ScreenTriangle {
+    v: [ScreenVertex; 3],
+    /// Twice the area in squared sub-pixel units, `> 0`.
+    area: i64,
+    /// Per edge opposite vertex `i`: `0` for top-left edges (pixel centres
+    /// exactly on them are inside), `1` otherwise.
+    bias: [i64; 3],
+    /// Inclusive pixel bounds: columns `x0..=x1`, rows `y0..=y1`.
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    y1: usize,
+}
+
+/// Edge function of the edge `a → b` at `(px, py)`: twice the signed area of
+/// `a, b, p`, exact in `i64` for coordinates within the guard band.
+fn edge(a: &ScreenVertex, b: &ScreenVertex, px: i64, py: i64) -> i64 {
+    (b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x)
+}
+
+/// Top-left rule for triangles with positive edge functions inside
+/// (clockwise on a y-down screen): a top edge runs exactly horizontally to
+/// the right, a left edge runs upwards.
+fn is_top_left(a: &ScreenVertex, b: &ScreenVertex) -> bool {
+    let (dx, dy) = (b.x - a.x, b.y - a.y);
+    dy < 0 || (dy == 0 && dx > 0)
+}
+
+/// Per-view constants of triangle setup.
+struct Setup<'v> {
+    view: &'v View,
+    near: f64,
+    /// Guard-band half sizes in pixels times `z / focal` (see `push`).
+    guard_x: f64,
+    guard_y: f64,
+    focal: f64,
+    width: f64,
+    height: f64,
+}
+
+impl<'v> Setup<'v> {
+    fn new(view: &'v View) -> Self {
+        let width = f64::from(view.width());
+        let height = f64::from(view.height());
+        Setup {
+            view,
+            near: f64::from(view.near()),
+            guard_x: GUARD_BAND * width / 2.0,
+            guard_y: GUARD_BAND * height / 2.0,
+            focal: view.focal_px(),
+            width,
+            height,
+        }
+    }
+
+    /// Clips, projects and snaps one camera-space triangle and appends the
+    /// resulting screen triangles (none if it is invisible).
+    fn push(&self, tri: [ClipVertex; 3], front: bool, out: &mut Vec<ScreenTriangle>) {
+        let mut poly = ClipPolygon {
+            v: [ClipVertex::default(); MAX_CLIPPED],
+            len: 3,
+        };
+        poly.v[..3].copy_from_slice(&tri);
+        let (near, f, gx, gy) = (self.near, self.focal, self.guard_x, self.guard_y);
+        // Near plane, then the four guard-band planes through the eye:
+        // `|f x / z| <= gx` and `|f y / z| <= gy`, multiplied by z > 0.
+        poly = clip(&poly, |p| p.z - near);
+        poly = clip(&poly, |p| gx * p.z - f * p.x);
+        poly = clip(&poly, |p| gx * p.z + f * p.x);
+        poly = clip(&poly, |p| gy * p.z - f * p.y);
+        poly = clip(&poly, |p| gy * p.z + f * p.y);
+        if poly.len < 3 {
+            return;
+        }
+        let mut screen = [None; MAX_CLIPPED];
+        for (s, v) in screen.iter_mut().zip(&poly.v[..poly.len]) {
+            *s = self.project(v, front);
+        }
+        // A fan from the first vertex: its inner edges are shared by
+        // neighbouring fan triangles with identical endpoints, so the fill
+        // rule covers them once as well.
+        for i in 1..poly.len - 1 {
+            if let (Some(a), Some(b), Some(c)) = (screen[0], screen[i], screen[i + 1]) {
+                if let Some(t) = self.triangle(a, b, c) {
+                    out.push(t);
+                }
+            }
+        }
+    }
+
+    fn project(&self, v: &ClipVertex, front: bool) -> Option<ScreenVertex> {
+        let pixel = self.view.camera_to_pixel(v.p)?;
+        let snap = |x: f64| (x * SUBPIXEL as f64).round();
+        let (x, y) = (snap(pixel.x), snap(pixel.y));
+        if !(x.is_finite() && y.is_finite()) {
+            return None;
+        }
+        let inv_z = 1.0 / v.p.z;
+        // Back faces are black: their radiosity is that of the other side.
+        let c = if front { v.c } else { [0.0; 3] };
+        Some(ScreenVertex {
+            // Within the guard band the values are far below 2^40, so the
+            // conversion is exact.
+            x: x as i64,
+            y: y as i64,
+            inv_z,
+            c_over_z: [c[0] * inv_z, c[1] * inv_z, c[2] * inv_z],
+        })
+    }
+
+    fn triangle(
+        &self,
+        a: ScreenVertex,
+        b: ScreenVertex,
+        c: ScreenVertex,
+    ) -> Option<ScreenTriangle> {
+        let area = edge(&a, &b, c.x, c.y);
+        let v = match area.signum() {
+            1 => [a, b, c],
+            -1 => [a, c, b],
+            // Degenerate (edge-on or collapsed by snapping): covers nothing.
+            _ => return None,
+        };
+        // Pixel centres are at (i + 1/2) pixels: the first column whose
+        // centre is at or right of min_x, the last at or left of max_x.
+        let lo = |m: i64| (m - SUBPIXEL / 2 + SUBPIXEL - 1).div_euclid(SUBPIXEL);
+        let hi = |m: i64| (m - SUBPIXEL / 2).div_euclid(SUBPIXEL);
+        let (min_x, max_x) = (v.iter().map(|p| p.x).min()?, v.iter().map(|p| p.x).max()?);
+        let (min_y, max_y) = (v.iter().map(|p| p.y).min()?, v.iter().map(|p| p.y).max()?);
+        let x0 = lo(min_x).max(0);
+        let x1 = hi(max_x).min(self.width as i64 - 1);
+        let y0 = lo(min_y).max(0);
+        let y1 = hi(max_y).min(self.height as i64 - 1);
+        if x0 > x1 || y0 > y1 {
+            return None;
+        }
+        Some(ScreenTriangle {
+            v,
+            area: area.abs(),
+            bias: [
+                i64::from(!is_top_left(&v[1], &v[2])),
+                i64::from(!is_top_left(&v[2], &v[0])),
+                i64::from(!is_top_left(&v[0], &v[1])),
+            ],
+            // Non-negative and inside the picture after the clamps above.
+            x0: x0 as usize,
+            x1: x1 as usize,
+            y0: y0 as usize,
+            y1: y1 as usize,
+        })
+    }
+}
+
+/// The rows of the picture one parallel task fills.
+struct Band<'a> {
+    width: usize,
+    first_row: usize,
+    rows: usize,
+    pixels: &'a mut [[f32; 3]],
+    covered: &'a mut [bool],
+    depth: &'a mut [f64],
+}
+
+impl Band<'_> {
+    fn draw(&mut self, t: &ScreenTriangle) {
+        let y0 = t.y0.max(self.first_row);
+        let y1 = t.y1.min(self.first_row + self.rows - 1);
+        if y0 > y1 {
+            return;
+        }
+        let [a, b, c] = &t.v;
+        let area = t.area as f64;
+        for y in y0..=y1 {
+            let py = y as i64 * SUBPIXEL + SUBPIXEL / 2;
+            let row = (y - self.first_row) * self.width;
+            for x in t.x0..=t.x1 {
+                let px = x as i64 * SUBPIXEL + SUBPIXEL / 2;
+                let w0 = edge(b, c, px, py);
+                let w1 = edge(c, a, px, py);
+                let w2 = edge(a, b, px, py);
+                if w0 < t.bias[0] || w1 < t.bias[1] || w2 < t.bias[2] {
+                    continue;
+                }
+                let (l0, l1, l2) = (w0 as f64 / area, w1 as f64 / area, w2 as f64 / area);
+                let inv_z = l0 * a.inv_z + l1 * b.inv_z + l2 * c.inv_z;
+                let i = row + x;
+                // Strictly nearer: on equal depth the first triangle drawn
+                // keeps the pixel, which is the same in every band.
+                if inv_z.is_nan() || inv_z <= self.depth[i] {
+                    continue;
+                }
+                self.depth[i] = inv_z;
+                self.covered[i] = true;
+                let channel = |k: usize| {
+                    ((l0 * a.c_over_z[k] + l1 * b.c_over_z[k] + l2 * c.c_over_z[k]) / inv_z) as f32
+                };
+                self.pixels[i] = [channel(0), channel(1), channel(2)];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Element, PolygonMesh};
+    use crate::scene::{Camera, PolygonId};
+    use glam::Vec3;
+
+    /// Tolerance on interpolated radiosity, relative to values of order one.
+    const VALUE_TOLERANCE: f32 = 1e-5;
+
+    /// A 100x100 picture looking down -z from the origin with a 90° field of
+    /// view: at depth `d` the picture spans `[-d, d]` in x and y, so one
+    /// pixel is `d / 50` wide.
+    fn view() -> View {
+        let camera = Camera {
+            eye: Vec3::ZERO,
+            lookat: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::Y,
+            fov_y: std::f32::consts::FRAC_PI_2,
+            width: 100,
+            height: 100,
+        };
+        View::new(&camera).unwrap()
+    }
+
+    /// A mesh builder: quads (one element each, counter-clockwise from the
+    /// front) with per-corner radiosity.
+    #[derive(Default)]
+    struct Builder {
+        mesh: Option<Mesh>,
+        radiosity: Vec<Rgb>,
+    }
+
+    impl Builder {
+        fn polygon(&mut self, corners: &[Vec3], values: &[f64]) -> &mut Self {
+            let mesh = self.mesh.get_or_insert_with(|| Mesh {
+                positions: vec![],
+                sample_positions: vec![],
+                vertex_polygon: vec![],
+                elements: vec![],
+                element_polygon: vec![],
+                polygons: vec![],
+            });
+            let first = mesh.positions.len() as u32;
+            let pid = PolygonId(mesh.polygons.len() as u32);
+            let normal = (corners[1] - corners[0])
+                .cross(corners[2] - corners[0])
+                .normalize();
+            for (&p, &v) in corners.iter().zip(values) {
+                mesh.positions.push(p);
+                mesh.sample_positions.push(p);
+                mesh.vertex_polygon.push(pid);
+                self.radiosity.push(Rgb::splat(v));
+            }
+            let id = |i: u32| VertexId(first + i);
+            let element = if corners.len() == 4 {
+                Element::quad(id(0), id(1), id(2), id(3))
+            } else {
+                Element::triangle(id(0), id(1), id(2))
+            };
+            let e = mesh.elements.len() as u32;
+            mesh.elements.push(element);
+            mesh.element_polygon.push(pid);
+            mesh.polygons.push(PolygonMesh {
+                nu: 1,
+                nv: 1,
+                vertices: first..mesh.positions.len() as u32,
+                elements: e..e + 1,
+                normal,
+                area: 1.0,
+            });
+            self
+        }
+
+        fn render(&self) -> Frame {
+            let mesh = self.mesh.as_ref().unwrap();
+            Rasterizer::new()
+                .render(mesh, &self.radiosity, &view())
+                .unwrap()
+                .clone()
+        }
+    }
+
+    /// An axis-aligned rectangle facing +z (towards the eye) at depth `d`,
+    /// given in pixel bounds of the 100x100 picture of [`view`].
+    fn rect(px0: f32, py0: f32, px1: f32, py1: f32, d: f32) -> [Vec3; 4] {
+        let wx = |px: f32| (px / 50.0 - 1.0) * d;
+        let wy = |py: f32| (1.0 - py / 50.0) * d;
+        [
+            Vec3::new(wx(px0), wy(py1), -d),
+            Vec3::new(wx(px1), wy(py1), -d),
+            Vec3::new(wx(px1), wy(py0), -d),
+            Vec3::new(wx(px0), wy(py0), -d),
+        ]
+    }
+
+    fn covered_count(f: &Frame) -> usize {
+        f.covered.iter().filter(|&&c| c).count()
+    }
+
+    #[test]
+    fn facing_quad_covers_its_rectangle() {
+        let frame = Builder::default()
+            .polygon(&rect(10.0, 20.0, 30.0, 60.0, 5.0), &[0.5; 4])
+            .render();
+        assert_eq!(covered_count(&frame), 20 * 40);
+        for y in 0..100 {
+            for x in 0..100 {
+                let inside = (10..30).contains(&x) && (20..60).contains(&y);
+                assert_eq!(frame.is_covered(x, y), inside, "({x}, {y})");
+                let v = frame.pixel(x, y).unwrap();
+                let want = if inside { 0.5 } else { 0.0 };
+                assert!(
+                    v.iter().all(|&c| (c - want).abs() < VALUE_TOLERANCE),
+                    "{v:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn nearer_quad_wins_in_either_order() {
+        let near = rect(10.0, 10.0, 60.0, 60.0, 2.0);
+        let far = rect(30.0, 30.0, 90.0, 90.0, 4.0);
+        let a = Builder::default()
+            .polygon(&near, &[1.0; 4])
+            .polygon(&far, &[0.25; 4])
+            .render();
+        let b = Builder::default()
+            .polygon(&far, &[0.25; 4])
+            .polygon(&near, &[1.0; 4])
+            .render();
+        assert_eq!(a, b);
+        assert_eq!(a.pixel(40, 40), Some([1.0; 3]));
+        assert_eq!(a.pixel(70, 70), Some([0.25; 3]));
+        assert_eq!(covered_count(&a), 50 * 50 + 60 * 60 - 30 * 30);
+    }
+
+    #[test]
+    fn back_face_is_black_but_occludes() {
+        let mut back = rect(10.0, 10.0, 60.0, 60.0, 2.0);
+        back.reverse();
+        let lit = rect(0.0, 0.0, 100.0, 100.0, 4.0);
+        let frame = Builder::default()
+            .polygon(&lit, &[1.0; 4])
+            .polygon(&back, &[3.0; 4])
+            .render();
+        assert_eq!(covered_count(&frame), 100 * 100);
+        assert_eq!(frame.pixel(30, 30), Some([0.0; 3]));
+        assert_eq!(frame.pixel(80, 80), Some([1.0; 3]));
+    }
+
+    #[test]
+    fn triangle_through_the_eye_plane_covers_the_lower_half() {
+        // A floor at y = -1 reaching from far in front to behind the eye:
+        // it covers everything below the horizon (rows 50..100).
+        let floor = [
+            Vec3::new(-1000.0, -1.0, -1000.0),
+            Vec3::new(0.0, -1.0, 1000.0),
+            Vec3::new(1000.0, -1.0, -1000.0),
+        ];
+        let frame = Builder::default().polygon(&floor, &[1.0; 3]).render();
+        for y in 0..100 {
+            let row = (0..100).filter(|&x| frame.is_covered(x, y)).count();
+            if y >= 51 {
+                assert_eq!(row, 100, "row {y}");
+            }
+            if y < 49 {
+                assert_eq!(row, 0, "row {y}");
+            }
+        }
+        assert!(frame.pixels.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    }
+
+    #[test]
+    fn shared_edges_have_no_gaps_or_overlaps() {
+        // A fan of thin triangles around an off-grid centre, plus the quads'
+        // own diagonals: every pixel of the covered square is drawn once.
+        let c = Vec3::new(0.123, -0.077, -3.0);
+        let ring: Vec<Vec3> = (0..24)
+            .map(|k| {
+                let a = k as f32 / 24.0 * std::f32::consts::TAU;
+                c + Vec3::new(a.cos(), a.sin(), 0.0) * 2.0
+            })
+            .collect();
+        let mut b = Builder::default();
+        for k in 0..24 {
+            b.polygon(&[c, ring[k], ring[(k + 1) % 24]], &[1.0; 3]);
+        }
+        let counts = coverage_counts(b.mesh.as_ref().unwrap(), &b.radiosity);
+        assert!(counts.iter().all(|&n| n <= 1), "a pixel drawn twice");
+        let all = b.render();
+        assert_eq!(
+            counts.iter().filter(|&&n| n == 1).count(),
+            covered_count(&all)
+        );
+        // No gap: the centre pixel's neighbourhood is fully covered.
+        let centre = view().project(c).unwrap();
+        let (cx, cy) = (centre.x as u32, centre.y as u32);
+        for y in cy - 20..cy + 20 {
+            for x in cx - 20..cx + 20 {
+                assert!(all.is_covered(x, y), "gap at ({x}, {y})");
+            }
+        }
+    }
+
+    /// How many triangles cover each pixel, drawing each triangle alone.
+    fn coverage_counts(mesh: &Mesh, radiosity: &[Rgb]) -> Vec<u32> {
+        let mut counts = vec![0u32; 100 * 100];
+        for (e, element) in mesh.elements.iter().enumerate() {
+            for tri in element.triangles() {
+                let mut single = mesh.clone();
+                single.elements = vec![Element::triangle(tri[0], tri[1], tri[2])];
+                single.element_polygon = vec![mesh.element_polygon[e]];
+                let f = Rasterizer::new()
+                    .render(&single, radiosity, &view())
+                    .unwrap()
+                    .clone();
+                for (n, &cov) in counts.iter_mut().zip(&f.covered) {
+                    *n += u32::from(cov);
+                }
+            }
+        }
+        counts
+    }
+
+    #[test]
+    fn edges_through_pixel_centres_follow_the_top_left_rule() {
+        // Edges exactly on pixel centres: the left and top ones include
+        // them, the right and bottom ones do not, and the quad's diagonal
+        // (through centres as well, it is square) is drawn once.
+        let mut b = Builder::default();
+        b.polygon(&rect(10.5, 20.5, 30.5, 40.5, 2.0), &[1.0; 4]);
+        let frame = b.render();
+        assert_eq!(covered_count(&frame), 20 * 20);
+        assert!(frame.is_covered(10, 20) && frame.is_covered(29, 39));
+        assert!(!frame.is_covered(30, 20) && !frame.is_covered(10, 40));
+        let counts = coverage_counts(b.mesh.as_ref().unwrap(), &b.radiosity);
+        assert!(counts.iter().all(|&n| n <= 1));
+        assert_eq!(counts.iter().filter(|&&n| n == 1).count(), 20 * 20);
+    }
+
+    #[test]
+    fn shared_edge_crossing_the_eye_plane_stays_watertight() {
+        // A floor quad reaching behind the eye, split along its 0–2 diagonal,
+        // which crosses the near plane off-centre: the two clipped halves
+        // must meet exactly.
+        let floor = [
+            Vec3::new(-30.0, -1.0, 7.0),
+            Vec3::new(40.0, -1.0, 9.0),
+            Vec3::new(33.0, -1.0, -50.0),
+            Vec3::new(-45.0, -1.0, -41.0),
+        ];
+        let mut b = Builder::default();
+        b.polygon(&floor, &[1.0; 4]);
+        let counts = coverage_counts(b.mesh.as_ref().unwrap(), &b.radiosity);
+        assert!(counts.iter().all(|&n| n <= 1), "a pixel drawn twice");
+        // Everything well below the horizon is floor.
+        for y in 60..100 {
+            for x in 0..100 {
+                assert_eq!(counts[y * 100 + x], 1, "gap at ({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn camera_inside_a_room_sees_walls_everywhere() {
+        // A box around an off-centre eye, every wall facing inwards with its
+        // own radiosity: every pixel is covered and lit, none is a back face.
+        let (lo, hi) = (Vec3::new(-2.0, -1.5, -4.0), Vec3::new(3.0, 2.5, 1.0));
+        let corner = |i: usize| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
+        // Each face counter-clockwise seen from inside the box.
+        let faces = [
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+        ];
+        let mut b = Builder::default();
+        for (k, f) in faces.iter().enumerate() {
+            let quad = f.map(corner);
+            b.polygon(&quad, &[k as f64 + 1.0; 4]);
+        }
+        let frame = b.render();
+        assert_eq!(covered_count(&frame), 100 * 100);
+        assert!(
+            frame.pixels.iter().all(|p| p[0] >= 1.0 - VALUE_TOLERANCE),
+            "a black pixel"
+        );
+        // The eye looks down -z, so the centre shows the far wall (face 4).
+        assert_eq!(frame.pixel(50, 50), Some([5.0; 3]));
+    }
+
+    #[test]
+    fn gradient_increases_across_a_row() {
+        let r = rect(0.0, 0.0, 100.0, 100.0, 2.0);
+        // Corners: bottom-left, bottom-right, top-right, top-left.
+        let frame = Builder::default()
+            .polygon(&r, &[0.0, 1.0, 1.0, 0.0])
+            .render();
+        for y in [0, 37, 99] {
+            let row: Vec<f32> = (0..100).map(|x| frame.pixel(x, y).unwrap()[0]).collect();
+            assert!(row.windows(2).all(|w| w[1] > w[0]), "row {y}: {row:?}");
+            // Facing the camera, perspective-correct is linear in x.
+            assert!((row[0] - 0.005).abs() < VALUE_TOLERANCE, "{}", row[0]);
+            assert!((row[99] - 0.995).abs() < VALUE_TOLERANCE, "{}", row[99]);
+        }
+    }
+
+    #[test]
+    fn perspective_correct_on_a_slanted_quad() {
+        // A floor strip from depth 1 to 3 with radiosity equal to its depth:
+        // each pixel must show the depth of the point it sees.
+        let corners = [
+            Vec3::new(-1.0, -1.0, -1.0),
+            Vec3::new(1.0, -1.0, -1.0),
+            Vec3::new(1.0, -1.0, -3.0),
+            Vec3::new(-1.0, -1.0, -3.0),
+        ];
+        let frame = Builder::default()
+            .polygon(&corners, &[1.0, 1.0, 3.0, 3.0])
+            .render();
+        for y in 0..100u32 {
+            if frame.is_covered(50, y) {
+                // Row centre at ndc_y = 1 - (y + 0.5) / 50 sees y=-1 at z = 1 / -ndc_y.
+                let ndc = 1.0 - (y as f32 + 0.5) / 50.0;
+                let want = -1.0 / ndc;
+                let got = frame.pixel(50, y).unwrap()[0];
+                assert!((got - want).abs() < 1e-4 * want, "row {y}: {got} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn same_bits_with_any_thread_count() {
+        let mut b = Builder::default();
+        for k in 0..40 {
+            let t = k as f32 * 0.37;
+            let c = Vec3::new(t.sin() * 2.0, t.cos() * 1.5, -3.0 - (k % 7) as f32);
+            b.polygon(
+                &[
+                    c,
+                    c + Vec3::new(1.3, 0.2, 0.5),
+                    c + Vec3::new(0.4, 1.1, -0.3),
+                ],
+                &[k as f64, 1.0, 0.5],
+            );
+        }
+        let mesh = b.mesh.clone().unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                Rasterizer::new()
+                    .render(&mesh, &b.radiosity, &view())
+                    .unwrap()
+                    .clone()
+            })
+        };
+        let one = run(1);
+        assert!(covered_count(&one) > 0);
+        assert_eq!(one, run(4));
+        assert_eq!(one, run(7));
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let mut b = Builder::default();
+        b.polygon(&rect(10.0, 10.0, 20.0, 20.0, 2.0), &[1.0; 4]);
+        let mesh = b.mesh.clone().unwrap();
+        let mut r = Rasterizer::new();
+        assert_eq!(
+            r.render(&mesh, &b.radiosity[..3], &view()).err(),
+            Some(RenderError::RadiosityCount {
+                expected: 4,
+                found: 3
+            })
+        );
+        let mut broken = mesh.clone();
+        broken
+            .elements
+            .push(Element::triangle(VertexId(0), VertexId(1), VertexId(9)));
+        broken.element_polygon.push(PolygonId(0));
+        assert!(matches!(
+            r.render(&broken, &b.radiosity, &view()),
+            Err(RenderError::BadMesh(_))
+        ));
+    }
+
+    #[test]
+    fn buffers_follow_the_view_size() {
+        let mut b = Builder::default();
+        b.polygon(&rect(0.0, 0.0, 100.0, 100.0, 2.0), &[1.0; 4]);
+        let mesh = b.mesh.clone().unwrap();
+        let mut r = Rasterizer::new();
+        let camera = Camera {
+            eye: Vec3::ZERO,
+            lookat: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::Y,
+            fov_y: std::f32::consts::FRAC_PI_2,
+            width: 33,
+            height: 21,
+        };
+        let small = View::new(&camera).unwrap();
+        let f = r.render(&mesh, &b.radiosity, &small).unwrap();
+        assert_eq!((f.width, f.height, f.pixels.len()), (33, 21, 33 * 21));
+        assert!(f.is_consistent());
+        let f = r.render(&mesh, &b.radiosity, &view()).unwrap();
+        assert_eq!(covered_count(f), 100 * 100);
+    }
+}
