@@ -1,5 +1,6 @@
 //! A progressive-refinement radiosity renderer with ray-traced form factors.
 
+pub mod app;
 pub mod color;
 pub mod mesh;
 pub mod output;

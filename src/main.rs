@@ -1,1 +1,197 @@
-fn main() {}
+//! `radiosity`: the command-line front end. Parses arguments, validates
+//! them into a [`RunConfig`], runs the pipeline and maps the outcome to an
+//! exit code: 0 success, 1 a failure writing results, 2 bad input or usage.
+
+use clap::Parser;
+use radiosity::app::{self, RunConfig, SceneSource};
+use radiosity::mesh::DEFAULT_INSET;
+use radiosity::render::Exposure;
+use radiosity::solver::{
+    FormFactorMethod, ShooterSamples, SolverOptions, DEFAULT_SHOOTER_SAMPLES, DEFAULT_THRESHOLD,
+};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Progressive-refinement radiosity renderer (ray-traced form factors after
+/// Wallace, Elmquist and Haines 1989).
+///
+/// Reads a .sc scene, meshes every polygon into elements, shoots light from
+/// the polygon with the most unshot power until the unshot power falls
+/// below the threshold, and writes a Gouraud-shaded picture.
+#[derive(Parser, Debug)]
+#[command(name = "radiosity", version, about, long_about = None, after_help = EXIT_CODES)]
+struct Args {
+    /// Scene file (.sc). Without it, the bundled scenes/rtable.sc.
+    scene: Option<PathBuf>,
+
+    /// Picture to write: .png or .tif/.tiff (8-bit, tone-mapped), .exr or
+    /// .pfm (32-bit float linear radiosity). Default: <scene-name>.png in
+    /// the current directory.
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+
+    /// Longest element edge, in scene units. Default: 1/40 of the scene's
+    /// bounding-box diagonal.
+    #[arg(long, value_name = "L")]
+    lenmax: Option<f32>,
+
+    /// Boundary vertices are evaluated this fraction of an element edge
+    /// inside their polygon, so room corners do not come out dark; 0
+    /// disables it.
+    #[arg(long, value_name = "F", default_value_t = DEFAULT_INSET)]
+    inset: f32,
+
+    /// Stop when the unshot power falls below this fraction of the emitted
+    /// power.
+    #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD)]
+    threshold: f64,
+
+    /// Stop after this many shooting steps at most.
+    #[arg(long, value_name = "N")]
+    max_steps: Option<u64>,
+
+    /// Form factor estimate: `wallace` (rays to every shooter sample) or
+    /// `center` (one ray from the shooter's centre, point-to-disc form
+    /// factor: fast, blocky shadows).
+    #[arg(long, value_name = "METHOD", default_value = "wallace", value_parser = ["wallace", "center"])]
+    form_factor: String,
+
+    /// Shooter sample points: a shooter with more element vertices than N
+    /// shoots from a regular grid of at most N points; `all` always uses
+    /// every element vertex (exact, slow on fine meshes).
+    #[arg(long, value_name = "N|all", default_value_t = DEFAULT_SHOOTER_SAMPLES.to_string())]
+    shooter_samples: String,
+
+    /// Use the plain disc approximation even for receivers close to a
+    /// shooter sample (the exact near-field form factor is on by default).
+    #[arg(long)]
+    no_near_field: bool,
+
+    /// Picture size in pixels, overriding the scene's camera.
+    #[arg(long, value_name = "WxH")]
+    size: Option<String>,
+
+    /// Exposure multiplier for 8-bit pictures; default: automatic (the
+    /// 95th-percentile luminance maps to 0.9).
+    #[arg(long, value_name = "X")]
+    exposure: Option<f32>,
+
+    /// Write counts and seconds per phase as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    stats: Option<PathBuf>,
+
+    /// Worker threads for the solver and renderer; default: all cores.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+const EXIT_CODES: &str = "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage.";
+
+/// A usage error found while validating arguments.
+fn usage(message: String) -> ExitCode {
+    eprintln!("error: {message}");
+    ExitCode::from(2)
+}
+
+fn config(args: &Args) -> Result<RunConfig, String> {
+    let form_factor = match args.form_factor.as_str() {
+        "center" => FormFactorMethod::Center,
+        _ => FormFactorMethod::Wallace,
+    };
+    let shooter_samples = match args.shooter_samples.as_str() {
+        "all" => ShooterSamples::All,
+        n => match n.parse::<u32>() {
+            Ok(n) if n >= 1 => ShooterSamples::AtMost(n),
+            _ => return Err(format!("--shooter-samples must be `all` or a whole number >= 1, got `{n}`")),
+        },
+    };
+    if !(0.0..=1.0).contains(&args.threshold) {
+        return Err(format!("--threshold must be between 0 and 1, got {}", args.threshold));
+    }
+    if let Some(l) = args.lenmax {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(format!("--lenmax must be a positive number of scene units, got {l}"));
+        }
+    }
+    if !(args.inset.is_finite() && (0.0..0.5).contains(&args.inset)) {
+        return Err(format!("--inset must be at least 0 and below 0.5, got {}", args.inset));
+    }
+    let size = match &args.size {
+        None => None,
+        Some(s) => {
+            let parsed = s
+                .split_once(['x', 'X'])
+                .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)));
+            match parsed {
+                Some((w, h)) if w >= 1 && h >= 1 => Some((w, h)),
+                _ => return Err(format!("--size must look like 640x480 (whole numbers >= 1), got `{s}`")),
+            }
+        }
+    };
+    let exposure = match args.exposure {
+        None => Exposure::Auto,
+        Some(x) if x.is_finite() && x > 0.0 => Exposure::Fixed(x),
+        Some(x) => return Err(format!("--exposure must be a positive number, got {x}")),
+    };
+    Ok(RunConfig {
+        scene: args.scene.clone().map_or(SceneSource::Bundled, SceneSource::File),
+        output: args.output.clone(),
+        lenmax: args.lenmax,
+        inset: args.inset,
+        solver: SolverOptions {
+            form_factor,
+            shooter_samples,
+            threshold: args.threshold,
+            max_steps: args.max_steps,
+            near_field: !args.no_near_field,
+        },
+        size,
+        exposure,
+        stats: args.stats.clone(),
+        progress: !args.quiet,
+    })
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let config = match config(&args) {
+        Ok(c) => c,
+        Err(message) => return usage(message),
+    };
+    if let Some(threads) = args.threads {
+        if threads == 0 {
+            return usage("--threads must be at least 1".into());
+        }
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(threads).build_global() {
+            eprintln!("error: cannot start {threads} threads: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    if args.output.is_none() && !args.quiet {
+        eprintln!(
+            "no -o given and no window available: writing {}.png in the current directory",
+            config.scene.stem()
+        );
+    }
+    match app::run(&config) {
+        Ok(stats) => {
+            if !args.quiet {
+                eprintln!("{}", app::summary(&stats));
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            // Load errors already read `FILE:LINE:COL: error: ...`.
+            if matches!(e, app::RunError::Load(_)) {
+                eprintln!("{e}");
+            } else {
+                eprintln!("error: {e}");
+            }
+            ExitCode::from(if e.is_bad_input() { 2 } else { 1 })
+        }
+    }
+}

@@ -140,6 +140,12 @@ pub fn write_atomically_seekable(
     Ok(())
 }
 
+/// Checks, before any work is done, that `path` could be written: its
+/// directory exists and is a directory.
+pub fn check_destination(path: &Path) -> Result<(), OutputError> {
+    destination_dir(path).map(|_| ())
+}
+
 /// The directory `path` goes in, which must exist.
 fn destination_dir(path: &Path) -> Result<PathBuf, OutputError> {
     let dir = match path.parent() {

@@ -1,0 +1,350 @@
+//! The batch driver: load → mesh → solve → render → write, with progress
+//! on the terminal and timings for `--stats`.
+//!
+//! The command-line front end turns its arguments into a [`RunConfig`] and
+//! calls [`run`]; nothing here reads `argv`. A future window drives the
+//! same solver and renderer.
+
+use crate::color::Rgb;
+use crate::mesh::{self, Mesh, MeshError, MeshOptions};
+use crate::output::{self, OutputError, PictureFormat};
+use crate::render::{Exposure, Frame, Rasterizer, RenderError, View, ViewError};
+use crate::scene::{self, LoadError, Scene};
+use crate::solver::{Progressive, SolverOptions, StopReason};
+use crate::visibility::Visibility;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The bundled default scene, compiled into the binary so it works from
+/// any directory.
+pub const BUNDLED_SCENE: &str = include_str!("../scenes/rtable.sc");
+/// The name the bundled scene goes by in messages and default file names.
+pub const BUNDLED_SCENE_NAME: &str = "scenes/rtable.sc";
+
+/// Where the scene comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SceneSource {
+    /// The bundled `rtable.sc`.
+    Bundled,
+    /// A `.sc` file.
+    File(PathBuf),
+}
+
+impl SceneSource {
+    /// The scene's name for messages: the path as given.
+    pub fn display_name(&self) -> String {
+        match self {
+            SceneSource::Bundled => BUNDLED_SCENE_NAME.to_string(),
+            SceneSource::File(p) => p.display().to_string(),
+        }
+    }
+
+    /// The file stem, for default output names (`rtable` for the bundled).
+    pub fn stem(&self) -> String {
+        let path = match self {
+            SceneSource::Bundled => Path::new(BUNDLED_SCENE_NAME),
+            SceneSource::File(p) => p.as_path(),
+        };
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".to_string())
+    }
+}
+
+/// Everything one batch run needs, validated by the front end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunConfig {
+    /// The scene to solve.
+    pub scene: SceneSource,
+    /// The picture to write; `None` writes `<scene-stem>.png` in the
+    /// current directory.
+    pub output: Option<PathBuf>,
+    /// Longest element edge in scene units; `None` for the default
+    /// ([`MeshOptions::for_scene`]).
+    pub lenmax: Option<f32>,
+    /// Boundary inset as a fraction of an element edge.
+    pub inset: f32,
+    /// Solver settings.
+    pub solver: SolverOptions,
+    /// Picture size override in pixels (width, height).
+    pub size: Option<(u32, u32)>,
+    /// Exposure for 8-bit pictures.
+    pub exposure: Exposure,
+    /// Where to write the statistics JSON, if anywhere.
+    pub stats: Option<PathBuf>,
+    /// Show a progress bar (only drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scene file is bad or unreadable.
+    #[error("{0}")]
+    Load(#[from] LoadError),
+    /// The mesh options do not suit the scene.
+    #[error("{0}")]
+    Mesh(#[from] MeshError),
+    /// The camera or picture size is unusable.
+    #[error("{0}")]
+    View(#[from] ViewError),
+    /// An output path is unusable before anything was computed.
+    #[error("{0}")]
+    BadOutput(OutputError),
+    /// Rendering failed (a bug if it happens).
+    #[error("{0}")]
+    Render(#[from] RenderError),
+    /// Writing a result failed.
+    #[error("{0}")]
+    Write(OutputError),
+}
+
+impl RunError {
+    /// True when the user's input or options are at fault (exit code 2),
+    /// false for failures of the machine (exit code 1).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, RunError::Render(_) | RunError::Write(_))
+    }
+}
+
+/// Seconds spent in each phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PhaseSeconds {
+    /// Reading and validating the scene.
+    pub load: f64,
+    /// Building the element mesh.
+    pub mesh: f64,
+    /// Building the visibility BVH.
+    pub bvh: f64,
+    /// Shooting.
+    pub solve: f64,
+    /// Rasterising the picture.
+    pub render: f64,
+    /// Encoding and writing files.
+    pub write: f64,
+}
+
+/// What a run did, as written by `--stats`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunStats {
+    /// The scene as named by the user.
+    pub scene: String,
+    /// The picture written.
+    pub output: String,
+    /// Scene polygons.
+    pub polygons: usize,
+    /// Mesh elements.
+    pub elements: usize,
+    /// Mesh element vertices.
+    pub vertices: usize,
+    /// The lenmax used, in scene units.
+    pub lenmax: f32,
+    /// Shooting steps taken.
+    pub steps: u64,
+    /// Shadow rays cast.
+    pub rays: u64,
+    /// Unshot power left as a fraction of the emitted power.
+    pub unshot_fraction: f64,
+    /// True when the threshold was reached (false: step limit).
+    pub converged: bool,
+    /// Seconds per phase.
+    pub seconds: PhaseSeconds,
+}
+
+/// Runs the whole pipeline once and writes the picture (and stats).
+pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
+    let output = config
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", config.scene.stem())));
+    // Refuse unusable outputs before spending minutes on a solve.
+    PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
+    output::check_destination(&output).map_err(RunError::BadOutput)?;
+    if let Some(stats) = &config.stats {
+        output::check_destination(stats).map_err(RunError::BadOutput)?;
+    }
+    if let SceneSource::File(input) = &config.scene {
+        for out in std::iter::once(&output).chain(config.stats.as_ref()) {
+            if same_file(input, out) {
+                return Err(RunError::BadOutput(OutputError::Io {
+                    path: out.clone(),
+                    error: std::io::Error::new(
+                        std::io::ErrorKind::InvalidInput,
+                        "refusing to overwrite the input scene",
+                    ),
+                }));
+            }
+        }
+    }
+
+    let mut seconds = PhaseSeconds::default();
+    let t = Instant::now();
+    let scene = load_scene(&config.scene)?;
+    seconds.load = t.elapsed().as_secs_f64();
+
+    let view = match config.size {
+        Some((w, h)) => View::with_size(&scene.camera, w, h)?,
+        None => View::new(&scene.camera)?,
+    };
+
+    let t = Instant::now();
+    let mut mesh_options = MeshOptions::for_scene(&scene);
+    mesh_options.inset = config.inset;
+    if let Some(lenmax) = config.lenmax {
+        mesh_options.lenmax = lenmax;
+    }
+    let mesh = mesh::build(&scene, &mesh_options)?;
+    seconds.mesh = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let visibility = Visibility::new(&scene);
+    seconds.bvh = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let mut solver = Progressive::new(&scene, &mesh, &visibility, config.solver);
+    solve_with_progress(&mut solver, config.progress);
+    seconds.solve = t.elapsed().as_secs_f64();
+    solver.validate().map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
+
+    let t = Instant::now();
+    let frame = render(&mesh, solver.radiosity(), &view)?;
+    seconds.render = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    output::write_picture(&output, &frame, config.exposure).map_err(RunError::Write)?;
+    let mut stats = RunStats {
+        scene: config.scene.display_name(),
+        output: output.display().to_string(),
+        polygons: scene.polygons.len(),
+        elements: mesh.elements.len(),
+        vertices: mesh.vertex_count(),
+        lenmax: mesh_options.lenmax,
+        steps: solver.steps(),
+        rays: solver.rays(),
+        unshot_fraction: solver.unshot_fraction(),
+        converged: solver.stop_reason() == Some(StopReason::Converged),
+        seconds,
+    };
+    stats.seconds.write = t.elapsed().as_secs_f64();
+    if let Some(path) = &config.stats {
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| {
+            RunError::Write(OutputError::Io {
+                path: path.clone(),
+                error: std::io::Error::other(e),
+            })
+        })?;
+        output::write_atomically(path, |w| writeln!(w, "{json}")).map_err(RunError::Write)?;
+    }
+    Ok(stats)
+}
+
+/// Loads the scene from its source.
+pub fn load_scene(source: &SceneSource) -> Result<Scene, LoadError> {
+    match source {
+        SceneSource::Bundled => scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME),
+        SceneSource::File(path) => scene::load(path),
+    }
+}
+
+/// Renders one frame of a solution.
+pub fn render(mesh: &Mesh, radiosity: &[Rgb], view: &View) -> Result<Frame, RenderError> {
+    let mut rasterizer = Rasterizer::new();
+    Ok(rasterizer.render(mesh, radiosity, view)?.clone())
+}
+
+/// True when both paths name the same existing file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Steps the solver until it stops, drawing a progress bar on stderr when
+/// it is a terminal. The bar's position is the fraction of the way, in
+/// log scale, from the initial unshot power to the threshold; the ETA
+/// extrapolates the recent rate at which the log of the unshot power falls.
+pub fn solve_with_progress(solver: &mut Progressive, progress: bool) {
+    let target = if progress && std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    const TICKS: u64 = 1000;
+    let bar = ProgressBar::with_draw_target(Some(TICKS), target);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let threshold = solver.options().threshold.max(f64::MIN_POSITIVE);
+    let total_log = (1.0 / threshold).ln();
+    let start = Instant::now();
+    let mut rate = RateEstimate::default();
+    while !solver.is_done() {
+        let Some(report) = solver.step() else {
+            break;
+        };
+        let elapsed = start.elapsed();
+        let fraction = report.unshot_fraction.max(f64::MIN_POSITIVE);
+        let done_log = (1.0 / fraction).ln().max(0.0);
+        rate.push(elapsed, done_log);
+        let eta = rate
+            .per_second()
+            .filter(|r| *r > 0.0)
+            .map(|r| Duration::from_secs_f64(((total_log - done_log) / r).clamp(0.0, 1e7)));
+        let rays_per_s = solver.rays() as f64 / elapsed.as_secs_f64().max(1e-9);
+        bar.set_position(((done_log / total_log).clamp(0.0, 1.0) * TICKS as f64) as u64);
+        bar.set_message(format!(
+            "step {} · unshot {:.3}% · {:.2} Mrays/s · ETA {}",
+            report.step,
+            report.unshot_fraction * 100.0,
+            rays_per_s / 1e6,
+            eta.map(|d| format!("{:.0}s", d.as_secs_f64())).unwrap_or_else(|| "?".into())
+        ));
+    }
+    bar.finish_and_clear();
+}
+
+/// The rate at which `log(1 / unshot fraction)` grows, over a sliding
+/// window of recent steps.
+#[derive(Default)]
+struct RateEstimate {
+    samples: std::collections::VecDeque<(Duration, f64)>,
+}
+
+impl RateEstimate {
+    /// Steps in the window: enough to smooth the step-to-step jitter of
+    /// which polygon shoots, few enough to follow the slowing down.
+    const WINDOW: usize = 20;
+
+    fn push(&mut self, t: Duration, progress: f64) {
+        self.samples.push_back((t, progress));
+        if self.samples.len() > Self::WINDOW {
+            self.samples.pop_front();
+        }
+    }
+
+    fn per_second(&self) -> Option<f64> {
+        let (t0, p0) = *self.samples.front()?;
+        let (t1, p1) = *self.samples.back()?;
+        let dt = (t1 - t0).as_secs_f64();
+        (dt > 0.0).then(|| (p1 - p0) / dt)
+    }
+}
+
+/// A one-line summary of a finished run.
+pub fn summary(stats: &RunStats) -> String {
+    format!(
+        "{}: {} steps, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {}",
+        stats.scene,
+        stats.steps,
+        stats.seconds.solve,
+        stats.rays as f64 / 1e6,
+        stats.unshot_fraction * 100.0,
+        if stats.converged { "" } else { " (step limit)" },
+        stats.output
+    )
+}
