@@ -11,8 +11,11 @@ mod polygon;
 mod sc;
 
 pub use error::{Diagnostic, LoadError};
-pub use polygon::{PolygonError, Shape};
-pub use sc::parse_str;
+pub use polygon::{
+    PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, PARALLELOGRAM_TOLERANCE,
+    PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
+};
+pub use sc::{parse_str, MAX_COORDINATE, MAX_DIAGNOSTICS, UP_PARALLEL_TOLERANCE};
 
 use crate::color::Rgb;
 use glam::Vec3;
@@ -123,6 +126,47 @@ pub struct Camera {
     pub height: u32,
 }
 
+impl Camera {
+    /// A camera that frames the axis-aligned box `bounds_min..bounds_max`
+    /// (scene units): what a file without a `camera` block gets.
+    ///
+    /// The rule: look at the centre of the box along +z, from the -z side,
+    /// with up +y, the default field of view ([`DEFAULT_FOV_DEG`], vertical)
+    /// and size ([`DEFAULT_SIZE`]), from the distance at which the box's
+    /// bounding sphere exactly fills the vertical field of view:
+    /// `distance = radius / sin(fov_y / 2)`, with `radius` half the box's
+    /// diagonal. The default picture is wider than tall, so the sphere fits
+    /// horizontally too, and the whole scene is in view.
+    ///
+    /// A box of zero size gets a radius of 1 scene unit, so the result is
+    /// always a valid camera (`eye != lookat`), and every field is finite
+    /// for finite bounds.
+    pub fn frame(bounds_min: Vec3, bounds_max: Vec3) -> Camera {
+        let (lo, hi) = (bounds_min.as_dvec3(), bounds_max.as_dvec3());
+        let centre = 0.5 * (lo + hi);
+        let radius = 0.5 * (hi - lo).length();
+        let radius = if radius > 0.0 && radius.is_finite() {
+            radius
+        } else {
+            1.0
+        };
+        let fov_y = DEFAULT_FOV_DEG.to_radians();
+        // Never closer than a few ulps of the centre, so `eye != lookat`
+        // survives the rounding to f32 even for a tiny box far away.
+        let distance = (radius / (0.5 * f64::from(fov_y)).sin()).max(centre.z.abs() * 1e-6);
+        let limit = f64::from(f32::MAX);
+        let eye_z = (centre.z - distance).clamp(-limit, limit);
+        Camera {
+            eye: Vec3::new(centre.x as f32, centre.y as f32, eye_z as f32),
+            lookat: centre.as_vec3(),
+            up: Vec3::Y,
+            fov_y,
+            width: DEFAULT_SIZE.0,
+            height: DEFAULT_SIZE.1,
+        }
+    }
+}
+
 /// Default picture size when the scene gives none, in pixels.
 pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
 /// Default vertical field of view when the scene gives none, in degrees.
@@ -159,7 +203,10 @@ impl Scene {
     /// Axis-aligned bounds `(min, max)` of all vertices, in scene units.
     /// For an empty scene both are zero.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut it = self.polygons.iter().flat_map(|p| p.vertices.iter().copied());
+        let mut it = self
+            .polygons
+            .iter()
+            .flat_map(|p| p.vertices.iter().copied());
         match it.next() {
             None => (Vec3::ZERO, Vec3::ZERO),
             Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),
