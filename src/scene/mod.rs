@@ -224,3 +224,37 @@ impl Scene {
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
     sc::load_file(path)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_fits_the_bounding_sphere_in_the_default_view() {
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 4.0, 6.0));
+        let c = Camera::frame(lo, hi);
+        assert_eq!(c.lookat, Vec3::new(1.0, 2.0, 4.0));
+        assert_eq!(c.up, Vec3::Y);
+        assert_eq!(c.fov_y, DEFAULT_FOV_DEG.to_radians());
+        assert_eq!((c.width, c.height), DEFAULT_SIZE);
+        // Straight down -z from the centre, at radius / sin(fov / 2).
+        let radius = 0.5 * (hi - lo).length();
+        let distance = radius / (0.5 * c.fov_y).sin();
+        assert!((c.eye - Vec3::new(1.0, 2.0, 4.0 - distance)).length() < 1e-4);
+    }
+
+    #[test]
+    fn frame_is_a_valid_camera_for_degenerate_bounds() {
+        let c = Camera::frame(Vec3::ZERO, Vec3::ZERO);
+        assert_ne!(c.eye, c.lookat);
+        assert!(c.eye.z < 0.0);
+        // A tiny scene far away still gets a view direction after rounding.
+        let far = Vec3::new(0.0, 0.0, 1e7);
+        let c = Camera::frame(far, far + Vec3::splat(1e-6));
+        assert_ne!(c.eye, c.lookat);
+        assert!(c.eye.is_finite());
+        // Huge bounds stay finite.
+        let c = Camera::frame(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
+        assert!(c.eye.is_finite() && c.lookat.is_finite());
+    }
+}
