@@ -1,4 +1,17 @@
-//! Load errors with positions. (placeholder; being written)
+//! Load errors with positions.
+//!
+//! Every problem the loader finds becomes a [`Diagnostic`] that names the
+//! file, the line and the column (counted in Unicode characters, from 1) of
+//! the token at fault, in the form compilers use:
+//!
+//! ```text
+//! scene.sc:12:3: error: duplicate `eye` in camera block (first at 4:3)
+//! ```
+//!
+//! A failed load is a [`LoadError`] holding one or more diagnostics in file
+//! order, so a user can fix several mistakes per run.
+
+use super::SourcePos;
 use std::fmt;
 
 /// One problem found while loading, with its position.
@@ -10,8 +23,28 @@ pub struct Diagnostic {
     pub line: u32,
     /// Column in characters, from 1.
     pub col: u32,
-    /// What is wrong.
+    /// What is wrong: one line, no trailing period, no position.
     pub message: String,
+}
+
+impl Diagnostic {
+    /// A diagnostic for `file` at `pos`.
+    pub fn new(file: &str, pos: SourcePos, message: impl Into<String>) -> Self {
+        Diagnostic {
+            file: file.to_owned(),
+            line: pos.line,
+            col: pos.col,
+            message: message.into(),
+        }
+    }
+
+    /// Where it points, as a [`SourcePos`].
+    pub fn pos(&self) -> SourcePos {
+        SourcePos {
+            line: self.line,
+            col: self.col,
+        }
+    }
 }
 
 impl fmt::Display for Diagnostic {
@@ -31,6 +64,21 @@ pub struct LoadError {
     pub diagnostics: Vec<Diagnostic>,
 }
 
+impl LoadError {
+    /// The first problem, the one a user should fix first.
+    pub fn first(&self) -> Option<&Diagnostic> {
+        self.diagnostics.first()
+    }
+}
+
+impl From<Diagnostic> for LoadError {
+    fn from(d: Diagnostic) -> Self {
+        LoadError {
+            diagnostics: vec![d],
+        }
+    }
+}
+
 impl fmt::Display for LoadError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         for (i, d) in self.diagnostics.iter().enumerate() {
@@ -40,5 +88,66 @@ impl fmt::Display for LoadError {
             write!(f, "{d}")?;
         }
         Ok(())
+    }
+}
+
+/// Formats a quantity for a message with about three significant digits and
+/// no trailing zeros (`0.31`, `0.005`, `120`), so messages stay short
+/// whatever the scale of the scene.
+pub(crate) fn fmt_num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor();
+    // Three significant digits; clamp so huge or tiny values stay readable.
+    let decimals = (2.0 - magnitude).clamp(0.0, 12.0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn diag(line: u32, col: u32, message: &str) -> Diagnostic {
+        Diagnostic::new("a.sc", SourcePos { line, col }, message)
+    }
+
+    #[test]
+    fn diagnostic_displays_like_a_compiler() {
+        assert_eq!(
+            diag(3, 7, "unknown keyword `foo`").to_string(),
+            "a.sc:3:7: error: unknown keyword `foo`"
+        );
+    }
+
+    #[test]
+    fn load_error_prints_one_line_per_diagnostic() {
+        let e = LoadError {
+            diagnostics: vec![diag(1, 1, "first"), diag(2, 5, "second")],
+        };
+        assert_eq!(
+            e.to_string(),
+            "a.sc:1:1: error: first\na.sc:2:5: error: second"
+        );
+        assert_eq!(
+            e.first().map(|d| d.pos()),
+            Some(SourcePos { line: 1, col: 1 })
+        );
+    }
+
+    #[test]
+    fn numbers_in_messages_have_three_significant_digits() {
+        assert_eq!(fmt_num(0.31), "0.31");
+        assert_eq!(fmt_num(0.005), "0.005");
+        assert_eq!(fmt_num(0.0123456), "0.0123");
+        assert_eq!(fmt_num(120.0), "120");
+        assert_eq!(fmt_num(1.5), "1.5");
+        assert_eq!(fmt_num(-2.25), "-2.25");
+        assert_eq!(fmt_num(0.0), "0");
     }
 }

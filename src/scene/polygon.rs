@@ -1,22 +1,513 @@
-//! Polygon validation and classification. (placeholder; being written)
+//! Polygon validation and classification.
+//!
+//! [`Polygon::new`] is the one door through which vertices become a
+//! [`Polygon`]: it refuses anything the later stages cannot mesh or light
+//! (too few vertices, repeated vertices, zero area, non-planar, non-convex),
+//! computes the normal and area by Newell's method in `f64`, and decides the
+//! [`Shape`], which picks the meshing scheme.
+//!
+//! All tolerances are relative to the polygon's *extent*, the largest
+//! distance between two of its vertices, so a scene means the same thing
+//! whatever its unit of length.
+
+use super::error::fmt_num;
+use super::{MaterialId, Polygon, SourcePos};
+use glam::{DVec3, Vec3};
+
+/// How far a vertex may lie from the polygon's plane, as a fraction of the
+/// polygon's extent (the format's "within 1e-3 of the largest extent").
+pub const PLANARITY_TOLERANCE: f64 = 1e-3;
+
+/// Two consecutive vertices closer than this fraction of the extent count as
+/// equal. Non-zero so that vertices equal up to `f32` rounding (after a
+/// transform, say) are caught as what they are rather than as a fold.
+pub const COINCIDENT_TOLERANCE: f64 = 1e-6;
+
+/// A polygon whose area is below this fraction of its extent squared has
+/// zero area. Coordinates are `f32`, so exactly collinear points written in
+/// decimal still produce a tiny rounding area of order `1e-8 × extent²`.
+pub const ZERO_AREA_TOLERANCE: f64 = 1e-7;
+
+/// A turn at a vertex whose sine (relative to the normal) is above
+/// `-CONVEXITY_TOLERANCE` counts as convex. Slightly negative values come
+/// from `f32` rounding of collinear vertices, which the format allows.
+pub const CONVEXITY_TOLERANCE: f64 = 1e-6;
+
+/// How far, in radians, the edges' total turning may differ from one full
+/// turn (`2π`) before the polygon is taken to wind around more than once.
+pub const TURNING_TOLERANCE: f64 = 1e-3;
+
+/// A quadrilateral is a parallelogram when `|v0 + v2 - v1 - v3|` is at most
+/// this fraction of its extent. Loose enough for `f32` rounding after a
+/// rotation, tight enough that meshing it as an exact parallelogram moves no
+/// vertex visibly.
+pub const PARALLELOGRAM_TOLERANCE: f64 = 1e-5;
 
 /// How a polygon is meshed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape {
     /// Three vertices.
     Triangle,
-    /// Four vertices with `v0 + v2 == v1 + v3` (within tolerance).
+    /// Four vertices with `v0 + v2 == v1 + v3` (within
+    /// [`PARALLELOGRAM_TOLERANCE`] of the extent): meshed into congruent
+    /// parallelogram elements.
     Parallelogram,
-    /// Any other convex quadrilateral.
+    /// Any other convex quadrilateral: meshed into a bilinear grid.
     Quad,
     /// Five or more vertices.
     Convex,
 }
 
-/// Why a list of vertices is not a valid polygon.
+/// Why a list of vertices is not a valid polygon. Vertex numbers in the
+/// variants and messages count from 1, in the order the vertices were given.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PolygonError {
-    /// Placeholder.
-    #[error("invalid polygon")]
-    Invalid,
+    /// Fewer than three vertices.
+    #[error("polygon has {count} vertices; at least 3 are needed")]
+    TooFewVertices {
+        /// How many there are.
+        count: usize,
+    },
+    /// A coordinate is NaN or infinite (for instance after a huge scale).
+    #[error("vertex {vertex} is not finite")]
+    NotFinite {
+        /// Which vertex, from 1.
+        vertex: usize,
+    },
+    /// Two consecutive vertices (also the last and the first) coincide.
+    #[error("vertices {first} and {second} are equal")]
+    EqualVertices {
+        /// The earlier of the two, from 1.
+        first: usize,
+        /// The later of the two, from 1 (1 when `first` is the last vertex).
+        second: usize,
+    },
+    /// The area is zero (for instance all vertices on one line).
+    #[error("polygon has zero area")]
+    ZeroArea,
+    /// A vertex lies too far from the polygon's plane.
+    #[error(
+        "polygon is not planar: vertex {vertex} is {} units from the plane (tolerance {})",
+        fmt_num(*.distance),
+        fmt_num(*.tolerance)
+    )]
+    NotPlanar {
+        /// The vertex farthest from the plane, from 1.
+        vertex: usize,
+        /// Its distance from the plane, in scene units.
+        distance: f64,
+        /// The largest distance allowed, in scene units.
+        tolerance: f64,
+    },
+    /// The polygon turns the wrong way (or folds back) at a vertex.
+    #[error("polygon is not convex at vertex {vertex}")]
+    NotConvex {
+        /// Where, from 1.
+        vertex: usize,
+    },
+    /// Every turn goes the same way but the boundary winds around more than
+    /// once, like a pentagram.
+    #[error(
+        "polygon is not convex: its edges turn through {} degrees, not 360 (it overlaps itself)",
+        fmt_num(*.turning_deg)
+    )]
+    SelfOverlapping {
+        /// Total turning of the edges, in degrees.
+        turning_deg: f64,
+    },
+    /// The stored normal, area or shape disagree with the vertices (only
+    /// from [`Polygon::validate`] on a polygon built by hand).
+    #[error("polygon's {what} does not match its vertices")]
+    Inconsistent {
+        /// Which derived field is wrong.
+        what: &'static str,
+    },
+}
+
+/// What [`analyze`] learns from valid vertices.
+struct Analysis {
+    normal: DVec3,
+    area: f64,
+    shape: Shape,
+}
+
+impl Polygon {
+    /// Validates the vertices and builds the polygon, with its unit normal
+    /// (the direction of Newell's area vector), its area in square scene
+    /// units, and its [`Shape`].
+    ///
+    /// `vertices` are in scene units, in order around the polygon,
+    /// counter-clockwise seen from the front. `origin` is where the statement
+    /// that made it starts, for later messages.
+    pub fn new(
+        material: MaterialId,
+        vertices: Vec<Vec3>,
+        origin: SourcePos,
+    ) -> Result<Polygon, PolygonError> {
+        let a = analyze(&vertices)?;
+        Ok(Polygon {
+            material,
+            vertices,
+            normal: a.normal.as_vec3(),
+            area: a.area,
+            shape: a.shape,
+            origin,
+        })
+    }
+
+    /// Re-checks every invariant of the type: the vertices are valid and the
+    /// stored normal, area and shape are the ones [`Polygon::new`] computes.
+    /// For tests and for polygons assembled field by field.
+    pub fn validate(&self) -> Result<(), PolygonError> {
+        let a = analyze(&self.vertices)?;
+        // The stored values went through f32; allow for that rounding only.
+        const STORED_TOLERANCE: f64 = 1e-5;
+        if (self.normal.as_dvec3() - a.normal).length() > STORED_TOLERANCE {
+            return Err(PolygonError::Inconsistent { what: "normal" });
+        }
+        if (self.area - a.area).abs() > STORED_TOLERANCE * a.area {
+            return Err(PolygonError::Inconsistent { what: "area" });
+        }
+        if self.shape != a.shape {
+            return Err(PolygonError::Inconsistent { what: "shape" });
+        }
+        Ok(())
+    }
+}
+
+/// Checks the vertices in the order of the error variants (so the simplest
+/// explanation wins) and computes the derived fields.
+fn analyze(vertices: &[Vec3]) -> Result<Analysis, PolygonError> {
+    let n = vertices.len();
+    if n < 3 {
+        return Err(PolygonError::TooFewVertices { count: n });
+    }
+    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
+        return Err(PolygonError::NotFinite { vertex: i + 1 });
+    }
+    let v: Vec<DVec3> = vertices.iter().map(|p| p.as_dvec3()).collect();
+    let extent = diameter(&v);
+    if !extent.is_finite() {
+        // Finite f32 coordinates cannot overflow in f64; kept so a future
+        // change of precision cannot slip a NaN past the checks below.
+        return Err(PolygonError::NotFinite { vertex: 1 });
+    }
+
+    for i in 0..n {
+        let j = (i + 1) % n;
+        if v[i].distance(v[j]) <= COINCIDENT_TOLERANCE * extent {
+            return Err(PolygonError::EqualVertices {
+                first: i + 1,
+                second: j + 1,
+            });
+        }
+    }
+
+    // Newell's method about the centroid: twice the area vector, and exact
+    // for planar polygons whatever the winding of the coordinate axes.
+    let centroid = v.iter().sum::<DVec3>() / n as f64;
+    let mut twice_area = DVec3::ZERO;
+    for i in 0..n {
+        let a = v[i] - centroid;
+        let b = v[(i + 1) % n] - centroid;
+        twice_area += a.cross(b);
+    }
+    let area = 0.5 * twice_area.length();
+    if area <= ZERO_AREA_TOLERANCE * extent * extent {
+        return Err(PolygonError::ZeroArea);
+    }
+    let normal = twice_area / (2.0 * area);
+
+    let tolerance = PLANARITY_TOLERANCE * extent;
+    let (worst, distance) = v
+        .iter()
+        .map(|p| (p - centroid).dot(normal).abs())
+        .enumerate()
+        .fold(
+            (0, 0.0),
+            |best, (i, d)| if d > best.1 { (i, d) } else { best },
+        );
+    if distance > tolerance {
+        return Err(PolygonError::NotPlanar {
+            vertex: worst + 1,
+            distance,
+            tolerance,
+        });
+    }
+
+    let mut turning = 0.0;
+    for i in 0..n {
+        let prev = v[(i + n - 1) % n];
+        let next = v[(i + 1) % n];
+        let e1 = (v[i] - prev).normalize();
+        let e2 = (next - v[i]).normalize();
+        let sin = e1.cross(e2).dot(normal);
+        let cos = e1.dot(e2);
+        // A straight-through vertex (cos ≈ 1) is allowed; one where the
+        // boundary doubles back (cos ≈ -1) is a fold, not a convex corner.
+        if sin < -CONVEXITY_TOLERANCE || (sin.abs() <= CONVEXITY_TOLERANCE && cos < 0.0) {
+            return Err(PolygonError::NotConvex { vertex: i + 1 });
+        }
+        turning += sin.atan2(cos);
+    }
+    if (turning - std::f64::consts::TAU).abs() > TURNING_TOLERANCE {
+        return Err(PolygonError::SelfOverlapping {
+            turning_deg: turning.to_degrees(),
+        });
+    }
+
+    let shape = match n {
+        3 => Shape::Triangle,
+        4 if (v[0] + v[2] - v[1] - v[3]).length() <= PARALLELOGRAM_TOLERANCE * extent => {
+            Shape::Parallelogram
+        }
+        4 => Shape::Quad,
+        _ => Shape::Convex,
+    };
+    Ok(Analysis {
+        normal,
+        area,
+        shape,
+    })
+}
+
+/// The largest distance between two vertices. Quadratic, which is fine for
+/// the handful of vertices a planar convex polygon has in practice.
+fn diameter(v: &[DVec3]) -> f64 {
+    let mut d2: f64 = 0.0;
+    for (i, a) in v.iter().enumerate() {
+        for b in &v[i + 1..] {
+            d2 = d2.max(a.distance_squared(*b));
+        }
+    }
+    d2.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn poly(vs: &[[f32; 3]]) -> Result<Polygon, PolygonError> {
+        let vertices = vs.iter().map(|&a| Vec3::from_array(a)).collect();
+        Polygon::new(MaterialId(0), vertices, SourcePos { line: 1, col: 1 })
+    }
+
+    fn ok(vs: &[[f32; 3]]) -> Polygon {
+        match poly(vs) {
+            Ok(p) => {
+                assert_eq!(p.validate(), Ok(()));
+                p
+            }
+            Err(e) => panic!("expected a valid polygon, got: {e}"),
+        }
+    }
+
+    fn err(vs: &[[f32; 3]]) -> String {
+        match poly(vs) {
+            Ok(p) => panic!("expected an error, got {p:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn triangle_normal_area_and_shape() {
+        let p = ok(&[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+        assert_eq!(p.shape, Shape::Triangle);
+        assert_eq!(p.normal, Vec3::Z);
+        assert!((p.area - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn square_is_parallelogram_and_normal_follows_winding() {
+        // Counter-clockwise seen from +y, as the format's floor example.
+        let p = ok(&[
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 5.0],
+            [5.0, 0.0, 5.0],
+            [5.0, 0.0, 0.0],
+        ]);
+        assert_eq!(p.shape, Shape::Parallelogram);
+        assert_eq!(p.normal, Vec3::Y);
+        assert!((p.area - 25.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn skewed_parallelogram_and_trapezoid() {
+        let para = ok(&[
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ]);
+        assert_eq!(para.shape, Shape::Parallelogram);
+        let trapezoid = ok(&[
+            [0.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ]);
+        assert_eq!(trapezoid.shape, Shape::Quad);
+        assert!((trapezoid.area - 2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn pentagon_is_convex_shape() {
+        let p = ok(&[
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 1.0, 0.0],
+            [1.0, 2.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ]);
+        assert_eq!(p.shape, Shape::Convex);
+        assert_eq!(p.normal, Vec3::Z);
+    }
+
+    #[test]
+    fn collinear_consecutive_vertices_are_allowed() {
+        // A square with an extra vertex in the middle of its first edge.
+        let p = ok(&[
+            [0.0, 0.0, 0.0],
+            [0.5, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ]);
+        assert_eq!(p.shape, Shape::Convex);
+        assert!((p.area - 1.0).abs() < 1e-9);
+        // Decimal coordinates that are only collinear up to f32 rounding.
+        ok(&[
+            [0.1, 0.1, 0.1],
+            [0.2, 0.2, 0.2],
+            [0.3, 0.3, 0.3],
+            [0.3, 0.7, 0.3],
+        ]);
+    }
+
+    #[test]
+    fn clockwise_vertices_give_the_opposite_normal() {
+        let p = ok(&[[0.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]]);
+        assert_eq!(p.normal, -Vec3::Z);
+    }
+
+    #[test]
+    fn too_few_vertices() {
+        assert_eq!(
+            err(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
+            "polygon has 2 vertices; at least 3 are needed"
+        );
+    }
+
+    #[test]
+    fn non_finite_vertex() {
+        assert_eq!(
+            err(&[[0.0, 0.0, 0.0], [f32::INFINITY, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+            "vertex 2 is not finite"
+        );
+        assert_eq!(
+            err(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, f32::NAN, 0.0]]),
+            "vertex 3 is not finite"
+        );
+    }
+
+    #[test]
+    fn equal_consecutive_vertices() {
+        assert_eq!(
+            err(&[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ]),
+            "vertices 2 and 3 are equal"
+        );
+        assert_eq!(
+            err(&[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 0.0],
+            ]),
+            "vertices 4 and 1 are equal"
+        );
+    }
+
+    #[test]
+    fn zero_area() {
+        assert_eq!(
+            err(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]),
+            "polygon has zero area"
+        );
+    }
+
+    #[test]
+    fn non_planar() {
+        let e = err(&[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.5],
+        ]);
+        // Extent 1.5 (vertex 2 to vertex 4), so the tolerance is 0.0015.
+        assert_eq!(
+            e,
+            "polygon is not planar: vertex 1 is 0.118 units from the plane (tolerance 0.0015)"
+        );
+        // Within 1e-3 of the extent is planar enough.
+        ok(&[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.001],
+        ]);
+    }
+
+    #[test]
+    fn non_convex() {
+        // An arrowhead: vertex 3 points inward.
+        assert_eq!(
+            err(&[
+                [0.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [1.0, 0.5, 0.0],
+                [2.0, 2.0, 0.0],
+                [0.0, 2.0, 0.0],
+            ]),
+            "polygon is not convex at vertex 3"
+        );
+        // A boundary that runs back along itself.
+        assert_eq!(
+            err(&[
+                [0.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ]),
+            "polygon is not convex at vertex 2"
+        );
+    }
+
+    #[test]
+    fn pentagram_winds_twice() {
+        let pts: Vec<[f32; 3]> = (0..5)
+            .map(|k| {
+                let a = (k as f32) * 2.0 * std::f32::consts::TAU / 5.0;
+                [a.cos(), a.sin(), 0.0]
+            })
+            .collect();
+        assert_eq!(
+            err(&pts),
+            "polygon is not convex: its edges turn through 720 degrees, not 360 (it overlaps itself)"
+        );
+    }
+
+    #[test]
+    fn validate_catches_tampered_fields() {
+        let mut p = ok(&[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+        p.normal = -p.normal;
+        assert_eq!(
+            p.validate(),
+            Err(PolygonError::Inconsistent { what: "normal" })
+        );
+    }
 }
