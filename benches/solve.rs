@@ -1,1 +1,50 @@
-fn main() {}
+//! Solve benchmarks: the bundled `rtable` and `cornell` scenes at their
+//! README settings (default lenmax, 64 shooter samples, 0.1 % threshold),
+//! from mesh to converged solution. Rays per second are printed once per
+//! scene; criterion reports the time per solve.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use radiosity::mesh::{self, MeshOptions};
+use radiosity::scene::{self, Scene};
+use radiosity::solver::{Progressive, SolverOptions};
+use radiosity::visibility::Visibility;
+use std::path::Path;
+use std::time::Instant;
+
+fn load(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    scene::load(&path).expect("bundled scene loads")
+}
+
+/// One full solve; returns (steps, rays).
+fn solve(scene: &Scene) -> (u64, u64) {
+    let mesh = mesh::build(scene, &MeshOptions::for_scene(scene)).expect("mesh");
+    let visibility = Visibility::new(scene);
+    let mut solver = Progressive::new(scene, &mesh, &visibility, SolverOptions::default());
+    while !solver.is_done() && solver.step().is_some() {}
+    (solver.steps(), solver.rays())
+}
+
+fn bench_solve(c: &mut Criterion) {
+    let mut group = c.benchmark_group("solve");
+    group.sample_size(10);
+    for name in ["rtable.sc", "cornell.sc"] {
+        let scene = load(name);
+        let t = Instant::now();
+        let (steps, rays) = solve(&scene);
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!(
+            "{name}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
+            rays as f64 / 1e6,
+            secs,
+            rays as f64 / secs / 1e6
+        );
+        group.bench_function(name, |b| b.iter(|| solve(&scene)));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_solve);
+criterion_main!(benches);

@@ -207,7 +207,9 @@ pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
     let mut solver = Progressive::new(&scene, &mesh, &visibility, config.solver);
     solve_with_progress(&mut solver, config.progress);
     seconds.solve = t.elapsed().as_secs_f64();
-    solver.validate().map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
+    solver
+        .validate()
+        .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
 
     let t = Instant::now();
     let frame = render(&mesh, solver.radiosity(), &view)?;
@@ -302,7 +304,8 @@ pub fn solve_with_progress(solver: &mut Progressive, progress: bool) {
             report.step,
             report.unshot_fraction * 100.0,
             rays_per_s / 1e6,
-            eta.map(|d| format!("{:.0}s", d.as_secs_f64())).unwrap_or_else(|| "?".into())
+            eta.map(|d| format!("{:.0}s", d.as_secs_f64()))
+                .unwrap_or_else(|| "?".into())
         ));
     }
     bar.finish_and_clear();

@@ -30,7 +30,7 @@ struct Args {
     #[arg(short, long, value_name = "FILE")]
     output: Option<PathBuf>,
 
-    /// Longest element edge, in scene units. Default: 1/40 of the scene's
+    /// Longest element edge, in scene units. Default: 1/80 of the scene's
     /// bounding-box diagonal.
     #[arg(long, value_name = "L")]
     lenmax: Option<f32>,
@@ -89,7 +89,8 @@ struct Args {
     quiet: bool,
 }
 
-const EXIT_CODES: &str = "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage.";
+const EXIT_CODES: &str =
+    "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage.";
 
 /// A usage error found while validating arguments.
 fn usage(message: String) -> ExitCode {
@@ -106,19 +107,31 @@ fn config(args: &Args) -> Result<RunConfig, String> {
         "all" => ShooterSamples::All,
         n => match n.parse::<u32>() {
             Ok(n) if n >= 1 => ShooterSamples::AtMost(n),
-            _ => return Err(format!("--shooter-samples must be `all` or a whole number >= 1, got `{n}`")),
+            _ => {
+                return Err(format!(
+                    "--shooter-samples must be `all` or a whole number >= 1, got `{n}`"
+                ))
+            }
         },
     };
     if !(0.0..=1.0).contains(&args.threshold) {
-        return Err(format!("--threshold must be between 0 and 1, got {}", args.threshold));
+        return Err(format!(
+            "--threshold must be between 0 and 1, got {}",
+            args.threshold
+        ));
     }
     if let Some(l) = args.lenmax {
         if !(l.is_finite() && l > 0.0) {
-            return Err(format!("--lenmax must be a positive number of scene units, got {l}"));
+            return Err(format!(
+                "--lenmax must be a positive number of scene units, got {l}"
+            ));
         }
     }
     if !(args.inset.is_finite() && (0.0..0.5).contains(&args.inset)) {
-        return Err(format!("--inset must be at least 0 and below 0.5, got {}", args.inset));
+        return Err(format!(
+            "--inset must be at least 0 and below 0.5, got {}",
+            args.inset
+        ));
     }
     let size = match &args.size {
         None => None,
@@ -128,7 +141,11 @@ fn config(args: &Args) -> Result<RunConfig, String> {
                 .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)));
             match parsed {
                 Some((w, h)) if w >= 1 && h >= 1 => Some((w, h)),
-                _ => return Err(format!("--size must look like 640x480 (whole numbers >= 1), got `{s}`")),
+                _ => {
+                    return Err(format!(
+                        "--size must look like 640x480 (whole numbers >= 1), got `{s}`"
+                    ))
+                }
             }
         }
     };
@@ -138,7 +155,10 @@ fn config(args: &Args) -> Result<RunConfig, String> {
         Some(x) => return Err(format!("--exposure must be a positive number, got {x}")),
     };
     Ok(RunConfig {
-        scene: args.scene.clone().map_or(SceneSource::Bundled, SceneSource::File),
+        scene: args
+            .scene
+            .clone()
+            .map_or(SceneSource::Bundled, SceneSource::File),
         output: args.output.clone(),
         lenmax: args.lenmax,
         inset: args.inset,
@@ -166,7 +186,10 @@ fn main() -> ExitCode {
         if threads == 0 {
             return usage("--threads must be at least 1".into());
         }
-        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(threads).build_global() {
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global()
+        {
             eprintln!("error: cannot start {threads} threads: {e}");
             return ExitCode::from(1);
         }

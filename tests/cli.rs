@@ -13,19 +13,40 @@ const QUICK: &[&str] = &["--threshold", "0.05", "--shooter-samples", "16", "-q"]
 fn render_scene(name: &str, lenmax: &str) {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene(name);
-    let mut args = vec![scene.to_str().unwrap(), "-o", "out.png", "--lenmax", lenmax, "--stats", "stats.json"];
+    let mut args = vec![
+        scene.to_str().unwrap(),
+        "-o",
+        "out.png",
+        "--lenmax",
+        lenmax,
+        "--stats",
+        "stats.json",
+    ];
     args.extend_from_slice(QUICK);
     let out = run_in(dir.path(), &args);
     assert!(out.status.success(), "{name}: {}", stderr(&out));
     let img = image::open(dir.path().join("out.png")).unwrap().to_rgb8();
     let text = std::fs::read_to_string(scene).unwrap();
     // The camera's size line, e.g. `size 640 480`.
-    let size_line = text.lines().find(|l| l.trim_start().starts_with("size")).unwrap();
-    let nums: Vec<u32> = size_line.split_whitespace().skip(1).take(2).map(|n| n.parse().unwrap()).collect();
+    let size_line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("size"))
+        .unwrap();
+    let nums: Vec<u32> = size_line
+        .split_whitespace()
+        .skip(1)
+        .take(2)
+        .map(|n| n.parse().unwrap())
+        .collect();
     assert_eq!((img.width(), img.height()), (nums[0], nums[1]), "{name}");
     let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
-    assert!(lit > (img.width() * img.height()) as usize / 4, "{name}: only {lit} lit pixels");
-    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap()).unwrap();
+    assert!(
+        lit > (img.width() * img.height()) as usize / 4,
+        "{name}: only {lit} lit pixels"
+    );
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
+            .unwrap();
     assert!(stats["steps"].as_u64().unwrap() > 0);
     assert!(stats["rays"].as_u64().unwrap() > 0);
     assert!(stats["vertices"].as_u64().unwrap() > stats["polygons"].as_u64().unwrap());
@@ -52,7 +73,10 @@ fn table_chair_renders() {
 #[test]
 fn default_run_writes_scene_named_png_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
-    let out = run_in(dir.path(), &["--lenmax", "0.5", "--threshold", "0.2", "--size", "64x48"]);
+    let out = run_in(
+        dir.path(),
+        &["--lenmax", "0.5", "--threshold", "0.2", "--size", "64x48"],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("rtable.png"), "{}", stderr(&out));
     let img = image::open(dir.path().join("rtable.png")).unwrap();
@@ -66,7 +90,18 @@ fn every_picture_format_is_written() {
     for name in ["a.png", "a.tiff", "a.tif", "a.exr", "a.pfm"] {
         let out = run_in(
             dir.path(),
-            &[scene.to_str().unwrap(), "-o", name, "--lenmax", "120", "--size", "32x32", "--max-steps", "3", "-q"],
+            &[
+                scene.to_str().unwrap(),
+                "-o",
+                name,
+                "--lenmax",
+                "120",
+                "--size",
+                "32x32",
+                "--max-steps",
+                "3",
+                "-q",
+            ],
         );
         assert!(out.status.success(), "{name}: {}", stderr(&out));
         assert!(dir.path().join(name).metadata().unwrap().len() > 0);
@@ -75,7 +110,10 @@ fn every_picture_format_is_written() {
     assert_eq!((exr.width(), exr.height()), (32, 32));
     // Linear radiosity: the light is far brighter than 1.
     assert!(exr.pixels().any(|p| p.0[0] > 1.0));
-    assert_eq!(listing(dir.path()), vec!["a.exr", "a.pfm", "a.png", "a.tif", "a.tiff"]);
+    assert_eq!(
+        listing(dir.path()),
+        vec!["a.exr", "a.pfm", "a.png", "a.tif", "a.tiff"]
+    );
 }
 
 /// Each bad file: exit status 2, the positioned message on stderr, and no
@@ -96,11 +134,28 @@ fn bad_scenes_are_refused_with_positions() {
     for (name, text, expected) in cases {
         let dir = tempfile::tempdir().unwrap();
         let path = write(dir.path(), name, text);
-        let out = run_in(dir.path(), &[path.file_name().unwrap().to_str().unwrap(), "-o", "out.png", "--stats", "s.json"]);
+        let out = run_in(
+            dir.path(),
+            &[
+                path.file_name().unwrap().to_str().unwrap(),
+                "-o",
+                "out.png",
+                "--stats",
+                "s.json",
+            ],
+        );
         assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
-        assert!(stderr(&out).contains(expected), "{name}: expected `{expected}` in:\n{}", stderr(&out));
+        assert!(
+            stderr(&out).contains(expected),
+            "{name}: expected `{expected}` in:\n{}",
+            stderr(&out)
+        );
         assert!(!stderr(&out).contains("panicked"));
-        assert_eq!(listing(dir.path()), vec![name.to_string()], "{name}: something was written");
+        assert_eq!(
+            listing(dir.path()),
+            vec![name.to_string()],
+            "{name}: something was written"
+        );
     }
 }
 
@@ -109,7 +164,11 @@ fn missing_scene_file_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let out = run_in(dir.path(), &["nowhere.sc", "-o", "out.png"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("nowhere.sc:1:1: error:"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("nowhere.sc:1:1: error:"),
+        "{}",
+        stderr(&out)
+    );
     assert!(listing(dir.path()).is_empty());
 }
 
@@ -140,7 +199,10 @@ fn refuses_to_overwrite_the_input_scene() {
     write(dir.path(), "scene.png", &text);
     let out = run_in(dir.path(), &["scene.png", "-o", "scene.png"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert_eq!(std::fs::read_to_string(dir.path().join("scene.png")).unwrap(), text);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("scene.png")).unwrap(),
+        text
+    );
 }
 
 #[test]
@@ -149,8 +211,17 @@ fn help_documents_every_option() {
     assert!(out.status.success());
     let help = String::from_utf8_lossy(&out.stdout);
     for option in [
-        "--output", "--lenmax", "--inset", "--threshold", "--max-steps", "--form-factor", "--shooter-samples",
-        "--size", "--exposure", "--stats", "--threads",
+        "--output",
+        "--lenmax",
+        "--inset",
+        "--threshold",
+        "--max-steps",
+        "--form-factor",
+        "--shooter-samples",
+        "--size",
+        "--exposure",
+        "--stats",
+        "--threads",
     ] {
         assert!(help.contains(option), "--help lacks {option}");
     }

@@ -633,6 +633,7 @@ mod tests {
                 elements: e..e + 1,
                 normal,
                 area: 1.0,
+                min_edge: 1.0,
             });
             self
         }
