@@ -194,16 +194,13 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    if args.output.is_none() && !args.quiet {
-        eprintln!(
-            "no -o given and no window available: writing {}.png in the current directory",
-            config.scene.stem()
-        );
-    }
     match app::run(&config) {
         Ok(stats) => {
             if !args.quiet {
                 eprintln!("{}", app::summary(&stats));
+                if args.output.is_none() {
+                    eprintln!("no -o given and no window available: wrote {} in the current directory", stats.output);
+                }
             }
             ExitCode::SUCCESS
         }

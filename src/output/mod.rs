@@ -124,7 +124,7 @@ pub fn write_atomically_seekable(
     let dir = destination_dir(path)?;
     // Same directory as the destination, so the final rename stays on one
     // file system and is atomic.
-    let tmp = NamedTempFile::new_in(&dir).map_err(|e| OutputError::io(path, e))?;
+    let tmp = temp_file_in(&dir).map_err(|e| OutputError::io(path, e))?;
     {
         let mut writer = BufWriter::new(tmp.as_file());
         write(&mut writer)?;
@@ -138,6 +138,20 @@ pub fn write_atomically_seekable(
     tmp.persist(path)
         .map_err(|e| OutputError::io(path, e.error))?;
     Ok(())
+}
+
+/// A temporary file in `dir` that, once renamed, has the permissions an
+/// ordinary new file would (`0666` less the umask on Unix), not the
+/// owner-only `0600` temporary files get by default.
+fn temp_file_in(dir: &Path) -> io::Result<NamedTempFile> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".radiosity-");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
 }
 
 /// Checks, before any work is done, that `path` could be written: its
