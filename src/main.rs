@@ -199,7 +199,10 @@ fn main() -> ExitCode {
             if !args.quiet {
                 eprintln!("{}", app::summary(&stats));
                 if args.output.is_none() {
-                    eprintln!("no -o given and no window available: wrote {} in the current directory", stats.output);
+                    eprintln!(
+                        "no -o given and no window available: wrote {} in the current directory",
+                        stats.output
+                    );
                 }
             }
             ExitCode::SUCCESS

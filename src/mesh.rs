@@ -692,45 +692,17 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::color::Rgb;
-    use crate::scene::{Camera, CameraSource, Material, MaterialId, SourcePos};
+    use crate::testutil;
 
-    /// A polygon built without the parser: Newell normal and area.
+    /// A polygon built without the parser, of the shape the test names.
     fn polygon(vertices: &[[f32; 3]], shape: Shape) -> Polygon {
-        let v: Vec<Vec3> = vertices.iter().map(|a| Vec3::from_array(*a)).collect();
-        let mut n = DVec3::ZERO;
-        for k in 0..v.len() {
-            n += v[k].as_dvec3().cross(v[(k + 1) % v.len()].as_dvec3());
-        }
-        Polygon {
-            material: MaterialId(0),
-            vertices: v,
-            normal: n.normalize().as_vec3(),
-            area: n.length() * 0.5,
-            shape,
-            origin: SourcePos::default(),
-        }
+        let p = testutil::polygon(0, vertices);
+        assert_eq!(p.shape, shape);
+        p
     }
 
     fn scene(polygons: Vec<Polygon>) -> Scene {
-        Scene {
-            polygons,
-            materials: vec![Material {
-                name: "m".into(),
-                color: Rgb::WHITE,
-                k_diffrefl: 0.5,
-                k_emission: 0.0,
-            }],
-            camera: Camera {
-                eye: Vec3::new(0.0, 0.0, 5.0),
-                lookat: Vec3::ZERO,
-                up: Vec3::Y,
-                fov_y: 1.0,
-                width: 8,
-                height: 8,
-            },
-            camera_source: CameraSource::File,
-        }
+        testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
     }
 
     fn all_shapes() -> Vec<Polygon> {

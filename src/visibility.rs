@@ -177,8 +177,8 @@ fn segment_ray(a: Vec3, b: Vec3) -> Option<Ray> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::color::Rgb;
-    use crate::scene::{Camera, CameraSource, Material, MaterialId, Polygon, Shape, SourcePos};
+    use crate::scene::{MaterialId, Polygon, Shape, SourcePos};
+    use crate::testutil;
 
     fn square(z: f32, size: f32, offset: (f32, f32)) -> Polygon {
         let (x, y) = offset;
@@ -198,24 +198,7 @@ mod tests {
     }
 
     fn scene(polygons: Vec<Polygon>) -> Scene {
-        Scene {
-            polygons,
-            materials: vec![Material {
-                name: "m".into(),
-                color: Rgb::WHITE,
-                k_diffrefl: 0.5,
-                k_emission: 0.0,
-            }],
-            camera: Camera {
-                eye: Vec3::new(0.0, 0.0, 5.0),
-                lookat: Vec3::ZERO,
-                up: Vec3::Y,
-                fov_y: 1.0,
-                width: 8,
-                height: 8,
-            },
-            camera_source: CameraSource::File,
-        }
+        testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
     }
 
     #[test]
