@@ -1,4 +1,5 @@
 //! A progressive-refinement radiosity renderer with ray-traced form factors.
+#![warn(missing_docs)]
 
 pub mod app;
 pub mod color;

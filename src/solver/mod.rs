@@ -30,9 +30,11 @@ use rayon::prelude::*;
 pub const DEFAULT_THRESHOLD: f64 = 1e-3;
 
 /// Default cap on shooter sample points (see [`ShooterSamples::AtMost`]).
-/// 64 points (an 8 × 8 grid on a square) put the form factor of the unit
-/// parallel squares within 0.1 % of the exact value while keeping a step
-/// on a 20,000-vertex mesh at about a million rays.
+/// Measured on unit squares (exact 0.19982 parallel, 0.20004
+/// perpendicular): 16 points are 0.6 % / 0.1 % off, 64 points 0.18 % /
+/// 0.27 %, 256 points 0.05 % / 0.22 %. Past 64 the rays quadruple for
+/// little gain, and 64 keeps a step on a 14,000-vertex mesh under a
+/// million rays.
 pub const DEFAULT_SHOOTER_SAMPLES: u32 = 64;
 
 /// How form factors are estimated.
