@@ -154,13 +154,72 @@ pub struct RunStats {
     pub seconds: PhaseSeconds,
 }
 
-/// Runs the whole pipeline once and writes the picture (and stats).
-pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
-    let output = config
+/// A scene loaded, meshed and put in a BVH: what both the batch run and
+/// the window start from.
+pub struct Prepared {
+    /// The scene.
+    pub scene: Scene,
+    /// Its element mesh.
+    pub mesh: Mesh,
+    /// Its visibility structure.
+    pub visibility: Visibility,
+    /// The lenmax the mesh was built with, in scene units.
+    pub lenmax: f32,
+    /// Seconds spent so far (load, mesh, bvh).
+    pub seconds: PhaseSeconds,
+}
+
+impl Prepared {
+    /// The view of the scene's camera, with the configured size override.
+    pub fn view(&self, config: &RunConfig) -> Result<View, ViewError> {
+        match config.size {
+            Some((w, h)) => View::with_size(&self.scene.camera, w, h),
+            None => View::new(&self.scene.camera),
+        }
+    }
+}
+
+/// Loads, validates, meshes and builds the BVH.
+pub fn prepare(config: &RunConfig) -> Result<Prepared, RunError> {
+    let mut seconds = PhaseSeconds::default();
+    let t = Instant::now();
+    let scene = load_scene(&config.scene)?;
+    seconds.load = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let mut mesh_options = MeshOptions::for_scene(&scene);
+    mesh_options.inset = config.inset;
+    if let Some(lenmax) = config.lenmax {
+        mesh_options.lenmax = lenmax;
+    }
+    let mesh = mesh::build(&scene, &mesh_options)?;
+    seconds.mesh = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let visibility = Visibility::new(&scene);
+    seconds.bvh = t.elapsed().as_secs_f64();
+    Ok(Prepared {
+        scene,
+        mesh,
+        visibility,
+        lenmax: mesh_options.lenmax,
+        seconds,
+    })
+}
+
+/// The picture path a batch run writes: `-o`, or `<scene-stem>.png` in
+/// the current directory.
+pub fn output_path(config: &RunConfig) -> PathBuf {
+    config
         .output
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}.png", config.scene.stem())));
-    // Refuse unusable outputs before spending minutes on a solve.
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", config.scene.stem())))
+}
+
+/// Refuses unusable outputs before any time is spent solving: an unknown
+/// extension, a missing directory, or a path that is the input scene.
+pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
+    let output = output_path(config);
     PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
     output::check_destination(&output).map_err(RunError::BadOutput)?;
     if let Some(stats) = &config.stats {
@@ -179,32 +238,30 @@ pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
             }
         }
     }
+    Ok(())
+}
 
-    let mut seconds = PhaseSeconds::default();
-    let t = Instant::now();
-    let scene = load_scene(&config.scene)?;
-    seconds.load = t.elapsed().as_secs_f64();
+/// Runs the whole batch pipeline once and writes the picture (and stats).
+pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
+    check_outputs(config)?;
+    let prepared = prepare(config)?;
+    run_prepared(config, &prepared)
+}
 
-    let view = match config.size {
-        Some((w, h)) => View::with_size(&scene.camera, w, h)?,
-        None => View::new(&scene.camera)?,
-    };
-
-    let t = Instant::now();
-    let mut mesh_options = MeshOptions::for_scene(&scene);
-    mesh_options.inset = config.inset;
-    if let Some(lenmax) = config.lenmax {
-        mesh_options.lenmax = lenmax;
-    }
-    let mesh = mesh::build(&scene, &mesh_options)?;
-    seconds.mesh = t.elapsed().as_secs_f64();
+/// The batch run from a prepared scene: solve, render, write.
+pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats, RunError> {
+    check_outputs(config)?;
+    let output = output_path(config);
+    let mut seconds = prepared.seconds;
+    let view = prepared.view(config)?;
 
     let t = Instant::now();
-    let visibility = Visibility::new(&scene);
-    seconds.bvh = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let mut solver = Progressive::new(&scene, &mesh, &visibility, config.solver);
+    let mut solver = Progressive::new(
+        &prepared.scene,
+        &prepared.mesh,
+        &prepared.visibility,
+        config.solver,
+    );
     solve_with_progress(&mut solver, config.progress);
     seconds.solve = t.elapsed().as_secs_f64();
     solver
@@ -212,7 +269,7 @@ pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
         .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
 
     let t = Instant::now();
-    let frame = render(&mesh, solver.radiosity(), &view)?;
+    let frame = render(&prepared.mesh, solver.radiosity(), &view)?;
     seconds.render = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -220,10 +277,10 @@ pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
     let mut stats = RunStats {
         scene: config.scene.display_name(),
         output: output.display().to_string(),
-        polygons: scene.polygons.len(),
-        elements: mesh.elements.len(),
-        vertices: mesh.vertex_count(),
-        lenmax: mesh_options.lenmax,
+        polygons: prepared.scene.polygons.len(),
+        elements: prepared.mesh.elements.len(),
+        vertices: prepared.mesh.vertex_count(),
+        lenmax: prepared.lenmax,
         steps: solver.steps(),
         rays: solver.rays(),
         unshot_fraction: solver.unshot_fraction(),

@@ -8,6 +8,7 @@ pub mod output;
 pub mod render;
 pub mod scene;
 pub mod solver;
+pub mod viewer;
 pub mod visibility;
 
 #[cfg(test)]

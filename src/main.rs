@@ -9,6 +9,7 @@ use radiosity::render::Exposure;
 use radiosity::solver::{
     FormFactorMethod, ShooterSamples, SolverOptions, DEFAULT_SHOOTER_SAMPLES, DEFAULT_THRESHOLD,
 };
+use radiosity::viewer;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -84,6 +85,11 @@ struct Args {
     /// Worker threads for the solver and renderer; default: all cores.
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
+
+    /// Do not open a window even when a display is available: solve and
+    /// write the picture, as with -o.
+    #[arg(long)]
+    no_window: bool,
 
     /// No progress bar and no summary line.
     #[arg(short, long)]
@@ -195,16 +201,16 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    match app::run(&config) {
-        Ok(stats) => {
+    let result = if args.output.is_none() && !args.no_window {
+        run_window_or_fallback(&config, args.quiet)
+    } else {
+        app::run(&config).map(Some)
+    };
+    match result {
+        Ok(None) => ExitCode::SUCCESS,
+        Ok(Some(stats)) => {
             if !args.quiet {
                 eprintln!("{}", app::summary(&stats));
-                if args.output.is_none() {
-                    eprintln!(
-                        "no -o given and no window available: wrote {} in the current directory",
-                        stats.output
-                    );
-                }
             }
             ExitCode::SUCCESS
         }
@@ -217,5 +223,36 @@ fn main() -> ExitCode {
             }
             ExitCode::from(if e.is_bad_input() { 2 } else { 1 })
         }
+    }
+}
+
+/// Without -o: the window when a display is available, else (saying why)
+/// the batch run writing `<scene>.png`. `Ok(None)` when the window ran.
+fn run_window_or_fallback(
+    config: &RunConfig,
+    quiet: bool,
+) -> Result<Option<app::RunStats>, app::RunError> {
+    let fallback = |why: &str| {
+        if !quiet {
+            eprintln!(
+                "{why}: writing {} in the current directory instead",
+                app::output_path(config).display()
+            );
+        }
+    };
+    if let Err(why) = viewer::display_available() {
+        app::check_outputs(config)?;
+        fallback(&why);
+        return app::run(config).map(Some);
+    }
+    let prepared = app::prepare(config)?;
+    match viewer::run(&prepared, config) {
+        Ok(()) => Ok(None),
+        Err(viewer::ViewerError::CannotOpen(why)) => {
+            fallback(&why);
+            app::run_prepared(config, &prepared).map(Some)
+        }
+        Err(viewer::ViewerError::View(e)) => Err(app::RunError::View(e)),
+        Err(viewer::ViewerError::Render(e)) => Err(app::RunError::Render(e)),
     }
 }

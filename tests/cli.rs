@@ -226,3 +226,75 @@ fn help_documents_every_option() {
         assert!(help.contains(option), "--help lacks {option}");
     }
 }
+
+#[test]
+fn without_a_display_it_says_why_and_writes_the_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    let out = run_in(
+        dir.path(),
+        &[
+            scene.to_str().unwrap(),
+            "--lenmax",
+            "120",
+            "--size",
+            "32x32",
+            "--max-steps",
+            "2",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no display"), "{}", stderr(&out));
+    assert!(dir.path().join("cornell.png").exists());
+}
+
+#[test]
+fn no_window_flag_runs_in_batch_even_with_a_display() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .current_dir(dir.path())
+        .env("DISPLAY", ":12345")
+        .args([
+            scene.to_str().unwrap(),
+            "--no-window",
+            "--lenmax",
+            "120",
+            "--size",
+            "32x32",
+            "--max-steps",
+            "2",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.path().join("cornell.png").exists());
+}
+
+#[test]
+fn an_unreachable_display_falls_back_to_batch() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .current_dir(dir.path())
+        .env("DISPLAY", ":12345")
+        .args([
+            scene.to_str().unwrap(),
+            "--lenmax",
+            "120",
+            "--size",
+            "32x32",
+            "--max-steps",
+            "2",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("cannot open a window"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(dir.path().join("cornell.png").exists());
+}

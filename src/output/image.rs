@@ -14,7 +14,7 @@
 
 use super::{write_atomically_seekable, OutputError};
 use crate::render::{to_srgb8, Exposure, Frame};
-use ::image::{ImageFormat, Rgb32FImage};
+use ::image::{ImageFormat, Rgb32FImage, RgbImage};
 use std::io::Write;
 use std::path::Path;
 
@@ -116,6 +116,30 @@ pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(
     }
 }
 
+/// Writes an 8-bit picture that is already tone-mapped (what a window
+/// shows) as PNG or TIFF, chosen by the extension, atomically. The float
+/// formats need the linear frame ([`write_picture`]) and are refused here.
+pub fn write_rgb8(path: &Path, image: &RgbImage) -> Result<(), OutputError> {
+    let kind = match PictureFormat::from_path(path)? {
+        PictureFormat::Png => ImageFormat::Png,
+        PictureFormat::Tiff => ImageFormat::Tiff,
+        PictureFormat::Exr | PictureFormat::Pfm => {
+            return Err(OutputError::UnknownFormat {
+                path: path.to_path_buf(),
+                reason: "a window picture is 8-bit: use .png, .tif or .tiff".into(),
+            })
+        }
+    };
+    write_atomically_seekable(path, |w| {
+        image
+            .write_to(w, kind)
+            .map_err(|error| OutputError::Encode {
+                path: path.to_path_buf(),
+                error,
+            })
+    })
+}
+
 /// Writes the portable float map: a text header (`PF` for colour, the size,
 /// and a negative scale meaning little-endian), then the rows from the
 /// BOTTOM of the picture to the top, each pixel three `f32`s.
@@ -138,6 +162,23 @@ fn write_pfm(w: &mut dyn Write, frame: &Frame) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rgb8_pictures_round_trip_and_float_formats_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut img = RgbImage::new(5, 3);
+        img.put_pixel(4, 0, ::image::Rgb([10, 200, 30]));
+        for name in ["a.tiff", "a.png"] {
+            let path = dir.path().join(name);
+            write_rgb8(&path, &img).unwrap();
+            assert_eq!(::image::open(&path).unwrap().to_rgb8(), img);
+        }
+        assert!(matches!(
+            write_rgb8(&dir.path().join("a.exr"), &img),
+            Err(OutputError::UnknownFormat { .. })
+        ));
+        assert!(!dir.path().join("a.exr").exists());
+    }
     use crate::render::srgb8;
     use std::path::PathBuf;
 

@@ -11,7 +11,7 @@
 
 pub mod image;
 
-pub use self::image::{write_picture, PictureFormat, SUPPORTED_EXTENSIONS};
+pub use self::image::{write_picture, write_rgb8, PictureFormat, SUPPORTED_EXTENSIONS};
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};

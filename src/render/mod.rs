@@ -17,9 +17,11 @@
 //! batch command writes the very same frames.
 
 pub mod camera;
+pub mod overlay;
 pub mod raster;
 pub mod tonemap;
 
 pub use camera::{View, ViewError};
+pub use overlay::draw_mesh_edges;
 pub use raster::{Frame, Rasterizer, RenderError};
 pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};

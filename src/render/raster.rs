@@ -171,6 +171,13 @@ impl Rasterizer {
         &self.frame
     }
 
+    /// Per pixel of the last picture, row-major from the top, `1 / z` of
+    /// the nearest surface (`z` the camera-space depth in scene units; 0
+    /// where nothing was drawn). Overlays use it for their depth test.
+    pub fn inv_depth(&self) -> &[f64] {
+        &self.inv_depth
+    }
+
     /// Draws `mesh` seen through `view`, shading every element vertex with
     /// its linear `radiosity` (one per mesh vertex, in the scene's radiosity
     /// units), and returns the picture, sized as the view.

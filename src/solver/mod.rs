@@ -25,6 +25,7 @@ use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
 use formfactor::{point_to_samples, shooter_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Default fraction of the initial unshot power at which solving stops.
 pub const DEFAULT_THRESHOLD: f64 = 1e-3;
@@ -287,6 +288,14 @@ impl<'a> Progressive<'a> {
     /// Does not look at the threshold or step limit: see
     /// [`Progressive::is_done`].
     pub fn step(&mut self) -> Option<StepReport> {
+        self.step_cancellable(&AtomicBool::new(false))
+    }
+
+    /// [`Progressive::step`] that gives up as soon as `cancel` is set (from
+    /// another thread), leaving the state exactly as before the step and
+    /// returning `None`. A window uses it to quit promptly during a long
+    /// step.
+    pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
         let shooter = self.next_shooter()?;
         let i = shooter.index();
         let shot = self.unshot[i];
@@ -307,7 +316,7 @@ impl<'a> Progressive<'a> {
             .with_min_len(256)
             .map(|(l, delta)| {
                 let j = mesh.vertex_polygon[l];
-                if !receives[j.index()] {
+                if !receives[j.index()] || cancel.load(Ordering::Relaxed) {
                     *delta = Rgb::BLACK;
                     return 0;
                 }
@@ -324,6 +333,9 @@ impl<'a> Progressive<'a> {
                 rays
             })
             .sum();
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
 
         for (j, pm) in mesh.polygons.iter().enumerate() {
             if !self.receives[j] {

@@ -16,10 +16,13 @@ pub fn scene(name: &str) -> PathBuf {
     root().join("scenes").join(name)
 }
 
-/// Runs the `radiosity` binary with `args` in `dir`.
+/// Runs the `radiosity` binary with `args` in `dir`, with no display (so
+/// it never opens a window).
 pub fn run_in(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_radiosity"))
         .current_dir(dir)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
         .args(args)
         .output()
         .expect("the radiosity binary runs")

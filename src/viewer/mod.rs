@@ -1,0 +1,500 @@
+//! The interactive window: shows the solution converging, redrawn after
+//! every shooting step (at most every [`REDRAW_INTERVAL`]), lets the user
+//! move around it and write pictures.
+//!
+//! The solver runs on a worker thread and publishes a copy of the vertex
+//! radiosities after each step; the window thread renders the latest copy
+//! with the same [`Rasterizer`] and tone mapping the batch command uses, so
+//! what `w` writes is exactly what is on screen. The window never waits
+//! for a step: a long step only delays the next new picture, and quitting
+//! cancels it ([`Progressive::step_cancellable`]).
+//!
+//! Keys: `q`/Escape quit · `w` write the picture as TIFF · space pause or
+//! resume · `+`/`-` exposure · `m` element mesh · `r` reset the camera ·
+//! `h` help · arrows and `a`/`d` (or Shift+W/A/S/D) walk · `PageUp`/`PageDown`
+//! up and down. Mouse: left-drag orbits around the look-at point,
+//! right-drag or the wheel zooms.
+
+pub mod controls;
+
+use crate::app::{Prepared, RunConfig};
+use crate::color::Rgb;
+use crate::output;
+use crate::render::{self, Exposure, Rasterizer, View};
+use crate::solver::{Progressive, StopReason};
+use controls::CameraControl;
+use image::RgbImage;
+use minifb::{InputCallback, Key, MouseButton, MouseMode, Window, WindowOptions};
+use std::io::{BufRead, IsTerminal, Write};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Shortest time between two pictures drawn because the solution changed;
+/// input (camera, exposure) redraws at once.
+pub const REDRAW_INTERVAL: Duration = Duration::from_millis(50);
+/// How often the window polls input when nothing changes (about 60 Hz).
+pub const FRAME_INTERVAL: Duration = Duration::from_millis(16);
+/// Radians of orbit per pixel of mouse drag.
+pub const ORBIT_PER_PIXEL: f32 = 0.008;
+/// Zoom factor per pixel of right-drag (`exp` of this times the pixels).
+pub const ZOOM_PER_PIXEL: f32 = 0.01;
+/// Zoom factor per notch of the mouse wheel.
+pub const ZOOM_PER_NOTCH: f32 = 0.9;
+/// Walking step per key press, as a fraction of the distance to the
+/// look-at point.
+pub const WALK_STEP: f32 = 0.05;
+/// Exposure factor of one `+` or `-` press (a third of a stop).
+pub const EXPOSURE_STEP: f32 = 1.26;
+/// Colour of the element mesh lines.
+pub const MESH_COLOR: [u8; 3] = [40, 220, 255];
+
+/// The key help printed by `h`.
+pub const KEY_HELP: &str = "\
+keys:
+  q, Escape        quit
+  w                write the picture as TIFF (asks for a name on a terminal)
+  space            pause / resume the solver
+  + / -            exposure up / down (a third of a stop)
+  m                show / hide the element mesh
+  r                reset the camera
+  h                this help
+  arrows, a, d     walk (Shift+W/A/S/D too); PageUp / PageDown: up / down
+mouse:
+  left-drag        orbit around the look-at point
+  right-drag, wheel  zoom towards / away from the look-at point";
+
+/// Why the window could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    /// No display, or the display libraries are missing: the caller can
+    /// fall back to batch mode.
+    #[error("{0}")]
+    CannotOpen(String),
+    /// The picture could not be made (a bug if it happens).
+    #[error("{0}")]
+    Render(#[from] render::RenderError),
+    /// The view is unusable.
+    #[error("{0}")]
+    View(#[from] render::ViewError),
+}
+
+/// Whether a window can be tried at all: `Err` says why not (no display).
+pub fn display_available() -> Result<(), String> {
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    if set("DISPLAY") {
+        Ok(())
+    } else if set("WAYLAND_DISPLAY") {
+        Err("WAYLAND_DISPLAY is set but DISPLAY is not: the window needs X11 (XWayland)".into())
+    } else {
+        Err("no display (DISPLAY is not set)".into())
+    }
+}
+
+/// What the solver thread publishes after each step.
+#[derive(Clone, Debug, Default)]
+struct Progress {
+    radiosity: Vec<Rgb>,
+    step: u64,
+    unshot_fraction: f64,
+    rays: u64,
+    /// Seconds spent shooting (pauses excluded).
+    solving: f64,
+    stopped: Option<StopReason>,
+    /// Bumped on every change.
+    version: u64,
+}
+
+/// Flags the window sets for the solver thread.
+struct Control {
+    quit: AtomicBool,
+    paused: AtomicBool,
+}
+
+/// Opens the window and runs until the user quits. Returns an error
+/// without side effects when no window can be opened.
+pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
+    display_available().map_err(ViewerError::CannotOpen)?;
+    let home = {
+        let view = prepared.view(config)?;
+        let mut camera = prepared.scene.camera;
+        camera.width = view.width();
+        camera.height = view.height();
+        camera
+    };
+    let (w, h) = (home.width as usize, home.height as usize);
+    let stem = config.scene.stem();
+    let mut window = Window::new(
+        &format!("radiosity — {stem}"),
+        w,
+        h,
+        WindowOptions::default(),
+    )
+    .map_err(|e| ViewerError::CannotOpen(format!("cannot open a window: {e}")))?;
+    let presses = Arc::new(Mutex::new(Vec::new()));
+    window.set_input_callback(Box::new(KeyPresses(Arc::clone(&presses))));
+
+    let mut solver = Progressive::new(
+        &prepared.scene,
+        &prepared.mesh,
+        &prepared.visibility,
+        config.solver,
+    );
+    let progress = Mutex::new(Progress {
+        radiosity: solver.radiosity().to_vec(),
+        unshot_fraction: solver.unshot_fraction(),
+        stopped: solver.stop_reason(),
+        ..Progress::default()
+    });
+    let control = Control {
+        quit: AtomicBool::new(false),
+        paused: AtomicBool::new(false),
+    };
+
+    std::thread::scope(|scope| {
+        scope.spawn(|| solve_in_background(&mut solver, &progress, &control));
+        let mut ui = Ui {
+            prepared,
+            window: &mut window,
+            camera: CameraControl::new(home),
+            exposure: config.exposure,
+            exposure_scale: 1.0,
+            show_mesh: false,
+            stem: stem.clone(),
+            rasterizer: Rasterizer::new(),
+            picture: RgbImage::new(home.width, home.height),
+            buffer: vec![0; w * h],
+            radiosity: Vec::new(),
+            last_mouse: None,
+            written: 0,
+            presses,
+            pending_name: None,
+        };
+        let result = ui.run(&progress, &control);
+        control.quit.store(true, Ordering::Relaxed);
+        result
+    })
+}
+
+/// The solver thread: steps until converged or told to quit, publishing
+/// after each step.
+fn solve_in_background(solver: &mut Progressive, progress: &Mutex<Progress>, control: &Control) {
+    let mut solving = Duration::ZERO;
+    loop {
+        if control.quit.load(Ordering::Relaxed) {
+            return;
+        }
+        if control.paused.load(Ordering::Relaxed) || solver.is_done() {
+            std::thread::sleep(FRAME_INTERVAL);
+            continue;
+        }
+        let t = Instant::now();
+        let report = solver.step_cancellable(&control.quit);
+        solving += t.elapsed();
+        let Ok(mut p) = progress.lock() else {
+            return;
+        };
+        if let Some(report) = report {
+            p.radiosity.clone_from_slice(solver.radiosity());
+            p.step = report.step;
+            p.unshot_fraction = report.unshot_fraction;
+            p.rays = solver.rays();
+        } else if control.quit.load(Ordering::Relaxed) {
+            return;
+        }
+        p.solving = solving.as_secs_f64();
+        p.stopped = solver
+            .stop_reason()
+            .or(report.is_none().then_some(StopReason::Converged));
+        p.version += 1;
+    }
+}
+
+/// The window thread's state.
+struct Ui<'a> {
+    prepared: &'a Prepared,
+    window: &'a mut Window,
+    camera: CameraControl,
+    exposure: Exposure,
+    exposure_scale: f32,
+    show_mesh: bool,
+    stem: String,
+    rasterizer: Rasterizer,
+    picture: RgbImage,
+    buffer: Vec<u32>,
+    radiosity: Vec<Rgb>,
+    last_mouse: Option<(f32, f32)>,
+    written: u32,
+    presses: Arc<Mutex<Vec<Key>>>,
+    /// A `w` waiting for its file name from the terminal, with the picture
+    /// as it was when `w` was pressed.
+    pending_name: Option<(std::sync::mpsc::Receiver<PathBuf>, RgbImage)>,
+}
+
+/// Collects every key press as it arrives. Polling the key state once a
+/// frame would miss a tap shorter than a frame; the callback sees each
+/// press event (auto-repeats included).
+struct KeyPresses(Arc<Mutex<Vec<Key>>>);
+
+impl InputCallback for KeyPresses {
+    fn add_char(&mut self, _uni_char: u32) {}
+
+    fn set_key_state(&mut self, key: Key, down: bool) {
+        if down {
+            if let Ok(mut q) = self.0.lock() {
+                q.push(key);
+            }
+        }
+    }
+}
+
+impl Ui<'_> {
+    fn run(&mut self, progress: &Mutex<Progress>, control: &Control) -> Result<(), ViewerError> {
+        let mut shown_version = u64::MAX;
+        let mut last_draw = Instant::now() - REDRAW_INTERVAL;
+        let mut dirty = true;
+        let mut title = String::new();
+        while self.window.is_open() {
+            let keys: Vec<Key> = self
+                .presses
+                .lock()
+                .map(|mut q| std::mem::take(&mut *q))
+                .unwrap_or_default();
+            if keys.contains(&Key::Q) || keys.contains(&Key::Escape) {
+                break;
+            }
+            dirty |= self.handle_keys(&keys, control);
+            self.finish_pending_write();
+            dirty |= self.handle_mouse();
+
+            let snapshot = progress.lock().map(|p| {
+                (
+                    p.version,
+                    p.step,
+                    p.unshot_fraction,
+                    p.rays,
+                    p.solving,
+                    p.stopped,
+                )
+            });
+            let Ok((version, step, unshot, rays, solving, stopped)) = snapshot else {
+                break;
+            };
+            let fresh = version != shown_version && last_draw.elapsed() >= REDRAW_INTERVAL;
+            if fresh || dirty {
+                if let Ok(p) = progress.lock() {
+                    self.radiosity.clone_from(&p.radiosity);
+                }
+                shown_version = version;
+                self.draw()?;
+                last_draw = Instant::now();
+                dirty = false;
+            }
+            let state = match stopped {
+                Some(StopReason::Converged) => " · converged",
+                Some(StopReason::MaxSteps) => " · step limit",
+                None if control.paused.load(Ordering::Relaxed) => " · paused",
+                None => "",
+            };
+            let rate = if solving > 0.0 {
+                rays as f64 / solving / 1e6
+            } else {
+                0.0
+            };
+            let new_title = format!(
+                "radiosity — {} — step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state}",
+                self.stem,
+                unshot * 100.0
+            );
+            if new_title != title {
+                self.window.set_title(&new_title);
+                title = new_title;
+            }
+            let (w, h) = (
+                self.picture.width() as usize,
+                self.picture.height() as usize,
+            );
+            if self.window.update_with_buffer(&self.buffer, w, h).is_err() {
+                break;
+            }
+            std::thread::sleep(FRAME_INTERVAL);
+        }
+        Ok(())
+    }
+
+    /// Renders the current solution from the current camera into the
+    /// picture and the window buffer.
+    fn draw(&mut self) -> Result<(), ViewerError> {
+        let view = View::new(self.camera.camera())?;
+        let mesh = &self.prepared.mesh;
+        let frame = self.rasterizer.render(mesh, &self.radiosity, &view)?;
+        let exposure = self.exposure.resolve(frame) * self.exposure_scale;
+        self.picture = render::to_srgb8(frame, exposure);
+        if self.show_mesh {
+            render::draw_mesh_edges(
+                &mut self.picture,
+                mesh,
+                &view,
+                self.rasterizer.inv_depth(),
+                MESH_COLOR,
+            );
+        }
+        for (out, p) in self.buffer.iter_mut().zip(self.picture.pixels()) {
+            let [r, g, b] = p.0;
+            *out = (u32::from(r) << 16) | (u32::from(g) << 8) | u32::from(b);
+        }
+        Ok(())
+    }
+
+    /// Applies key presses; true when the picture must be redrawn.
+    fn handle_keys(&mut self, keys: &[Key], control: &Control) -> bool {
+        let shift =
+            self.window.is_key_down(Key::LeftShift) || self.window.is_key_down(Key::RightShift);
+        let mut dirty = false;
+        for key in keys {
+            match key {
+                Key::W if !shift => self.write_picture(),
+                Key::Space => {
+                    let paused = !control.paused.load(Ordering::Relaxed);
+                    control.paused.store(paused, Ordering::Relaxed);
+                }
+                Key::Equal | Key::NumPadPlus => {
+                    self.exposure_scale *= EXPOSURE_STEP;
+                    dirty = true;
+                }
+                Key::Minus | Key::NumPadMinus => {
+                    self.exposure_scale /= EXPOSURE_STEP;
+                    dirty = true;
+                }
+                Key::M => {
+                    self.show_mesh = !self.show_mesh;
+                    dirty = true;
+                }
+                Key::R => {
+                    self.camera.reset();
+                    dirty = true;
+                }
+                Key::H => println!("{KEY_HELP}"),
+                Key::Up | Key::W => {
+                    self.camera.walk(0.0, 0.0, WALK_STEP);
+                    dirty = true;
+                }
+                Key::Down | Key::S => {
+                    self.camera.walk(0.0, 0.0, -WALK_STEP);
+                    dirty = true;
+                }
+                Key::Left | Key::A => {
+                    self.camera.walk(-WALK_STEP, 0.0, 0.0);
+                    dirty = true;
+                }
+                Key::Right | Key::D => {
+                    self.camera.walk(WALK_STEP, 0.0, 0.0);
+                    dirty = true;
+                }
+                Key::PageUp => {
+                    self.camera.walk(0.0, WALK_STEP, 0.0);
+                    dirty = true;
+                }
+                Key::PageDown => {
+                    self.camera.walk(0.0, -WALK_STEP, 0.0);
+                    dirty = true;
+                }
+                _ => {}
+            }
+        }
+        dirty
+    }
+
+    /// Mouse drags and the wheel; true when the camera moved.
+    fn handle_mouse(&mut self) -> bool {
+        let mut dirty = false;
+        if let Some((_, dy)) = self.window.get_scroll_wheel() {
+            if dy != 0.0 {
+                self.camera.zoom(ZOOM_PER_NOTCH.powf(dy.signum()));
+                dirty = true;
+            }
+        }
+        let pos = self.window.get_mouse_pos(MouseMode::Pass);
+        let left = self.window.get_mouse_down(MouseButton::Left);
+        let right = self.window.get_mouse_down(MouseButton::Right);
+        match (pos, self.last_mouse) {
+            (Some((x, y)), Some((x0, y0))) if left || right => {
+                let (dx, dy) = (x - x0, y - y0);
+                if dx != 0.0 || dy != 0.0 {
+                    if left {
+                        self.camera
+                            .orbit(-dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
+                    } else {
+                        self.camera.zoom((dy * ZOOM_PER_PIXEL).exp());
+                    }
+                    dirty = true;
+                }
+            }
+            _ => {}
+        }
+        self.last_mouse = if left || right { pos } else { None };
+        dirty
+    }
+
+    /// Writes the picture on screen as TIFF. When stdin is a terminal it
+    /// asks for the name there, on a helper thread so the window keeps
+    /// drawing while the user types; the picture is the one on screen when
+    /// `w` was pressed. Otherwise it picks `<scene>-NNN.tiff`.
+    fn write_picture(&mut self) {
+        let default = self.next_auto_name();
+        if !std::io::stdin().is_terminal() {
+            self.save(&default, &self.picture.clone());
+            return;
+        }
+        if self.pending_name.is_some() {
+            return;
+        }
+        eprint!("write picture to [{}]: ", default.display());
+        let _ = std::io::stderr().flush();
+        let (send, receive) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let name = match std::io::stdin().lock().read_line(&mut line) {
+                Ok(_) if !line.trim().is_empty() => PathBuf::from(line.trim()),
+                _ => default,
+            };
+            let _ = send.send(name);
+        });
+        self.pending_name = Some((receive, self.picture.clone()));
+    }
+
+    /// Finishes a write whose name was typed on the terminal.
+    fn finish_pending_write(&mut self) {
+        let Some((receive, _)) = &self.pending_name else {
+            return;
+        };
+        match receive.try_recv() {
+            Ok(path) => {
+                if let Some((_, picture)) = self.pending_name.take() {
+                    self.save(&path, &picture);
+                }
+            }
+            Err(std::sync::mpsc::TryRecvError::Empty) => {}
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => self.pending_name = None,
+        }
+    }
+
+    fn save(&mut self, path: &std::path::Path, picture: &RgbImage) {
+        match output::write_rgb8(path, picture) {
+            Ok(()) => {
+                self.written += 1;
+                println!("wrote {}", path.display());
+            }
+            Err(e) => eprintln!("error: {e}"),
+        }
+    }
+
+    /// The first `<scene>-NNN.tiff` (NNN from 001) that does not exist.
+    fn next_auto_name(&self) -> PathBuf {
+        (self.written + 1..)
+            .map(|n| PathBuf::from(format!("{}-{n:03}.tiff", self.stem)))
+            .find(|p| !p.exists())
+            .unwrap_or_else(|| PathBuf::from(format!("{}.tiff", self.stem)))
+    }
+}

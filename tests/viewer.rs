@@ -1,0 +1,184 @@
+//! The window, end to end, under a virtual X server: start the program on
+//! a small scene, let it take a few steps, press `w` (stdin is not a
+//! terminal, so the picture gets an automatic name), check the TIFF, press
+//! `q`, and check the program exits 0 promptly.
+//!
+//! Needs `Xvfb` and `xdotool` (`.ci/run` installs them). Without them, or
+//! when no X server can be started, the test says loudly that it skipped.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn which(program: &str) -> Option<PathBuf> {
+    std::env::var_os("PATH")?
+        .to_str()?
+        .split(':')
+        .map(|dir| Path::new(dir).join(program))
+        .find(|p| p.is_file())
+}
+
+fn skip(why: &str) {
+    eprintln!("\n**************** SKIPPED: window end-to-end test: {why} ****************\n");
+}
+
+/// Kills a child process when dropped, so a failed assertion never leaves
+/// an X server or a window behind.
+struct Reaper(Child);
+
+impl Drop for Reaper {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Polls `f` every 50 ms until it returns `Some` or `limit` passes.
+fn wait_for<T>(limit: Duration, mut f: impl FnMut() -> Option<T>) -> Option<T> {
+    let start = Instant::now();
+    while start.elapsed() < limit {
+        if let Some(v) = f() {
+            return Some(v);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    None
+}
+
+fn xdotool(display: &str, args: &[&str]) -> Option<String> {
+    let out = Command::new("xdotool")
+        .env("DISPLAY", display)
+        .args(args)
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+/// Starts Xvfb on a free display number; `None` if none starts.
+fn start_xvfb() -> Option<(Reaper, String)> {
+    for n in 90..110 {
+        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
+            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
+        {
+            continue;
+        }
+        let display = format!(":{n}");
+        let child = Command::new("Xvfb")
+            .args([
+                display.as_str(),
+                "-screen",
+                "0",
+                "800x600x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .ok()?;
+        let mut xvfb = Reaper(child);
+        let up = wait_for(Duration::from_secs(10), || {
+            if let Ok(Some(_)) = xvfb.0.try_wait() {
+                return Some(false);
+            }
+            Path::new(&format!("/tmp/.X11-unix/X{n}"))
+                .exists()
+                .then_some(true)
+        });
+        if up == Some(true) {
+            return Some((xvfb, display));
+        }
+    }
+    None
+}
+
+#[test]
+fn window_writes_a_picture_and_quits_on_keys() {
+    if which("Xvfb").is_none() || which("xdotool").is_none() {
+        skip("Xvfb or xdotool is not installed");
+        return;
+    }
+    let Some((_xvfb, display)) = start_xvfb() else {
+        skip("no X server could be started");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::scene("cornell.sc");
+    let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args([
+            scene.to_str().unwrap(),
+            "--lenmax",
+            "80",
+            "--size",
+            "160x120",
+        ])
+        .current_dir(dir.path())
+        .env("DISPLAY", &display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut program = Reaper(child);
+
+    let window = wait_for(Duration::from_secs(20), || {
+        xdotool(&display, &["search", "--name", "^radiosity.*cornell"])
+            .and_then(|ids| ids.lines().next().map(str::to_string))
+    })
+    .expect("the window appears");
+    // A few steps, read from the title.
+    let title = wait_for(Duration::from_secs(30), || {
+        let title = xdotool(&display, &["getwindowname", &window])?;
+        let step: u64 = title
+            .split("step ")
+            .nth(1)?
+            .split_whitespace()
+            .next()?
+            .parse()
+            .ok()?;
+        (step >= 3).then_some(title)
+    })
+    .expect("the solver takes steps and the title shows them");
+    assert!(
+        title.contains("unshot") && title.contains("Mrays/s"),
+        "{title}"
+    );
+
+    xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus");
+    xdotool(&display, &["key", "w"]).expect("key w");
+    let tiff = dir.path().join("cornell-001.tiff");
+    wait_for(Duration::from_secs(10), || tiff.exists().then_some(()))
+        .expect("w writes cornell-001.tiff");
+    let img = image::open(&tiff).unwrap().to_rgb8();
+    assert_eq!((img.width(), img.height()), (160, 120));
+    let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 30)).count();
+    assert!(
+        lit > 160 * 120 / 2,
+        "the picture is mostly black ({lit} lit pixels)"
+    );
+
+    xdotool(&display, &["key", "q"]).expect("key q");
+    let status = wait_for(Duration::from_secs(5), || {
+        program.0.try_wait().ok().flatten()
+    })
+    .expect("the program exits within 5 s of q");
+    let mut stdout = String::new();
+    use std::io::Read;
+    program
+        .0
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
+    assert!(status.success(), "exit status {status}");
+    assert!(
+        stdout.contains("wrote cornell-001.tiff"),
+        "stdout: {stdout}"
+    );
+}
