@@ -146,6 +146,12 @@ pub struct RunStats {
     pub steps: u64,
     /// Shadow rays cast.
     pub rays: u64,
+    /// Sample–vertex pairs whose visibility mattered; `pairs - rays` rays
+    /// were saved by shaft culling.
+    pub pairs: u64,
+    /// Fraction of shooter–receiver polygon pairs whose shaft was clear,
+    /// so that no ray at all was cast between them.
+    pub clear_shaft_fraction: f64,
     /// Unshot power left as a fraction of the emitted power.
     pub unshot_fraction: f64,
     /// True when the threshold was reached (false: step limit).
@@ -283,6 +289,15 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
         lenmax: prepared.lenmax,
         steps: solver.steps(),
         rays: solver.rays(),
+        pairs: solver.pairs(),
+        clear_shaft_fraction: {
+            let (all, clear) = solver.receiver_pairs();
+            if all > 0 {
+                clear as f64 / all as f64
+            } else {
+                0.0
+            }
+        },
         unshot_fraction: solver.unshot_fraction(),
         converged: solver.stop_reason() == Some(StopReason::Converged),
         seconds,

@@ -69,6 +69,12 @@ struct Args {
     #[arg(long)]
     no_near_field: bool,
 
+    /// Test every shadow ray against the whole scene instead of only the
+    /// polygons in the shaft between shooter and receiver (slower, same
+    /// result; for comparison).
+    #[arg(long)]
+    no_shaft_culling: bool,
+
     /// Picture size in pixels, overriding the scene's camera.
     #[arg(long, value_name = "WxH")]
     size: Option<String>,
@@ -175,6 +181,7 @@ fn config(args: &Args) -> Result<RunConfig, String> {
             threshold: args.threshold,
             max_steps: args.max_steps,
             near_field: !args.no_near_field,
+            shaft_culling: !args.no_shaft_culling,
         },
         size,
         exposure,

@@ -27,6 +27,21 @@ use formfactor::{point_to_samples, shooter_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// Receiver vertices are grouped in runs of this many consecutive vertices
+/// of one polygon (a stretch of a grid row) for shaft culling: a shaft to
+/// a whole wall holds most of a room, one to a short run is thin and often
+/// clear. Sixteen keeps the shaft work per step well below the ray work it
+/// saves.
+pub const TILE_VERTICES: u32 = 16;
+
+/// Shooter samples are grouped in runs of this many (a stretch of their
+/// grid) for shaft culling, for the same reason as [`TILE_VERTICES`].
+pub const SHOOTER_GROUP: usize = 8;
+
+/// A receiver whose shaft holds at most this many polygons tests its rays
+/// against them one by one; more, and the BVH is faster.
+pub const LINEAR_CANDIDATES: usize = 8;
+
 /// Default fraction of the initial unshot power at which solving stops.
 pub const DEFAULT_THRESHOLD: f64 = 1e-3;
 
@@ -73,6 +88,9 @@ pub struct SolverOptions {
     /// Use the exact point-to-cell form factor for receivers close to a
     /// grid sample (see [`formfactor`]); off gives the plain disc sum.
     pub near_field: bool,
+    /// Cull shadow rays with shafts between shooter and receiver (same
+    /// result bits; off tests every ray against the whole scene's BVH).
+    pub shaft_culling: bool,
 }
 
 impl Default for SolverOptions {
@@ -83,6 +101,7 @@ impl Default for SolverOptions {
             threshold: DEFAULT_THRESHOLD,
             max_steps: None,
             near_field: true,
+            shaft_culling: true,
         }
     }
 }
@@ -100,6 +119,14 @@ pub struct StepReport {
     pub unshot_fraction: f64,
     /// Shadow rays cast in this step.
     pub rays: u64,
+    /// Sample–vertex pairs whose visibility mattered (both cosines
+    /// positive); with shaft culling, those in clear shafts cast no ray.
+    pub pairs: u64,
+    /// Polygons that received in this step.
+    pub receivers: u64,
+    /// Of those, the ones whose shaft to the shooter held no polygon, so
+    /// no ray was cast to them (0 without shaft culling).
+    pub clear_receivers: u64,
 }
 
 /// Why the solver stops.
@@ -135,6 +162,21 @@ pub struct Progressive<'a> {
     delta: Vec<Rgb>,
     /// Per polygon: scratch, whether it receives in this step.
     receives: Vec<bool>,
+    /// Per polygon: scratch, the polygons in its shaft to the shooter.
+    candidates: Vec<Vec<u32>>,
+    /// Groups of at most [`TILE_VERTICES`] consecutive vertices of one
+    /// polygon, for thin shafts.
+    tiles: Vec<std::ops::Range<u32>>,
+    /// Per vertex: its tile.
+    tile_of: Vec<u32>,
+    /// Per tile and shooter sample group: scratch, the polygons in the
+    /// shaft between them.
+    tile_candidates: Vec<Vec<u32>>,
+    /// Scratch: the shooter's sample positions.
+    group_points: Vec<glam::Vec3>,
+    pairs: u64,
+    receiver_pairs: u64,
+    clear_receiver_pairs: u64,
     initial_unshot_power: f64,
     steps: u64,
     rays: u64,
@@ -177,6 +219,19 @@ impl<'a> Progressive<'a> {
             .map(|p| emission[p.index()])
             .collect();
         let unshot = emission.clone();
+        let mut tiles = Vec::new();
+        let mut tile_of = vec![0u32; mesh.vertex_count()];
+        for pm in &mesh.polygons {
+            let mut start = pm.vertices.start;
+            while start < pm.vertices.end {
+                let end = (start + TILE_VERTICES).min(pm.vertices.end);
+                for l in start..end {
+                    tile_of[l as usize] = tiles.len() as u32;
+                }
+                tiles.push(start..end);
+                start = end;
+            }
+        }
         let mut solver = Progressive {
             mesh,
             visibility,
@@ -188,6 +243,14 @@ impl<'a> Progressive<'a> {
             unshot,
             delta: vec![Rgb::BLACK; mesh.vertex_count()],
             receives: vec![false; mesh.polygons.len()],
+            candidates: vec![Vec::new(); mesh.polygons.len()],
+            tile_candidates: Vec::new(),
+            group_points: Vec::new(),
+            tile_of,
+            tiles,
+            pairs: 0,
+            receiver_pairs: 0,
+            clear_receiver_pairs: 0,
             initial_unshot_power: 0.0,
             steps: 0,
             rays: 0,
@@ -254,6 +317,18 @@ impl<'a> Progressive<'a> {
         self.rays
     }
 
+    /// Sample–vertex pairs whose visibility mattered so far (rays cast
+    /// plus rays saved by clear shafts).
+    pub fn pairs(&self) -> u64 {
+        self.pairs
+    }
+
+    /// Shooter–receiver polygon pairs processed so far, and how many of
+    /// them had a clear shaft (no ray cast at all).
+    pub fn receiver_pairs(&self) -> (u64, u64) {
+        (self.receiver_pairs, self.clear_receiver_pairs)
+    }
+
     /// Why the solve should stop now, or `None` to go on.
     pub fn stop_reason(&self) -> Option<StopReason> {
         if self.unshot_fraction() <= self.options.threshold || self.unshot_power() <= 0.0 {
@@ -304,12 +379,58 @@ impl<'a> Progressive<'a> {
 
         let mesh = self.mesh;
         let visibility = self.visibility;
+        let culling = self.options.shaft_culling;
+        let receives = &self.receives;
+        if culling {
+            self.candidates
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(j, c)| {
+                    if receives[j] {
+                        visibility.shaft_candidates(shooter, PolygonId(j as u32), c);
+                    } else {
+                        c.clear();
+                    }
+                });
+            // Thin shafts between small groups of shooter samples and of
+            // receiver vertices, searched among their polygons' candidates.
+            let groups = self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1);
+            self.group_points.clear();
+            self.group_points
+                .extend(self.samples[i].iter().map(|s| s.position));
+            let group_points = &self.group_points;
+            let polygon_candidates = &self.candidates;
+            let tiles = &self.tiles;
+            self.tile_candidates
+                .resize_with(tiles.len() * groups, Vec::new);
+            self.tile_candidates
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(index, c)| {
+                    let (t, g) = (index / groups, index % groups);
+                    let Some(tile) = tiles.get(t) else {
+                        c.clear();
+                        return;
+                    };
+                    let j = mesh.vertex_polygon[tile.start as usize].index();
+                    if receives[j] && !polygon_candidates[j].is_empty() {
+                        let to = &mesh.sample_positions[tile.start as usize..tile.end as usize];
+                        let from = &group_points
+                            [g * SHOOTER_GROUP..((g + 1) * SHOOTER_GROUP).min(group_points.len())];
+                        visibility.refine_candidates(from, to, &polygon_candidates[j], c);
+                    } else {
+                        c.clear();
+                    }
+                });
+        }
+        let groups = self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1);
+        let tile_candidates = &self.tile_candidates;
+        let tile_of = &self.tile_of;
         let samples = &self.samples[i];
         let shooter_normal = mesh.polygons[i].normal;
-        let receives = &self.receives;
         let reflectance = &self.reflectance;
         let near_field = self.options.near_field;
-        let rays: u64 = self
+        let (pairs, rays) = self
             .delta
             .par_iter_mut()
             .enumerate()
@@ -318,29 +439,51 @@ impl<'a> Progressive<'a> {
                 let j = mesh.vertex_polygon[l];
                 if !receives[j.index()] || cancel.load(Ordering::Relaxed) {
                     *delta = Rgb::BLACK;
-                    return 0;
+                    return (0, 0);
                 }
                 let x = mesh.sample_positions[l];
-                let (f, rays) = point_to_samples(
+                let tile = tile_of[l] as usize * groups;
+                let mut rays = 0u64;
+                let (f, pairs) = point_to_samples(
                     x,
                     mesh.polygons[j.index()].normal,
                     shooter_normal,
                     samples,
                     near_field,
-                    |s| visibility.occluded(s, x, (shooter, j)),
+                    |k, s| {
+                        let blockers = tile_candidates
+                            .get(tile + k / SHOOTER_GROUP)
+                            .map_or(&[][..], |c| &c[..]);
+                        if !culling {
+                            rays += 1;
+                            visibility.occluded(s, x, (shooter, j))
+                        } else if blockers.is_empty() {
+                            // Nothing in the shaft: visible, no ray needed.
+                            false
+                        } else if blockers.len() <= LINEAR_CANDIDATES {
+                            rays += 1;
+                            visibility.occluded_among(s, x, blockers)
+                        } else {
+                            rays += 1;
+                            visibility.occluded(s, x, (shooter, j))
+                        }
+                    },
                 );
                 *delta = reflectance[j.index()] * shot * f;
-                rays
+                (pairs, rays)
             })
-            .sum();
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         if cancel.load(Ordering::Relaxed) {
             return None;
         }
 
+        let (mut receivers, mut clear) = (0u64, 0u64);
         for (j, pm) in mesh.polygons.iter().enumerate() {
             if !self.receives[j] {
                 continue;
             }
+            receivers += 1;
+            clear += (culling && self.candidates[j].is_empty()) as u64;
             let mut gathered = Rgb::BLACK;
             for l in pm.vertices.clone() {
                 let d = self.delta[l as usize];
@@ -349,6 +492,9 @@ impl<'a> Progressive<'a> {
             }
             self.unshot[j] += gathered / pm.vertex_count() as f64;
         }
+        self.pairs += pairs;
+        self.receiver_pairs += receivers;
+        self.clear_receiver_pairs += clear;
         self.unshot[i] = Rgb::BLACK;
         self.steps += 1;
         self.rays += rays;
@@ -358,6 +504,9 @@ impl<'a> Progressive<'a> {
             shot_power,
             unshot_fraction: self.unshot_fraction(),
             rays,
+            pairs,
+            receivers,
+            clear_receivers: clear,
         })
     }
 
