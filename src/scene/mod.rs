@@ -7,6 +7,7 @@
 //! reflectance below one), so later stages may rely on it.
 
 mod error;
+pub mod hall;
 mod polygon;
 mod sc;
 

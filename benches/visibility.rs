@@ -1,0 +1,99 @@
+//! Shadow-ray throughput of the visibility queries alone, on `cornell` and
+//! on the 1,000-polygon hall: the wide BVH against testing every polygon,
+//! on one thread and on all threads. The segments are the solver's own:
+//! from shooter samples (cell centres) of random polygons to random
+//! element vertices of the mesh, fixed by a seed.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glam::Vec3;
+use radiosity::mesh::{self, MeshOptions};
+use radiosity::scene::{self, PolygonId, Scene};
+use radiosity::visibility::Visibility;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// Segments per measured batch.
+const SEGMENTS: usize = 20_000;
+
+fn segments(scene: &Scene) -> Vec<(Vec3, Vec3, (PolygonId, PolygonId))> {
+    let mesh = mesh::build(scene, &MeshOptions::for_scene(scene)).expect("mesh");
+    let mut seed = 0x5eed_1234_abcd_ef01u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut out = Vec::with_capacity(SEGMENTS);
+    while out.len() < SEGMENTS {
+        let l = (next() % mesh.vertex_count() as u64) as usize;
+        let m = (next() % mesh.vertex_count() as u64) as usize;
+        let (i, j) = (mesh.vertex_polygon[l], mesh.vertex_polygon[m]);
+        if i == j {
+            continue;
+        }
+        let (a, b) = (mesh.sample_positions[l], mesh.sample_positions[m]);
+        // Only pairs that face each other, as the solver asks.
+        let (ni, nj) = (
+            mesh.polygons[i.index()].normal,
+            mesh.polygons[j.index()].normal,
+        );
+        if ni.dot(b - a) > 0.0 && nj.dot(a - b) > 0.0 {
+            out.push((a, b, (i, j)));
+        }
+    }
+    out
+}
+
+fn bench_visibility(c: &mut Criterion) {
+    let cornell = scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.sc"))
+        .expect("cornell");
+    let hall = scene::parse_str(&scene::hall::hall_sc(15), "hall.sc").expect("hall");
+    let mut group = c.benchmark_group("shadow rays");
+    group.throughput(Throughput::Elements(SEGMENTS as u64));
+    group.sample_size(10);
+    for (name, scene) in [("cornell", &cornell), ("hall-1000", &hall)] {
+        let vis = Visibility::new(scene);
+        let segs = segments(scene);
+        let blocked = segs
+            .iter()
+            .filter(|(a, b, e)| vis.occluded(*a, *b, *e))
+            .count();
+        eprintln!(
+            "{name}: {} polygons, {:.1} % of the segments blocked",
+            scene.polygons.len(),
+            100.0 * blocked as f64 / SEGMENTS as f64
+        );
+        for threads in [1usize, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            group.bench_function(BenchmarkId::new(format!("{name}/bvh"), threads), |bch| {
+                bch.iter(|| {
+                    pool.install(|| {
+                        segs.par_iter()
+                            .filter(|(a, b, e)| vis.occluded(*a, *b, *e))
+                            .count()
+                    })
+                })
+            });
+            group.bench_function(
+                BenchmarkId::new(format!("{name}/every-polygon"), threads),
+                |bch| {
+                    bch.iter(|| {
+                        pool.install(|| {
+                            segs.par_iter()
+                                .filter(|(a, b, e)| vis.occluded_brute_force(*a, *b, *e))
+                                .count()
+                        })
+                    })
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_visibility);
+criterion_main!(benches);
