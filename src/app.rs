@@ -1,5 +1,7 @@
 //! The batch driver: load → mesh → solve → render → write, with progress
-//! on the terminal and timings for `--stats`.
+//! on the terminal and timings for `--stats`; optionally the solved mesh
+//! (`--export`), the per-step log (`--log`) and the convergence plot
+//! (`--plot`).
 //!
 //! The command-line front end turns its arguments into a [`RunConfig`] and
 //! calls [`run`]; nothing here reads `argv`. A future window drives the
@@ -7,10 +9,11 @@
 
 use crate::color::Rgb;
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
-use crate::output::{self, OutputError, PictureFormat};
+use crate::output::convergence::{self, StepRecord};
+use crate::output::{self, MeshFormat, OutputError, PictureFormat};
 use crate::render::{Exposure, Frame, Rasterizer, RenderError, View, ViewError};
 use crate::scene::{self, LoadError, Scene};
-use crate::solver::{Progressive, SolverOptions, StopReason};
+use crate::solver::{Progressive, SolverOptions, StepReport, StopReason};
 use crate::visibility::Visibility;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -29,7 +32,7 @@ pub const BUNDLED_SCENE_NAME: &str = "scenes/rtable.sc";
 pub enum SceneSource {
     /// The bundled `rtable.sc`.
     Bundled,
-    /// A `.sc` file.
+    /// A scene file: `.obj` (Wavefront OBJ with MTL materials) or `.sc`.
     File(PathBuf),
 }
 
@@ -75,8 +78,31 @@ pub struct RunConfig {
     pub exposure: Exposure,
     /// Where to write the statistics JSON, if anywhere.
     pub stats: Option<PathBuf>,
+    /// A `.sc` file whose `camera` block replaces the scene's camera.
+    pub camera: Option<PathBuf>,
+    /// Where to write the solved mesh (`.glb` or `.ply`), if anywhere.
+    pub export: Option<PathBuf>,
+    /// Where to write the per-step CSV log, if anywhere.
+    pub log: Option<PathBuf>,
+    /// Where to write the convergence plot (`.png`), if anywhere.
+    pub plot: Option<PathBuf>,
     /// Show a progress bar (only drawn when stderr is a terminal).
     pub progress: bool,
+}
+
+impl RunConfig {
+    /// True when the run asks for results only a batch run writes (the
+    /// mesh export, the log or the plot), so no window should open.
+    pub fn wants_batch_outputs(&self) -> bool {
+        self.export.is_some() || self.log.is_some() || self.plot.is_some()
+    }
+
+    /// Every file the batch run writes besides the picture.
+    fn extra_outputs(&self) -> impl Iterator<Item = &PathBuf> {
+        [&self.stats, &self.export, &self.log, &self.plot]
+            .into_iter()
+            .flatten()
+    }
 }
 
 /// Why a run failed.
@@ -154,6 +180,9 @@ pub struct RunStats {
     pub clear_shaft_fraction: f64,
     /// Unshot power left as a fraction of the emitted power.
     pub unshot_fraction: f64,
+    /// The exposure the 8-bit picture and the exported display colours
+    /// used (dimensionless): the given one, or the automatic one.
+    pub exposure: f32,
     /// True when the threshold was reached (false: step limit).
     pub converged: bool,
     /// Seconds per phase.
@@ -189,7 +218,7 @@ impl Prepared {
 pub fn prepare(config: &RunConfig) -> Result<Prepared, RunError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let scene = load_scene(&config.scene)?;
+    let scene = load_scene_with_camera(&config.scene, config.camera.as_deref())?;
     seconds.load = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -223,22 +252,46 @@ pub fn output_path(config: &RunConfig) -> PathBuf {
 }
 
 /// Refuses unusable outputs before any time is spent solving: an unknown
-/// extension, a missing directory, or a path that is the input scene.
+/// extension, a missing directory, a path that is an input (the scene, its
+/// camera file), or two outputs that are the same file.
 pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     let output = output_path(config);
     PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
-    output::check_destination(&output).map_err(RunError::BadOutput)?;
-    if let Some(stats) = &config.stats {
-        output::check_destination(stats).map_err(RunError::BadOutput)?;
+    if let Some(export) = &config.export {
+        MeshFormat::from_path(export).map_err(RunError::BadOutput)?;
     }
-    if let SceneSource::File(input) = &config.scene {
-        for out in std::iter::once(&output).chain(config.stats.as_ref()) {
+    if let Some(plot) = &config.plot {
+        convergence::check_plot_path(plot).map_err(RunError::BadOutput)?;
+    }
+    let outputs: Vec<&PathBuf> = std::iter::once(&output)
+        .chain(config.extra_outputs())
+        .collect();
+    for out in &outputs {
+        output::check_destination(out).map_err(RunError::BadOutput)?;
+    }
+    for (i, a) in outputs.iter().enumerate() {
+        if outputs[..i].iter().any(|b| a == b || same_file(a, b)) {
+            return Err(RunError::BadOutput(OutputError::Io {
+                path: a.to_path_buf(),
+                error: std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "two outputs would be written to this same file",
+                ),
+            }));
+        }
+    }
+    let inputs = match &config.scene {
+        SceneSource::File(input) => Some(input),
+        SceneSource::Bundled => None,
+    };
+    for input in inputs.into_iter().chain(config.camera.as_ref()) {
+        for out in &outputs {
             if same_file(input, out) {
                 return Err(RunError::BadOutput(OutputError::Io {
-                    path: out.clone(),
+                    path: out.to_path_buf(),
                     error: std::io::Error::new(
                         std::io::ErrorKind::InvalidInput,
-                        "refusing to overwrite the input scene",
+                        "refusing to overwrite an input file",
                     ),
                 }));
             }
@@ -268,7 +321,7 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
         &prepared.visibility,
         config.solver,
     );
-    solve_with_progress(&mut solver, config.progress);
+    let steps = solve_with_progress(&mut solver, config.progress);
     seconds.solve = t.elapsed().as_secs_f64();
     solver
         .validate()
@@ -279,7 +332,33 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
     seconds.render = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    output::write_picture(&output, &frame, config.exposure).map_err(RunError::Write)?;
+    // Resolved once, so the picture and the exported colours agree.
+    let exposure = config.exposure.resolve(&frame);
+    output::write_picture(&output, &frame, Exposure::Fixed(exposure)).map_err(RunError::Write)?;
+    if let Some(path) = &config.export {
+        output::write_mesh(path, &prepared.mesh, solver.radiosity(), exposure)
+            .map_err(RunError::Write)?;
+    }
+    let records: Vec<StepRecord> = steps
+        .iter()
+        .map(|&(report, elapsed)| StepRecord {
+            report,
+            shooter_line: prepared.scene.polygons[report.shooter.index()].origin.line,
+            seconds: elapsed.as_secs_f64(),
+        })
+        .collect();
+    if let Some(path) = &config.log {
+        convergence::write_log_file(path, &records).map_err(RunError::Write)?;
+    }
+    if let Some(path) = &config.plot {
+        convergence::write_plot_file(
+            path,
+            &records,
+            config.solver.threshold,
+            &config.scene.display_name(),
+        )
+        .map_err(RunError::Write)?;
+    }
     let mut stats = RunStats {
         scene: config.scene.display_name(),
         output: output.display().to_string(),
@@ -299,6 +378,7 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
             }
         },
         unshot_fraction: solver.unshot_fraction(),
+        exposure,
         converged: solver.stop_reason() == Some(StopReason::Converged),
         seconds,
     };
@@ -317,9 +397,25 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
 
 /// Loads the scene from its source.
 pub fn load_scene(source: &SceneSource) -> Result<Scene, LoadError> {
+    load_scene_with_camera(source, None)
+}
+
+/// Loads the scene from its source, with the camera of the `.sc` file
+/// `camera` when given (see [`scene::load_with_camera`]).
+pub fn load_scene_with_camera(
+    source: &SceneSource,
+    camera: Option<&Path>,
+) -> Result<Scene, LoadError> {
     match source {
-        SceneSource::Bundled => scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME),
-        SceneSource::File(path) => scene::load(path),
+        SceneSource::Bundled => {
+            let mut scene = scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?;
+            if let Some(camera) = camera {
+                scene.camera = scene::load_camera(camera)?;
+                scene.camera_source = scene::CameraSource::File;
+            }
+            Ok(scene)
+        }
+        SceneSource::File(path) => scene::load_with_camera(path, camera),
     }
 }
 
@@ -341,7 +437,13 @@ fn same_file(a: &Path, b: &Path) -> bool {
 /// it is a terminal. The bar's position is the fraction of the way, in
 /// log scale, from the initial unshot power to the threshold; the ETA
 /// extrapolates the recent rate at which the log of the unshot power falls.
-pub fn solve_with_progress(solver: &mut Progressive, progress: bool) {
+///
+/// Returns every step's report with the time from the start of this call
+/// to the end of that step.
+pub fn solve_with_progress(
+    solver: &mut Progressive,
+    progress: bool,
+) -> Vec<(StepReport, Duration)> {
     let target = if progress && std::io::stderr().is_terminal() {
         ProgressDrawTarget::stderr()
     } else {
@@ -357,11 +459,13 @@ pub fn solve_with_progress(solver: &mut Progressive, progress: bool) {
     let total_log = (1.0 / threshold).ln();
     let start = Instant::now();
     let mut rate = RateEstimate::default();
+    let mut steps = Vec::new();
     while !solver.is_done() {
         let Some(report) = solver.step() else {
             break;
         };
         let elapsed = start.elapsed();
+        steps.push((report, elapsed));
         let fraction = report.unshot_fraction.max(f64::MIN_POSITIVE);
         let done_log = (1.0 / fraction).ln().max(0.0);
         rate.push(elapsed, done_log);
@@ -381,6 +485,7 @@ pub fn solve_with_progress(solver: &mut Progressive, progress: bool) {
         ));
     }
     bar.finish_and_clear();
+    steps
 }
 
 /// The rate at which `log(1 / unshot fraction)` grows, over a sliding

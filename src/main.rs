@@ -16,13 +16,14 @@ use std::process::ExitCode;
 /// Progressive-refinement radiosity renderer (ray-traced form factors after
 /// Wallace, Elmquist and Haines 1989).
 ///
-/// Reads a .sc scene, meshes every polygon into elements, shoots light from
+/// Reads a .sc or .obj scene, meshes every polygon into elements, shoots light from
 /// the polygon with the most unshot power until the unshot power falls
 /// below the threshold, and writes a Gouraud-shaded picture.
 #[derive(Parser, Debug)]
 #[command(name = "radiosity", version, about, long_about = None, after_help = EXIT_CODES)]
 struct Args {
-    /// Scene file (.sc). Without it, the bundled scenes/rtable.sc.
+    /// Scene file: .sc, or .obj (Wavefront OBJ with its MTL materials).
+    /// Without it, the bundled scenes/rtable.sc.
     scene: Option<PathBuf>,
 
     /// Picture to write: .png or .tif/.tiff (8-bit, tone-mapped), .exr or
@@ -87,6 +88,29 @@ struct Args {
     /// Write counts and seconds per phase as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats: Option<PathBuf>,
+
+    /// Take the camera from the `camera` block of this .sc file (for .obj
+    /// scenes, which have none; also overrides a .sc scene's camera).
+    /// Without it an .obj scene is framed automatically.
+    #[arg(long, value_name = "FILE.sc")]
+    camera: Option<PathBuf>,
+
+    /// Write the solved element mesh: .glb (glTF 2.0 binary: display
+    /// colours as COLOR_0, linear radiosity as _RADIOSITY) or .ply (binary
+    /// little-endian: float radiosity and 8-bit colour per vertex). Runs in
+    /// batch mode, as -o does.
+    #[arg(long, value_name = "FILE")]
+    export: Option<PathBuf>,
+
+    /// Write one CSV row per shooting step (step, shooter, unshot fraction,
+    /// rays, seconds). Runs in batch mode, as -o does.
+    #[arg(long, value_name = "FILE.csv")]
+    log: Option<PathBuf>,
+
+    /// Draw the unshot fraction against the step on a log axis as a PNG.
+    /// Runs in batch mode, as -o does.
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
 
     /// Worker threads for the solver and renderer; default: all cores.
     #[arg(long, value_name = "N")]
@@ -186,6 +210,10 @@ fn config(args: &Args) -> Result<RunConfig, String> {
         size,
         exposure,
         stats: args.stats.clone(),
+        camera: args.camera.clone(),
+        export: args.export.clone(),
+        log: args.log.clone(),
+        plot: args.plot.clone(),
         progress: !args.quiet,
     })
 }
@@ -208,7 +236,7 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    let result = if args.output.is_none() && !args.no_window {
+    let result = if args.output.is_none() && !args.no_window && !config.wants_batch_outputs() {
         run_window_or_fallback(&config, args.quiet)
     } else {
         app::run(&config).map(Some)

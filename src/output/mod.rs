@@ -1,5 +1,6 @@
-//! Writing results to files: pictures (png, tiff, exr, pfm), and the
-//! atomic-write helper every other output shares.
+//! Writing results to files: pictures (png, tiff, exr, pfm), the solved
+//! mesh (glb, ply), the convergence log and plot, and the atomic-write
+//! helper every output shares.
 //!
 //! Every file is written to a temporary file in its destination directory
 //! and renamed into place once complete ([`write_atomically`]), so a failed
@@ -9,9 +10,12 @@
 //! Errors are [`OutputError`]s; each names the path it is about and, when
 //! the operating system or an encoder failed, says why in the same message.
 
+pub mod convergence;
 pub mod image;
+pub mod mesh_export;
 
 pub use self::image::{write_picture, write_rgb8, PictureFormat, SUPPORTED_EXTENSIONS};
+pub use self::mesh_export::{write_mesh, MeshFormat, MESH_EXTENSIONS};
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};

@@ -8,15 +8,20 @@
 
 mod error;
 pub mod hall;
+pub mod obj;
 mod polygon;
 mod sc;
 
 pub use error::{Diagnostic, LoadError};
+pub use obj::load_obj;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, PARALLELOGRAM_TOLERANCE,
     PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
-pub use sc::{parse_str, MAX_COORDINATE, MAX_DIAGNOSTICS, UP_PARALLEL_TOLERANCE};
+pub use sc::{
+    load_camera, parse_camera_str, parse_str, MAX_COORDINATE, MAX_DIAGNOSTICS,
+    UP_PARALLEL_TOLERANCE,
+};
 
 use crate::color::Rgb;
 use glam::Vec3;
@@ -221,9 +226,29 @@ impl Scene {
     }
 }
 
-/// Reads and parses a `.sc` file. Errors carry the file name, line and column.
+/// Reads and parses a scene file: Wavefront OBJ (with its MTL libraries)
+/// when the extension is `.obj` in any case, else `.sc`. Errors carry the
+/// file name, line and column.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    sc::load_file(path)
+    load_with_camera(path, None)
+}
+
+/// [`load`], with the camera taken from the `camera` block of the `.sc`
+/// file `camera` when given (see [`load_camera`]) instead of the scene's
+/// own or the auto-framed one.
+pub fn load_with_camera(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    let is_obj = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        return obj::load_obj(path, camera);
+    }
+    let mut scene = sc::load_file(path)?;
+    if let Some(camera) = camera {
+        scene.camera = sc::load_camera(camera)?;
+        scene.camera_source = CameraSource::File;
+    }
+    Ok(scene)
 }
 
 #[cfg(test)]

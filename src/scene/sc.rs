@@ -83,6 +83,30 @@ pub fn parse_str(source: &str, file: &str) -> Result<Scene, LoadError> {
     parser.finish()
 }
 
+/// Parses `.sc` source text for its camera only, as a sidecar camera for
+/// a scene from another format (`--camera`). The file is checked exactly
+/// as [`parse_str`] checks it, except that it may have no polygons; it
+/// must have a `camera` block.
+pub fn parse_camera_str(source: &str, file: &str) -> Result<Camera, LoadError> {
+    let source = source.strip_prefix('\u{feff}').unwrap_or(source);
+    let mut parser = Parser::new(file, lex(source));
+    parser.run();
+    parser.report_pending(false)?;
+    parser.camera.ok_or_else(|| {
+        Diagnostic::new(file, FILE_START, "camera file has no `camera` block").into()
+    })
+}
+
+/// Reads `path` and parses its camera (see [`parse_camera_str`]); the
+/// path as given names the file in diagnostics.
+pub fn load_camera(path: &Path) -> Result<Camera, LoadError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path)
+        .map_err(|e| Diagnostic::new(&file, FILE_START, format!("cannot read file: {e}")))?;
+    let text = decode(&bytes, &file)?;
+    parse_camera_str(text, &file)
+}
+
 /// Reads `path` and parses it; the path as given names the file in
 /// diagnostics. A file that cannot be read is reported at `1:1`, a file
 /// that is not UTF-8 at its first bad byte.
@@ -1115,29 +1139,7 @@ impl<'a> Parser<'a> {
     // ----------------------------------------------------------- finish --
 
     fn finish(mut self) -> Result<Scene, LoadError> {
-        for u in std::mem::take(&mut self.undefined_uses) {
-            let message = match self.material_ids.get(u.name.as_str()) {
-                Some(&(_, def)) => format!(
-                    "material `{}` is used before its definition at {}",
-                    u.name,
-                    at(def)
-                ),
-                None => format!("undefined material `{}`", u.name),
-            };
-            self.error(u.pos, message);
-        }
-        if self.diags.is_empty() && self.polygons.is_empty() {
-            self.error(FILE_START, "scene has no polygons");
-        }
-        if !self.diags.is_empty() {
-            // Stable, so messages at one position keep the order they were
-            // found in.
-            self.diags.sort_by_key(|d| (d.line, d.col));
-            self.diags.truncate(MAX_DIAGNOSTICS);
-            return Err(LoadError {
-                diagnostics: self.diags,
-            });
-        }
+        self.report_pending(true)?;
         let (camera, camera_source) = match self.camera {
             Some(c) => (c, CameraSource::File),
             None => {
@@ -1151,6 +1153,35 @@ impl<'a> Parser<'a> {
             camera,
             camera_source,
         })
+    }
+
+    /// Reports the uses of undefined materials and, when
+    /// `require_polygons`, an empty scene; then every diagnostic found, in
+    /// file order, if there is any.
+    fn report_pending(&mut self, require_polygons: bool) -> Result<(), LoadError> {
+        for u in std::mem::take(&mut self.undefined_uses) {
+            let message = match self.material_ids.get(u.name.as_str()) {
+                Some(&(_, def)) => format!(
+                    "material `{}` is used before its definition at {}",
+                    u.name,
+                    at(def)
+                ),
+                None => format!("undefined material `{}`", u.name),
+            };
+            self.error(u.pos, message);
+        }
+        if require_polygons && self.diags.is_empty() && self.polygons.is_empty() {
+            self.error(FILE_START, "scene has no polygons");
+        }
+        if !self.diags.is_empty() {
+            // Stable, so messages at one position keep the order they were
+            // found in.
+            let mut diags = std::mem::take(&mut self.diags);
+            diags.sort_by_key(|d| (d.line, d.col));
+            diags.truncate(MAX_DIAGNOSTICS);
+            return Err(LoadError { diagnostics: diags });
+        }
+        Ok(())
     }
 }
 
@@ -2149,5 +2180,29 @@ end
                 assert!(d.message.starts_with("cannot read file: "), "{}", d.message);
             }
         }
+    }
+
+    #[test]
+    fn camera_files_need_a_camera_but_no_polygons() {
+        let cam = "camera\n  eye 1 2 3\n  lookat 1 2 4\n  fov 30\n  size 64 48\nend\n";
+        let c = parse_camera_str(cam, "cam.sc").unwrap();
+        assert_eq!(c.eye, Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(c.lookat, Vec3::new(1.0, 2.0, 4.0));
+        assert_eq!((c.width, c.height), (64, 48));
+        assert!((c.fov_y - 30f32.to_radians()).abs() < 1e-6);
+        // A whole scene is accepted too; its camera is taken.
+        let with_scene =
+            format!("{cam}material m color 0.5 0.5 0.5 k_diffrefl 1 end box m 0 0 0 1 1 1\n");
+        assert_eq!(parse_camera_str(&with_scene, "s.sc").unwrap(), c);
+        // No camera block: an error at the start of the file.
+        let e = parse_camera_str("# nothing\n", "empty.sc").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "empty.sc:1:1: error: camera file has no `camera` block"
+        );
+        // Mistakes are reported as in any scene file.
+        let e =
+            parse_camera_str("camera\n  eye 0 0 0\n  lookat 0 0 0\nend\n", "bad.sc").unwrap_err();
+        assert_eq!(e.first().map(|d| (d.line, d.col)), Some((3, 3)), "{e}");
     }
 }

@@ -1,0 +1,248 @@
+//! How the solve converged: a CSV log of every shooting step (`--log`) and
+//! a plot of the unshot power against the step (`--plot`).
+//!
+//! The CSV has a header line and one row per step, in order:
+//!
+//! | column | meaning |
+//! |---|---|
+//! | `step` | the step, from 1 |
+//! | `shooter` | the polygon that shot: its index in the scene, from 0 |
+//! | `shooter_line` | the line of the scene file where that polygon is written |
+//! | `shot_power` | the power it shot, radiosity × area (scene units) |
+//! | `unshot_fraction` | unshot power left after the step ÷ emitted power |
+//! | `rays` | shadow rays cast in the step |
+//! | `seconds` | wall-clock seconds from the start of the solve to the end of the step |
+//!
+//! Numbers are written in Rust's shortest round-trip form, so reading them
+//! back gives the very values of the run.
+//!
+//! The plot is a PNG drawn with `plotters`: the unshot fraction on a log
+//! axis against the step, starting from 1 at step 0, with the stopping
+//! threshold as a horizontal line. Its text uses the Noto Mono font bundled
+//! in the binary (SIL Open Font License, `assets/fonts/OFL.txt`), so no
+//! system font is needed.
+
+use super::{write_rgb8, OutputError, PictureFormat};
+use crate::solver::StepReport;
+use image::RgbImage;
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+use std::io::{self, Write};
+use std::path::Path;
+use std::sync::Once;
+
+/// The plot's size in pixels (width, height).
+pub const PLOT_SIZE: (u32, u32) = (900, 560);
+
+/// The CSV header line (without the line break).
+pub const LOG_HEADER: &str = "step,shooter,shooter_line,shot_power,unshot_fraction,rays,seconds";
+
+/// The font family the plot's text is drawn with.
+const FONT: &str = "sans-serif";
+static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/NotoMono-Regular.ttf");
+
+/// One shooting step as logged.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepRecord {
+    /// What the solver reported.
+    pub report: StepReport,
+    /// The line of the scene file where the shooter is written.
+    pub shooter_line: u32,
+    /// Seconds from the start of the solve to the end of this step.
+    pub seconds: f64,
+}
+
+/// Writes the CSV log (see the module docs) of `steps`.
+pub fn write_log(w: &mut dyn Write, steps: &[StepRecord]) -> io::Result<()> {
+    writeln!(w, "{LOG_HEADER}")?;
+    for s in steps {
+        let r = &s.report;
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{}",
+            r.step, r.shooter.0, s.shooter_line, r.shot_power, r.unshot_fraction, r.rays, s.seconds
+        )?;
+    }
+    Ok(())
+}
+
+/// Writes the CSV log to `path`, atomically.
+pub fn write_log_file(path: &Path, steps: &[StepRecord]) -> Result<(), OutputError> {
+    super::write_atomically(path, |w| write_log(w, steps))
+}
+
+/// Checks that `path` names a picture format the plot can be written in
+/// (8-bit: `.png`, `.tif`, `.tiff`).
+pub fn check_plot_path(path: &Path) -> Result<(), OutputError> {
+    if PictureFormat::from_path(path)?.is_linear() {
+        return Err(OutputError::UnknownFormat {
+            path: path.to_path_buf(),
+            reason: "a plot is an 8-bit picture: use .png, .tif or .tiff".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Draws the convergence plot of `steps` (see the module docs) for a solve
+/// that stops at `threshold` (a fraction of the emitted power); `title`
+/// names the scene.
+pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImage, String> {
+    static REGISTER: Once = Once::new();
+    REGISTER.call_once(|| {
+        // The bytes are a valid font, checked by the tests; a failure here
+        // only means text is not drawn.
+        let _ = register_font(FONT, FontStyle::Normal, FONT_BYTES);
+    });
+    let (w, h) = PLOT_SIZE;
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let points: Vec<(f64, f64)> = std::iter::once((0.0, 1.0))
+            .chain(
+                steps
+                    .iter()
+                    .map(|s| (s.report.step as f64, s.report.unshot_fraction)),
+            )
+            .filter(|&(_, y)| y > 0.0 && y.is_finite())
+            .collect();
+        let last_step = points.last().map_or(1.0, |p| p.0).max(1.0);
+        let lowest = points
+            .iter()
+            .map(|p| p.1)
+            .chain((threshold > 0.0).then_some(threshold))
+            .fold(1.0, f64::min);
+        // A decade of room below the lowest value, and some above 1.
+        let y_range = (lowest / 10.0)..2.0;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(format!("convergence of {title}"), (FONT, 22).into_font())
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.0..last_step, y_range.log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("shooting step")
+            .y_desc("unshot power / emitted power")
+            .label_style((FONT, 14).into_font())
+            .axis_desc_style((FONT, 16).into_font())
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        chart
+            .draw_series(LineSeries::new(points, BLUE.stroke_width(2)))
+            .map_err(|e| e.to_string())?
+            .label("unshot fraction")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+        if threshold > 0.0 {
+            chart
+                .draw_series(LineSeries::new(
+                    vec![(0.0, threshold), (last_step, threshold)],
+                    RED.stroke_width(1),
+                ))
+                .map_err(|e| e.to_string())?
+                .label(format!("threshold {threshold}"))
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FONT, 14).into_font())
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    RgbImage::from_raw(w, h, buf).ok_or_else(|| "plot buffer has the wrong size".to_string())
+}
+
+/// Draws the plot and writes it to `path` (`.png`, `.tif`, `.tiff`),
+/// atomically.
+pub fn write_plot_file(
+    path: &Path,
+    steps: &[StepRecord],
+    threshold: f64,
+    title: &str,
+) -> Result<(), OutputError> {
+    check_plot_path(path)?;
+    let image = plot(steps, threshold, title).map_err(|e| OutputError::Io {
+        path: path.to_path_buf(),
+        error: io::Error::other(format!("cannot draw the plot: {e}")),
+    })?;
+    write_rgb8(path, &image)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::PolygonId;
+    use crate::solver::StepReport;
+
+    fn steps(n: u64) -> Vec<StepRecord> {
+        (1..=n)
+            .map(|i| StepRecord {
+                report: StepReport {
+                    step: i,
+                    shooter: PolygonId(i as u32 % 3),
+                    shot_power: 1.0 / i as f64,
+                    unshot_fraction: 0.5f64.powi(i as i32),
+                    rays: 100 * i,
+                },
+                shooter_line: 7,
+                seconds: 0.1 * i as f64,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_bundled_font_is_a_font() {
+        assert!(ab_glyph_ok(FONT_BYTES));
+    }
+
+    fn ab_glyph_ok(bytes: &'static [u8]) -> bool {
+        register_font("test-font", FontStyle::Normal, bytes).is_ok()
+    }
+
+    #[test]
+    fn log_has_a_header_and_one_exact_row_per_step() {
+        let s = steps(3);
+        let mut out = Vec::new();
+        write_log(&mut out, &s).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4);
+        assert_eq!(lines[0], LOG_HEADER);
+        assert_eq!(lines[2], "2,2,7,0.5,0.25,200,0.2");
+        let third: Vec<f64> = lines[3].split(',').map(|x| x.parse().unwrap()).collect();
+        assert_eq!(third[4], s[2].report.unshot_fraction);
+        assert_eq!(third[6], s[2].seconds);
+    }
+
+    #[test]
+    fn plot_draws_the_curve_and_text() {
+        let img = plot(&steps(20), 1e-3, "test").unwrap();
+        assert_eq!(img.dimensions(), PLOT_SIZE);
+        let blue = img.pixels().filter(|p| p.0 == [0, 0, 255]).count();
+        let red = img.pixels().filter(|p| p.0 == [255, 0, 0]).count();
+        assert!(blue > 500, "curve pixels: {blue}");
+        assert!(red > 300, "threshold pixels: {red}");
+        // Text is drawn in black anti-aliased strokes: many grey pixels in
+        // the caption band at the top, which has no lines.
+        let caption_ink = (0..40)
+            .flat_map(|y| (0..PLOT_SIZE.0).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0[0] < 128)
+            .count();
+        assert!(caption_ink > 100, "caption pixels: {caption_ink}");
+        // No steps at all (nothing emits): still a plot.
+        assert!(plot(&[], 1e-3, "dark").is_ok());
+    }
+
+    #[test]
+    fn plot_paths_must_be_8_bit_pictures() {
+        assert!(check_plot_path(Path::new("p.png")).is_ok());
+        assert!(check_plot_path(Path::new("p.exr")).is_err());
+        assert!(check_plot_path(Path::new("p.txt")).is_err());
+    }
+}

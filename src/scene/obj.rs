@@ -1,0 +1,1130 @@
+//! Wavefront OBJ + MTL import: a model exported from Blender (or taken from
+//! a public OBJ collection) becomes a [`Scene`].
+//!
+//! What is read:
+//!
+//! - every `f` line is one face; a face that [`Polygon::new`] accepts as it
+//!   is (a planar convex triangle, quad or n-gon) stays one polygon, any
+//!   other face with four or more vertices (non-planar, non-convex) is
+//!   split into triangles by ear clipping in its best-fit plane. The front
+//!   of a face is the side from which its vertices run counter-clockwise,
+//!   as in the OBJ convention;
+//! - `usemtl NAME` picks the material of the faces that follow; materials
+//!   come from the `mtllib` files named in the OBJ, relative to its folder;
+//! - in a material, `Kd` is the diffuse reflectance (`k_diffrefl` 1 × Kd)
+//!   and `Ke` the emitted radiosity (`k_emission` 1 × Ke), in the scene's
+//!   radiosity units. Every channel of `Kd` must be below 1, as in `.sc`.
+//!   A material with both a non-black `Kd` and a non-black `Ke` keeps the
+//!   colour of `Ke` exactly and the luminance of `Kd` (a [`Material`] has
+//!   one colour): its reflectance is `Ke × lum(Kd) / lum(Ke)`, capped below
+//!   one.
+//!
+//! What is ignored: texture coordinates, normals, smoothing groups, object
+//! and group names, lines (`l`) and points (`p`), and every other MTL
+//! statement (`Ka`, `Ks`, `Ns`, `illum`, `map_*`, …), none of which
+//! changes a diffuse radiosity solution. Faces before any `usemtl` get
+//! the built-in material [`DEFAULT_MATERIAL_NAME`] with reflectance
+//! [`DEFAULT_REFLECTANCE`] (Blender's default base colour).
+//!
+//! The geometry is parsed by the `tobj` crate with `triangulate: false`, so
+//! quads stay quads. `tobj` reports no positions, so this module checks
+//! every `v` and `f` line itself first (numbers, index ranges, vertex
+//! counts), giving `FILE:LINE:COL` for each mistake, locates any error
+//! `tobj` still finds by the line it stopped reading at, and matches the
+//! n-th face `tobj` returns to the n-th `f` line of the file (`tobj` keeps
+//! file order). MTL files are read here (they are a handful of lines) so
+//! that each `Kd` and `Ke` has its position for messages.
+//!
+//! The camera comes from a sidecar `.sc` file (see
+//! [`super::sc::load_camera`]) or is [`Camera::frame`]d around the model.
+
+use super::error::fmt_num;
+use super::sc::MAX_DIAGNOSTICS;
+use super::{
+    Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError,
+    Scene, SourcePos,
+};
+use crate::color::Rgb;
+use glam::{DVec2, DVec3, Vec3};
+use std::cell::{Cell, RefCell};
+use std::collections::HashMap;
+use std::io::{self, BufRead, Read};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// The name of the material given to faces that come before any `usemtl`.
+pub const DEFAULT_MATERIAL_NAME: &str = "(no usemtl)";
+
+/// Reflectance of [`DEFAULT_MATERIAL_NAME`], every channel, dimensionless:
+/// 0.8, the default base colour of a new Blender material.
+pub const DEFAULT_REFLECTANCE: f64 = 0.8;
+
+/// In ear clipping, a corner whose doubled signed area (in the face's
+/// plane) is at most this fraction of the face's extent squared counts as
+/// straight, not as an ear: it would make a sliver of no area.
+pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
+
+/// Where the start of a file is, for problems of the file as a whole.
+const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
+
+/// Reads the OBJ file at `path`, its material libraries, and the camera:
+/// from the `.sc` file `camera` when given (its `camera` block), else
+/// framed around the model ([`Camera::frame`]).
+///
+/// Errors name the file (the OBJ, an MTL, or the camera file), the line
+/// and the column, and every problem found is reported (up to
+/// [`MAX_DIAGNOSTICS`]).
+pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    let camera = camera.map(super::sc::load_camera).transpose()?;
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path)
+        .map_err(|e| Diagnostic::new(&file, FILE_START, format!("cannot read file: {e}")))?;
+    // Lossy: a stray Latin-1 byte in a comment must not refuse the model;
+    // names are decoded the same way in the OBJ and in its MTL files.
+    let text = String::from_utf8_lossy(&bytes);
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let read_mtl = |name: &str| -> Result<(String, String), String> {
+        let mtl_path: PathBuf = dir.join(name);
+        let display = mtl_path.display().to_string();
+        match std::fs::read(&mtl_path) {
+            Ok(bytes) => Ok((display, String::from_utf8_lossy(&bytes).into_owned())),
+            Err(e) => Err(format!("cannot read material library {display}: {e}")),
+        }
+    };
+    parse_obj(&text, &file, &read_mtl, camera)
+}
+
+/// Turns a `mtllib` name into the library's name for messages and its
+/// text, or says why it cannot.
+pub(crate) type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
+
+/// Parses OBJ text named `file`. `read_mtl` turns a `mtllib` name into
+/// the library's name for messages and its text, or says why it cannot.
+/// `camera` replaces the auto-framed camera.
+pub(crate) fn parse_obj(
+    text: &str,
+    file: &str,
+    read_mtl: &ReadMtl<'_>,
+    camera: Option<Camera>,
+) -> Result<Scene, LoadError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let scan = scan_obj(text, file);
+    let mut diags = scan.diags.clone();
+    if diags.len() >= MAX_DIAGNOSTICS {
+        return Err(finish_diags(diags));
+    }
+
+    // tobj reads the text through a reader that remembers how far it got,
+    // so an error it reports can be placed on its line.
+    let consumed = Rc::new(Cell::new(0usize));
+    let libraries: RefCell<Vec<Library>> = RefCell::new(Vec::new());
+    let mtl_diags: RefCell<Vec<Diagnostic>> = RefCell::new(Vec::new());
+    let mut reader = CountingReader {
+        bytes: text.as_bytes(),
+        pos: consumed.clone(),
+    };
+    let options = tobj::LoadOptions {
+        single_index: false,
+        triangulate: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let loaded = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
+        let at = line_at(text, consumed.get());
+        let name = mtl.to_string_lossy();
+        let pos = scan
+            .mtllibs
+            .iter()
+            .find(|m| m.line == at)
+            .map_or(SourcePos { line: at, col: 1 }, |m| m.pos);
+        let (mtl_file, mtl_text) = match read_mtl(&name) {
+            Ok(x) => x,
+            Err(message) => {
+                mtl_diags
+                    .borrow_mut()
+                    .push(Diagnostic::new(file, pos, message));
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        };
+        let library = parse_mtl(&mtl_text, &mtl_file, at);
+        mtl_diags.borrow_mut().extend(library.diags.iter().cloned());
+        let materials: Vec<tobj::Material> = library
+            .materials
+            .iter()
+            .map(|m| tobj::Material {
+                name: m.name.clone(),
+                ..Default::default()
+            })
+            .collect();
+        // Names map to indices into the concatenation of every library, as
+        // tobj offsets them, so its material ids are ours.
+        let map = library
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (m.name.clone(), i))
+            .collect();
+        libraries.borrow_mut().push(library);
+        Ok((materials, map))
+    });
+    diags.extend(mtl_diags.into_inner());
+    let libraries = libraries.into_inner();
+    let models = match loaded {
+        Ok((models, _)) => models,
+        // The scan found the mistake already, with its column.
+        Err(_) if !scan.diags.is_empty() => return Err(finish_diags(diags)),
+        Err(e) => {
+            let line = line_at(text, consumed.get());
+            diags.push(Diagnostic::new(
+                file,
+                SourcePos {
+                    line,
+                    col: first_word_col(text, line),
+                },
+                format!("cannot read OBJ: {e}"),
+            ));
+            return Err(finish_diags(diags));
+        }
+    };
+
+    // Materials, in library order, by name for `usemtl` checks.
+    let records: Vec<&MtlMaterial> = libraries.iter().flat_map(|l| &l.materials).collect();
+    let mut defined: HashMap<&str, (u32, &MtlMaterial)> = HashMap::new();
+    for (lib, m) in libraries
+        .iter()
+        .flat_map(|l| l.materials.iter().map(move |m| (l, m)))
+    {
+        match defined.get(m.name.as_str()) {
+            Some((_, first)) => diags.push(Diagnostic::new(
+                &lib.file,
+                m.pos,
+                format!(
+                    "material `{}` is already defined in {} at {}:{}",
+                    m.name, first.file, first.pos.line, first.pos.col
+                ),
+            )),
+            None => {
+                defined.insert(&m.name, (lib.loaded_at, m));
+            }
+        }
+    }
+    for u in &scan.usemtls {
+        match defined.get(u.name.as_str()) {
+            Some((loaded_at, _)) if *loaded_at < u.pos.line => {}
+            Some((loaded_at, _)) => diags.push(Diagnostic::new(
+                file,
+                u.pos,
+                format!(
+                    "material `{}` is used before the `mtllib` that defines it (line {loaded_at})",
+                    u.name
+                ),
+            )),
+            None => diags.push(Diagnostic::new(
+                file,
+                u.pos,
+                format!("undefined material `{}`: no `mtllib` defines it", u.name),
+            )),
+        }
+    }
+
+    let mut materials: Vec<Material> = records.iter().map(|m| m.to_material()).collect();
+    let mut default_id = None;
+    let mut polygons = Vec::new();
+    let mut faces = scan.faces.iter();
+    for model in &models {
+        let mesh = &model.mesh;
+        let material = match mesh.material_id {
+            Some(i) if i < materials.len() => MaterialId(i as u32),
+            _ => *default_id.get_or_insert_with(|| {
+                materials.push(Material {
+                    name: DEFAULT_MATERIAL_NAME.to_string(),
+                    color: Rgb::splat(DEFAULT_REFLECTANCE),
+                    k_diffrefl: 1.0,
+                    k_emission: 0.0,
+                });
+                MaterialId(materials.len() as u32 - 1)
+            }),
+        };
+        let mut next = 0usize;
+        let arities = mesh.face_arities.iter().copied().map(|a| a as usize);
+        let all_triangles = std::iter::repeat_n(3, mesh.indices.len() / 3);
+        let arities: Box<dyn Iterator<Item = usize>> = if mesh.face_arities.is_empty() {
+            Box::new(all_triangles)
+        } else {
+            Box::new(arities)
+        };
+        for arity in arities {
+            let Some(indices) = mesh.indices.get(next..next + arity) else {
+                break;
+            };
+            next += arity;
+            let Some(face) = faces.next() else {
+                diags.push(Diagnostic::new(
+                    file,
+                    FILE_START,
+                    "internal error: the OBJ reader returned more faces than the file has `f` lines",
+                ));
+                return Err(finish_diags(diags));
+            };
+            if face.is_line {
+                // An `l` line with three or more vertices comes out of
+                // tobj as a face: a polyline, not a surface.
+                continue;
+            }
+            let vertices: Vec<Vec3> = indices
+                .iter()
+                .map(|&i| {
+                    let i = i as usize * 3;
+                    Vec3::new(
+                        mesh.positions[i],
+                        mesh.positions[i + 1],
+                        mesh.positions[i + 2],
+                    )
+                })
+                .collect();
+            match face_polygons(material, vertices, face.pos) {
+                Ok(ps) => polygons.extend(ps),
+                Err(message) => diags.push(Diagnostic::new(file, face.pos, message)),
+            }
+        }
+    }
+    if diags.is_empty() && polygons.is_empty() {
+        diags.push(Diagnostic::new(file, FILE_START, "OBJ file has no faces"));
+    }
+    if !diags.is_empty() {
+        return Err(finish_diags(diags));
+    }
+    let (camera, camera_source) = match camera {
+        Some(c) => (c, CameraSource::File),
+        None => {
+            let (lo, hi) = bounds(&polygons);
+            (Camera::frame(lo, hi), CameraSource::AutoFramed)
+        }
+    };
+    Ok(Scene {
+        polygons,
+        materials,
+        camera,
+        camera_source,
+    })
+}
+
+/// The diagnostics as an error: sorted by file, then position (stable, so
+/// several messages at one place keep their order), at most
+/// [`MAX_DIAGNOSTICS`].
+fn finish_diags(mut diags: Vec<Diagnostic>) -> LoadError {
+    diags.sort_by(|a, b| (a.file.as_str(), a.line, a.col).cmp(&(b.file.as_str(), b.line, b.col)));
+    diags.truncate(MAX_DIAGNOSTICS);
+    LoadError { diagnostics: diags }
+}
+
+fn bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
+    polygons
+        .iter()
+        .flat_map(|p| p.vertices.iter().copied())
+        .fold(None, |acc: Option<(Vec3, Vec3)>, v| match acc {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+        })
+        .unwrap_or((Vec3::ZERO, Vec3::ZERO))
+}
+
+// ------------------------------------------------------------ faces --
+
+/// The polygons of one face: itself when it is a valid polygon, else
+/// (four or more vertices) its ear-clipped triangles. Triangles of no area
+/// (from collinear vertices) are dropped; a face with nothing left is an
+/// error, as is a degenerate triangle.
+fn face_polygons(
+    material: MaterialId,
+    vertices: Vec<Vec3>,
+    origin: SourcePos,
+) -> Result<Vec<Polygon>, String> {
+    let whole = match Polygon::new(material, vertices.clone(), origin) {
+        Ok(p) => return Ok(vec![p]),
+        Err(e) => e,
+    };
+    let degenerate = |e: &PolygonError| format!("degenerate face: {e}");
+    if vertices.len() < 4 || matches!(whole, PolygonError::NotFinite { .. }) {
+        return Err(degenerate(&whole));
+    }
+    let triangles = match ear_clip(&vertices) {
+        Some(t) => t,
+        None if matches!(
+            whole,
+            PolygonError::ZeroArea | PolygonError::EqualVertices { .. }
+        ) =>
+        {
+            return Err(degenerate(&whole))
+        }
+        None => {
+            return Err(format!(
+                "bad face: it overlaps itself and cannot be split into triangles ({whole})"
+            ))
+        }
+    };
+    let mut out = Vec::with_capacity(triangles.len());
+    for [a, b, c] in triangles {
+        match Polygon::new(
+            material,
+            vec![vertices[a], vertices[b], vertices[c]],
+            origin,
+        ) {
+            Ok(p) => out.push(p),
+            Err(PolygonError::ZeroArea | PolygonError::EqualVertices { .. }) => {}
+            Err(e) => return Err(degenerate(&e)),
+        }
+    }
+    if out.is_empty() {
+        Err(degenerate(&whole))
+    } else {
+        Ok(out)
+    }
+}
+
+/// Triangulates a simple polygon (possibly non-convex, possibly slightly
+/// non-planar) by ear clipping in the plane of its Newell normal. The
+/// triangles are index triples into `vertices`, counter-clockwise about
+/// that normal, like the face. Straight corners are clipped last and come
+/// out as zero-area triangles, which the caller drops. `None` when the
+/// polygon has no area or overlaps itself.
+fn ear_clip(vertices: &[Vec3]) -> Option<Vec<[usize; 3]>> {
+    let p: Vec<DVec3> = vertices.iter().map(|v| v.as_dvec3()).collect();
+    let n = p.len();
+    let mut normal = DVec3::ZERO;
+    for i in 0..n {
+        let (a, b) = (p[i], p[(i + 1) % n]);
+        normal += DVec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    let normal = normal.normalize_or_zero();
+    if normal == DVec3::ZERO {
+        return None;
+    }
+    let u = normal.any_orthonormal_vector();
+    let v = normal.cross(u);
+    let q: Vec<DVec2> = p.iter().map(|x| DVec2::new(x.dot(u), x.dot(v))).collect();
+    let extent = q
+        .iter()
+        .flat_map(|a| q.iter().map(move |b| a.distance(*b)))
+        .fold(0.0, f64::max);
+    let eps = EAR_AREA_TOLERANCE * extent * extent;
+    let cross = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
+    let mut left: Vec<usize> = (0..n).collect();
+    let mut out = Vec::with_capacity(n - 2);
+    while left.len() > 3 {
+        let m = left.len();
+        let ear = (0..m).find(|&k| {
+            let (a, b, c) = (left[(k + m - 1) % m], left[k], left[(k + 1) % m]);
+            if cross(q[a], q[b], q[c]) <= eps {
+                return false;
+            }
+            // No other corner inside or on the triangle.
+            left.iter().all(|&o| {
+                o == a
+                    || o == b
+                    || o == c
+                    || q[o] == q[a]
+                    || q[o] == q[b]
+                    || q[o] == q[c]
+                    || !(cross(q[a], q[b], q[o]) >= -eps
+                        && cross(q[b], q[c], q[o]) >= -eps
+                        && cross(q[c], q[a], q[o]) >= -eps)
+            })
+        });
+        let k = match ear {
+            Some(k) => k,
+            // Only straight corners left: clip one; it has no area.
+            None if (0..m).all(|k| {
+                let (a, b, c) = (left[(k + m - 1) % m], left[k], left[(k + 1) % m]);
+                cross(q[a], q[b], q[c]).abs() <= eps
+            }) =>
+            {
+                0
+            }
+            None => return None,
+        };
+        out.push([left[(k + m - 1) % m], left[k], left[(k + 1) % m]]);
+        left.remove(k);
+    }
+    out.push([left[0], left[1], left[2]]);
+    Some(out)
+}
+
+// ------------------------------------------------------------- scan --
+
+/// What the OBJ pre-scan finds.
+struct Scan {
+    diags: Vec<Diagnostic>,
+    /// Every `f` line, and every `l` line with three or more vertices, in
+    /// file order.
+    faces: Vec<FaceLine>,
+    usemtls: Vec<Named>,
+    mtllibs: Vec<MtlLib>,
+}
+
+struct FaceLine {
+    pos: SourcePos,
+    is_line: bool,
+}
+
+struct Named {
+    name: String,
+    pos: SourcePos,
+}
+
+struct MtlLib {
+    line: u32,
+    pos: SourcePos,
+}
+
+/// The words of a line (split on whitespace, as `tobj` splits them) with
+/// their 1-based columns in characters.
+fn words(line: &str) -> Vec<(&str, u32)> {
+    let mut out = Vec::new();
+    let mut start: Option<(usize, u32)> = None;
+    let mut col = 0u32;
+    for (i, c) in line.char_indices() {
+        col += 1;
+        if c.is_whitespace() {
+            if let Some((s, sc)) = start.take() {
+                out.push((&line[s..i], sc));
+            }
+        } else if start.is_none() {
+            start = Some((i, col));
+        }
+    }
+    if let Some((s, sc)) = start {
+        out.push((&line[s..], sc));
+    }
+    out
+}
+
+/// Lines as `tobj` reads them (split at LF, a CR before it dropped), with
+/// their 1-based numbers.
+fn lines(text: &str) -> impl Iterator<Item = (u32, &str)> {
+    text.split('\n')
+        .enumerate()
+        .map(|(i, l)| (i as u32 + 1, l.strip_suffix('\r').unwrap_or(l)))
+}
+
+/// Checks every `v`, `vt`, `vn`, `f` and `l` line, and notes where the
+/// faces, `usemtl` and `mtllib` lines are.
+fn scan_obj(text: &str, file: &str) -> Scan {
+    let mut scan = Scan {
+        diags: Vec::new(),
+        faces: Vec::new(),
+        usemtls: Vec::new(),
+        mtllibs: Vec::new(),
+    };
+    // Positive indices may refer to any vertex of the file (tobj resolves
+    // them at the end), negative ones count back from the current line.
+    let mut totals = [0usize; 3];
+    for (_, line) in lines(text) {
+        match line.split_whitespace().next() {
+            Some("v") => totals[0] += 1,
+            Some("vt") => totals[1] += 1,
+            Some("vn") => totals[2] += 1,
+            _ => {}
+        }
+    }
+    let mut seen = [0usize; 3];
+    for (number, line) in lines(text) {
+        if scan.diags.len() >= MAX_DIAGNOSTICS {
+            break;
+        }
+        let w = words(line);
+        let Some(&(keyword, col)) = w.first() else {
+            continue;
+        };
+        let at = |col: u32| SourcePos { line: number, col };
+        let mut error = |col: u32, message: String| {
+            scan.diags.push(Diagnostic::new(file, at(col), message));
+        };
+        match keyword {
+            "v" | "vt" | "vn" => {
+                let (kind, need) = match keyword {
+                    "v" => (0, 3),
+                    "vt" => (1, 1),
+                    _ => (2, 3),
+                };
+                seen[kind] += 1;
+                if w.len() - 1 < need {
+                    error(
+                        col,
+                        format!(
+                            "`{keyword}` needs at least {need} numbers, found {}",
+                            w.len() - 1
+                        ),
+                    );
+                    continue;
+                }
+                for &(word, c) in &w[1..] {
+                    match word.parse::<f32>() {
+                        Ok(x) if x.is_finite() => {}
+                        Ok(_) => error(
+                            c,
+                            format!("`{word}` is not allowed: numbers must be finite"),
+                        ),
+                        Err(_) => error(c, format!("invalid number `{word}`")),
+                    }
+                }
+            }
+            "f" | "l" => {
+                let is_line = keyword == "l";
+                let count = w.len() - 1;
+                if !is_line && count < 3 {
+                    error(
+                        col,
+                        format!("face has {count} vertices; at least 3 are needed"),
+                    );
+                    continue;
+                }
+                let mut ok = true;
+                for &(word, c) in &w[1..] {
+                    if let Err(message) = check_reference(word, &seen, &totals) {
+                        error(c, message);
+                        ok = false;
+                    }
+                }
+                if ok && count >= 3 {
+                    scan.faces.push(FaceLine {
+                        pos: at(col),
+                        is_line,
+                    });
+                }
+            }
+            "usemtl" => {
+                // tobj takes everything after the first space, trimmed.
+                let name = line.split_once(' ').map_or("", |x| x.1.trim());
+                if name.is_empty() {
+                    error(col, "`usemtl` needs a material name".into());
+                } else {
+                    scan.usemtls.push(Named {
+                        name: name.to_string(),
+                        pos: at(col),
+                    });
+                }
+            }
+            "mtllib" => {
+                if line.split_once(' ').map_or("", |x| x.1.trim()).is_empty() {
+                    error(col, "`mtllib` needs a file name".into());
+                } else {
+                    scan.mtllibs.push(MtlLib {
+                        line: number,
+                        pos: at(col),
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    scan
+}
+
+/// Checks one face corner `v`, `v/vt`, `v//vn` or `v/vt/vn` against the
+/// counts of vertices, texture coordinates and normals (`seen` so far for
+/// negative indices, `totals` in the file for positive ones).
+fn check_reference(word: &str, seen: &[usize; 3], totals: &[usize; 3]) -> Result<(), String> {
+    const WHAT: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    const PLURAL: [&str; 3] = ["vertices", "texture coordinates", "normals"];
+    let parts: Vec<&str> = word.split('/').collect();
+    if parts.len() > 3 || parts[0].is_empty() {
+        return Err(format!(
+            "invalid face vertex `{word}`: expected v, v/vt, v//vn or v/vt/vn"
+        ));
+    }
+    for (k, part) in parts.iter().enumerate() {
+        if part.is_empty() {
+            continue;
+        }
+        let Ok(i) = part.parse::<i64>() else {
+            return Err(format!(
+                "invalid face vertex `{word}`: `{part}` is not a whole number"
+            ));
+        };
+        let ok = match i {
+            0 => false,
+            i if i > 0 => i as u64 <= totals[k] as u64,
+            i => i.unsigned_abs() <= seen[k] as u64,
+        };
+        if !ok {
+            return Err(format!(
+                "{} index {i} in `{word}` is out of range: {} {} {}",
+                WHAT[k],
+                if i < 0 { seen[k] } else { totals[k] },
+                PLURAL[k],
+                if i < 0 {
+                    "are defined above this line"
+                } else {
+                    "are defined in the file (indices count from 1)"
+                }
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The 1-based number of the line that ends at byte `pos` (the last line
+/// read when a reader has consumed `pos` bytes).
+fn line_at(text: &str, pos: usize) -> u32 {
+    let end = pos.min(text.len()).saturating_sub(1);
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count() as u32
+        + 1
+}
+
+/// The column of the first word of line `line`, or 1.
+fn first_word_col(text: &str, line: u32) -> u32 {
+    lines(text)
+        .find(|(n, _)| *n == line)
+        .and_then(|(_, l)| words(l).first().map(|w| w.1))
+        .unwrap_or(1)
+}
+
+/// A `BufRead` over the text that records how many bytes were consumed.
+struct CountingReader<'a> {
+    bytes: &'a [u8],
+    pos: Rc<Cell<usize>>,
+}
+
+impl Read for CountingReader<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let rest = self.fill_buf()?;
+        let n = rest.len().min(buf.len());
+        buf[..n].copy_from_slice(&rest[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl BufRead for CountingReader<'_> {
+    fn fill_buf(&mut self) -> io::Result<&[u8]> {
+        Ok(&self.bytes[self.pos.get().min(self.bytes.len())..])
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.pos.set((self.pos.get() + amt).min(self.bytes.len()));
+    }
+}
+
+// -------------------------------------------------------------- mtl --
+
+/// One material library as read.
+struct Library {
+    file: String,
+    /// The OBJ line of the `mtllib` that loaded it.
+    loaded_at: u32,
+    materials: Vec<MtlMaterial>,
+    diags: Vec<Diagnostic>,
+}
+
+/// One `newmtl` block: the values that matter here, with positions.
+struct MtlMaterial {
+    name: String,
+    file: String,
+    pos: SourcePos,
+    kd: Rgb,
+    ke: Rgb,
+}
+
+impl MtlMaterial {
+    /// The scene material: see the module docs for the mapping.
+    fn to_material(&self) -> Material {
+        let (color, k_diffrefl, k_emission) = if self.ke.is_black() {
+            (self.kd, 1.0, 0.0)
+        } else if self.kd.is_black() {
+            (self.ke, 0.0, 1.0)
+        } else {
+            let lum = |c: Rgb| c.luminance().max(f64::MIN_POSITIVE);
+            let k = lum(self.kd) / lum(self.ke);
+            // Below one in every channel, like Kd itself.
+            let k = k.min(self.kd.max_channel() / self.ke.max_channel());
+            (self.ke, k, 1.0)
+        };
+        Material {
+            name: self.name.clone(),
+            color,
+            k_diffrefl,
+            k_emission,
+        }
+    }
+}
+
+/// Reads an MTL library: `newmtl`, `Kd` and `Ke` (other statements are
+/// ignored). `loaded_at` is the OBJ line that names it.
+fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lib = Library {
+        file: file.to_string(),
+        loaded_at,
+        materials: Vec::new(),
+        diags: Vec::new(),
+    };
+    for (number, line) in lines(text) {
+        let w = words(line);
+        let Some(&(keyword, col)) = w.first() else {
+            continue;
+        };
+        let at = |col: u32| SourcePos { line: number, col };
+        match keyword {
+            "newmtl" => {
+                // As tobj reads it: everything after the keyword, trimmed.
+                let name = line.trim_start()["newmtl".len()..].trim();
+                if name.is_empty() {
+                    lib.diags.push(Diagnostic::new(
+                        file,
+                        at(col),
+                        "`newmtl` needs a material name",
+                    ));
+                    continue;
+                }
+                lib.materials.push(MtlMaterial {
+                    name: name.to_string(),
+                    file: file.to_string(),
+                    pos: at(col),
+                    kd: Rgb::BLACK,
+                    ke: Rgb::BLACK,
+                });
+            }
+            "Kd" | "Ke" => {
+                let Some(m) = lib.materials.last_mut() else {
+                    lib.diags.push(Diagnostic::new(
+                        file,
+                        at(col),
+                        format!("`{keyword}` before any `newmtl`"),
+                    ));
+                    continue;
+                };
+                match color(&w) {
+                    Err((c, message)) => lib.diags.push(Diagnostic::new(file, at(c), message)),
+                    Ok(rgb) if keyword == "Ke" => m.ke = rgb,
+                    Ok(rgb) => {
+                        if rgb.max_channel() >= 1.0 {
+                            let (channel, value) = ["red", "green", "blue"]
+                                .into_iter()
+                                .zip(rgb.to_array())
+                                .fold(("red", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
+                            lib.diags.push(Diagnostic::new(
+                                file,
+                                at(col),
+                                format!(
+                                    "reflectance `Kd` is {} in the {channel} channel; every channel must be below 1",
+                                    fmt_num(value)
+                                ),
+                            ));
+                        }
+                        m.kd = rgb;
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    lib
+}
+
+/// The colour of a `Kd`/`Ke` line: `r g b`, or one value for grey (as the
+/// MTL format allows). Each finite and `>= 0`. Errors carry the column.
+fn color(w: &[(&str, u32)]) -> Result<Rgb, (u32, String)> {
+    let (keyword, col) = w[0];
+    let values = &w[1..];
+    if let Some(&(word, c)) = values
+        .first()
+        .filter(|(x, _)| *x == "spectral" || *x == "xyz")
+    {
+        return Err((
+            c,
+            format!("`{keyword} {word}` is not supported: give r g b values"),
+        ));
+    }
+    if values.len() != 1 && values.len() != 3 {
+        return Err((
+            col,
+            format!(
+                "`{keyword}` takes 3 numbers (r g b) or 1 (grey), found {}",
+                values.len()
+            ),
+        ));
+    }
+    let mut out = [0.0f64; 3];
+    for (slot, &(word, c)) in out.iter_mut().zip(values) {
+        let x = match word.parse::<f64>() {
+            Ok(x) if x.is_finite() => x,
+            Ok(_) => {
+                return Err((
+                    c,
+                    format!("`{word}` is not allowed: numbers must be finite"),
+                ))
+            }
+            Err(_) => return Err((c, format!("invalid number `{word}`"))),
+        };
+        if x < 0.0 {
+            return Err((
+                c,
+                format!("`{keyword}` channel {word} is negative; channels must be >= 0"),
+            ));
+        }
+        *slot = x;
+    }
+    if values.len() == 1 {
+        out = [out[0]; 3];
+    }
+    Ok(Rgb::new(out[0], out[1], out[2]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Shape;
+
+    const MTL: &str = "\
+# two materials
+newmtl white
+Kd 0.5 0.5 0.5
+Ks 0.1 0.1 0.1
+newmtl lamp
+Kd 0 0 0
+Ke 10 8 6
+newmtl grey
+Kd 0.25
+";
+
+    /// Parses `obj` with `lib.mtl` = [`MTL`] and nothing else readable.
+    fn parse(obj: &str) -> Result<Scene, LoadError> {
+        parse_with(obj, MTL)
+    }
+
+    fn parse_with(obj: &str, mtl: &str) -> Result<Scene, LoadError> {
+        let read = |name: &str| match name {
+            "lib.mtl" => Ok(("lib.mtl".to_string(), mtl.to_string())),
+            other => Err(format!("cannot read material library {other}: not found")),
+        };
+        parse_obj(obj, "m.obj", &read, None)
+    }
+
+    fn messages(e: &LoadError) -> Vec<String> {
+        e.diagnostics.iter().map(|d| d.to_string()).collect()
+    }
+
+    const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+
+    #[test]
+    fn quads_stay_quads_and_materials_map() {
+        let obj =
+            format!("mtllib lib.mtl\n{SQUARE}usemtl white\nf 1 2 3 4\nusemtl lamp\nf -4 -2 -1\n");
+        let s = parse(&obj).unwrap();
+        assert_eq!(s.polygons.len(), 2);
+        assert_eq!(s.polygons[0].shape, Shape::Parallelogram);
+        assert_eq!(s.polygons[0].vertices.len(), 4);
+        assert_eq!(s.polygons[0].origin, SourcePos { line: 7, col: 1 });
+        assert_eq!(
+            s.polygons[1].vertices,
+            vec![Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::Y]
+        );
+        assert_eq!(s.polygons[1].origin.line, 9);
+        let white = s.material_of(crate::scene::PolygonId(0));
+        assert_eq!(white.name, "white");
+        assert_eq!(white.reflectance(), Rgb::splat(0.5));
+        assert_eq!(white.emission(), Rgb::BLACK);
+        let lamp = s.material_of(crate::scene::PolygonId(1));
+        assert_eq!(lamp.emission(), Rgb::new(10.0, 8.0, 6.0));
+        assert_eq!(lamp.reflectance(), Rgb::BLACK);
+        // `Kd 0.25` is grey; unused materials are kept, in library order.
+        assert_eq!(s.materials[2].reflectance(), Rgb::splat(0.25));
+        assert_eq!(s.materials.len(), 3);
+        // Facing +z (counter-clockwise seen from +z); auto-framed.
+        assert_eq!(s.polygons[0].normal, Vec3::Z);
+        assert_eq!(s.camera_source, CameraSource::AutoFramed);
+    }
+
+    #[test]
+    fn faces_without_usemtl_get_the_default_material() {
+        let s = parse(&format!(
+            "{SQUARE}f 1/1/1 2//2 3/3 4\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nvn 0 0 1\n"
+        ))
+        .unwrap();
+        assert_eq!(s.materials.len(), 1);
+        assert_eq!(s.materials[0].name, DEFAULT_MATERIAL_NAME);
+        assert_eq!(
+            s.materials[0].reflectance(),
+            Rgb::splat(DEFAULT_REFLECTANCE)
+        );
+    }
+
+    #[test]
+    fn non_planar_and_non_convex_faces_are_triangulated() {
+        // A quad folded along its diagonal: two triangles.
+        let s = parse("v 0 0 0\nv 1 0 0\nv 1 1 0.5\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        assert_eq!(s.polygons.len(), 2);
+        assert!(s
+            .polygons
+            .iter()
+            .all(|p| p.shape == Shape::Triangle && p.normal.z > 0.0));
+        let area: f64 = s.polygons.iter().map(|p| p.area).sum();
+        assert!(area > 1.0 && area < 1.2, "{area}");
+        // An L-shaped hexagon (area 3): four triangles covering it exactly.
+        let l = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6\n";
+        let s = parse(l).unwrap();
+        assert_eq!(s.polygons.len(), 4);
+        let area: f64 = s.polygons.iter().map(|p| p.area).sum();
+        assert!((area - 3.0).abs() < 1e-6, "{area}");
+        assert!(s
+            .polygons
+            .iter()
+            .all(|p| (p.normal - Vec3::Z).length() < 1e-6));
+        // A pentagon with a straight corner is a valid convex polygon.
+        let s = parse("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4 5\n").unwrap();
+        assert_eq!(s.polygons.len(), 1);
+        assert_eq!(s.polygons[0].shape, Shape::Convex);
+        // A quad with a repeated vertex keeps its one real triangle.
+        let s = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2 3\n").unwrap();
+        assert_eq!(s.polygons.len(), 1);
+        assert!((s.polygons[0].area - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn degenerate_faces_are_errors_with_positions() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n  f 1 1 2 2\nf 1 2\n";
+        let e = parse(obj).unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec![
+                "m.obj:5:1: error: degenerate face: polygon has zero area",
+                "m.obj:7:3: error: degenerate face: vertices 1 and 2 are equal",
+                "m.obj:8:1: error: face has 2 vertices; at least 3 are needed",
+            ]
+        );
+        // A bow tie cannot be split.
+        let e = parse("v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n").unwrap_err();
+        assert!(messages(&e)[0].starts_with("m.obj:5:1: error: "), "{e}");
+    }
+
+    #[test]
+    fn bad_numbers_and_indices_are_errors_with_columns() {
+        let obj = "v 0 0 0\nv 1 0 x\nv 1 1\nv 0 1 nan\nf 1 2 5\nf 1 -5 2\nf 1 0 2\nf 1/7 2 3\nf 1//x 2 3\n";
+        let e = parse(obj).unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec![
+                "m.obj:2:7: error: invalid number `x`",
+                "m.obj:3:1: error: `v` needs at least 3 numbers, found 2",
+                "m.obj:4:7: error: `nan` is not allowed: numbers must be finite",
+                "m.obj:5:7: error: vertex index 5 in `5` is out of range: 4 vertices are defined in the file (indices count from 1)",
+                "m.obj:6:5: error: vertex index -5 in `-5` is out of range: 4 vertices are defined above this line",
+                "m.obj:7:5: error: vertex index 0 in `0` is out of range: 4 vertices are defined in the file (indices count from 1)",
+                "m.obj:8:3: error: texture coordinate index 7 in `1/7` is out of range: 0 texture coordinates are defined in the file (indices count from 1)",
+                "m.obj:9:3: error: invalid face vertex `1//x`: `x` is not a whole number",
+            ]
+        );
+    }
+
+    #[test]
+    fn errors_the_reader_finds_are_placed_on_their_line() {
+        // Five numbers on a `v` line: neither w nor a colour.
+        let e = parse(&format!("{SQUARE}\n  v 1 2 3 4 5\nf 1 2 3\n")).unwrap_err();
+        let m = messages(&e);
+        assert_eq!(m.len(), 1, "{m:?}");
+        assert!(
+            m[0].starts_with("m.obj:6:3: error: cannot read OBJ: "),
+            "{m:?}"
+        );
+    }
+
+    #[test]
+    fn material_problems_name_the_mtl_file() {
+        let mtl =
+            "newmtl a\nKd 0.5 1.0 0.2\nnewmtl b\nKe 1 -2 3\nKd 1 2\nnewmtl a\nKd spectral x.spd\n";
+        let obj = format!("mtllib lib.mtl\n{SQUARE}usemtl a\nf 1 2 3\nusemtl nope\nf 1 3 4\n");
+        let e = parse_with(&obj, mtl).unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec![
+                "lib.mtl:2:1: error: reflectance `Kd` is 1 in the green channel; every channel must be below 1",
+                "lib.mtl:4:6: error: `Ke` channel -2 is negative; channels must be >= 0",
+                "lib.mtl:5:1: error: `Kd` takes 3 numbers (r g b) or 1 (grey), found 2",
+                "lib.mtl:6:1: error: material `a` is already defined in lib.mtl at 1:1",
+                "lib.mtl:7:4: error: `Kd spectral` is not supported: give r g b values",
+                "m.obj:8:1: error: undefined material `nope`: no `mtllib` defines it",
+            ]
+        );
+        // A library that cannot be read, and a material used before its library.
+        let obj = format!("usemtl white\nmtllib other.mtl\nmtllib lib.mtl\n{SQUARE}f 1 2 3\n");
+        let e = parse(&obj).unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec![
+                "m.obj:1:1: error: material `white` is used before the `mtllib` that defines it (line 3)",
+                "m.obj:2:1: error: cannot read material library other.mtl: not found",
+            ]
+        );
+    }
+
+    #[test]
+    fn emitters_that_also_reflect_keep_ke_and_the_luminance_of_kd() {
+        let mtl = "newmtl glow\nKd 0.5 0.5 0.5\nKe 4 2 2\n";
+        let s = parse_with(
+            &format!("mtllib lib.mtl\nusemtl glow\n{SQUARE}f 1 2 3\n"),
+            mtl,
+        )
+        .unwrap();
+        let m = &s.materials[0];
+        assert_eq!(m.emission(), Rgb::new(4.0, 2.0, 2.0));
+        let rho = m.reflectance();
+        assert!((rho.luminance() - 0.5).abs() < 1e-9 || rho.max_channel() <= 0.5 + 1e-12);
+        assert!(rho.max_channel() < 1.0);
+        assert!((rho.r / rho.g - 2.0).abs() < 1e-9, "{rho:?}");
+    }
+
+    #[test]
+    fn polylines_and_points_are_not_faces() {
+        let s = parse(&format!("{SQUARE}l 1 2 3 4\np 1\nl 1 2\nf 1 2 3\n")).unwrap();
+        assert_eq!(s.polygons.len(), 1);
+        assert_eq!(s.polygons[0].origin.line, 8);
+        let e = parse(&format!("{SQUARE}l 1 2 3\n")).unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec!["m.obj:1:1: error: OBJ file has no faces"]
+        );
+    }
+
+    #[test]
+    fn load_obj_reads_libraries_next_to_the_file_and_a_sidecar_camera() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("lib.mtl"), MTL).unwrap();
+        let obj = dir.path().join("m.obj");
+        std::fs::write(
+            &obj,
+            format!("mtllib lib.mtl\nusemtl lamp\n{SQUARE}f 1 2 3 4\n"),
+        )
+        .unwrap();
+        let cam = dir.path().join("cam.sc");
+        std::fs::write(
+            &cam,
+            "camera eye 0.5 0.5 3 lookat 0.5 0.5 0 size 32 24 end\n",
+        )
+        .unwrap();
+        let s = load_obj(&obj, Some(&cam)).unwrap();
+        assert_eq!(s.camera_source, CameraSource::File);
+        assert_eq!((s.camera.width, s.camera.height), (32, 24));
+        assert_eq!(s.materials[s.polygons[0].material.index()].name, "lamp");
+        // The dispatch by extension, and the camera override for .sc too.
+        assert_eq!(crate::scene::load(&obj).unwrap().polygons, s.polygons);
+        let missing = dir.path().join("none.obj");
+        let e = load_obj(&missing, None).unwrap_err();
+        assert!(
+            messages(&e)[0].contains("none.obj:1:1: error: cannot read file"),
+            "{e}"
+        );
+        let e = load_obj(&obj, Some(&dir.path().join("nocam.sc"))).unwrap_err();
+        assert!(
+            messages(&e)[0].contains("nocam.sc:1:1: error: cannot read file"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,724 @@
+//! Whole-program tests of the model formats: OBJ + MTL import, glTF and
+//! PLY export of the solved mesh, and the convergence log and plot.
+
+mod common;
+
+use common::{listing, run_in, scene, stderr, write};
+use radiosity::color::Rgb;
+use radiosity::mesh::{self, Mesh, MeshOptions};
+use radiosity::output::convergence::{LOG_HEADER, PLOT_SIZE};
+use radiosity::output::mesh_export::RADIOSITY_ATTRIBUTE;
+use radiosity::output::write_mesh;
+use radiosity::render::srgb8;
+use radiosity::scene::{self, Scene};
+use radiosity::solver::{Progressive, SolverOptions};
+use radiosity::visibility::Visibility;
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// The Cornell box of `scenes/cornell.sc` as Blender would export it: one
+/// object per wall with its own vertices, the blocks with shared vertices
+/// (the tall one by negative indices), normals and smoothing lines that
+/// the importer ignores.
+const CORNELL_OBJ: &str = "\
+# Blender 4.1.1
+# www.blender.org
+mtllib cornell.mtl
+o floor
+v 552.800000 0.000000 0.000000
+v 0.000000 0.000000 0.000000
+v 0.000000 0.000000 559.200000
+v 549.600000 0.000000 559.200000
+vn 0.0000 1.0000 0.0000
+s 0
+usemtl white
+f 1//1 2//1 3//1 4//1
+o light
+v 343.000000 548.300000 227.000000
+v 343.000000 548.300000 332.000000
+v 213.000000 548.300000 332.000000
+v 213.000000 548.300000 227.000000
+vn 0.0000 1.0000 0.0000
+s 0
+usemtl light
+f 5//2 6//2 7//2 8//2
+o ceiling
+v 556.000000 548.800000 0.000000
+v 556.000000 548.800000 559.200000
+v 0.000000 548.800000 559.200000
+v 0.000000 548.800000 0.000000
+vn 0.0000 1.0000 0.0000
+s 0
+usemtl white
+f 9//3 10//3 11//3 12//3
+o back_wall
+v 549.600000 0.000000 559.200000
+v 0.000000 0.000000 559.200000
+v 0.000000 548.800000 559.200000
+v 556.000000 548.800000 559.200000
+vn 0.0000 1.0000 0.0000
+s 0
+usemtl white
+f 13//4 14//4 15//4 16//4
+o green_wall
+v 0.000000 0.000000 559.200000
+v 0.000000 0.000000 0.000000
+v 0.000000 548.800000 0.000000
+v 0.000000 548.800000 559.200000
+vn 0.0000 1.0000 0.0000
+s 0
+usemtl green
+f 17//5 18//5 19//5 20//5
+o red_wall
+v 552.800000 0.000000 0.000000
+v 549.600000 0.000000 559.200000
+v 552.800000 548.800000 559.200000
+v 556.000000 548.800000 0.000000
+vn 0.0000 1.0000 0.0000
+s 0
+usemtl red
+f 21//6 22//6 23//6 24//6
+o short_block
+v 130.000000 165.000000 65.000000
+v 82.000000 165.000000 225.000000
+v 240.000000 165.000000 272.000000
+v 290.000000 165.000000 114.000000
+v 290.000000 0.000000 114.000000
+v 240.000000 0.000000 272.000000
+v 130.000000 0.000000 65.000000
+v 82.000000 0.000000 225.000000
+usemtl white
+f 25 26 27 28
+f 29 28 27 30
+f 31 25 28 29
+f 32 26 25 31
+f 30 27 26 32
+o tall_block
+v 423.000000 330.000000 247.000000
+v 265.000000 330.000000 296.000000
+v 314.000000 330.000000 456.000000
+v 472.000000 330.000000 406.000000
+v 423.000000 0.000000 247.000000
+v 472.000000 0.000000 406.000000
+v 314.000000 0.000000 456.000000
+v 265.000000 0.000000 296.000000
+usemtl white
+f -8 -7 -6 -5
+f -4 -8 -5 -3
+f -3 -5 -6 -2
+f -2 -6 -7 -1
+f -1 -7 -8 -4
+";
+
+const CORNELL_MTL: &str = "\
+# Blender 4.1.1 MTL File: 'cornell.blend'
+# Material Count: 4
+
+newmtl white
+Ns 250.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.73 0.73 0.73
+Ks 0.500000 0.500000 0.500000
+Ke 0.000000 0.000000 0.000000
+Ni 1.450000
+d 1.000000
+illum 2
+
+newmtl red
+Ns 250.000000
+Kd 0.63 0.065 0.05
+Ks 0.500000 0.500000 0.500000
+illum 2
+
+newmtl green
+Kd 0.14 0.45 0.091
+illum 2
+
+newmtl light
+Kd 0.000000 0.000000 0.000000
+Ke 17 11.9 4.25
+illum 2
+";
+
+/// Relative tolerance of comparisons between quantities computed from the
+/// same decimal input along two paths (f32 vertices, f64 sums).
+const SAME_VALUE_TOLERANCE: f64 = 1e-9;
+
+fn write_cornell_obj(dir: &Path) -> std::path::PathBuf {
+    write(dir, "cornell.mtl", CORNELL_MTL);
+    write(dir, "cornell.obj", CORNELL_OBJ)
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= SAME_VALUE_TOLERANCE * a.abs().max(b.abs()).max(1.0)
+}
+
+fn close_rgb(a: Rgb, b: Rgb) -> bool {
+    a.to_array()
+        .iter()
+        .zip(b.to_array())
+        .all(|(&x, y)| close(x, y))
+}
+
+#[test]
+fn cornell_obj_loads_to_the_polygons_and_materials_of_cornell_sc() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = scene::load(&write_cornell_obj(dir.path())).unwrap();
+    let sc = scene::load(&scene("cornell.sc")).unwrap();
+    assert_eq!(obj.polygons.len(), sc.polygons.len());
+    for (i, (a, b)) in obj.polygons.iter().zip(&sc.polygons).enumerate() {
+        assert_eq!(a.vertices, b.vertices, "polygon {i}");
+        assert_eq!(a.shape, b.shape, "polygon {i}");
+        assert!(
+            close(a.area, b.area),
+            "polygon {i}: {} vs {}",
+            a.area,
+            b.area
+        );
+        assert!((a.normal - b.normal).length() < 1e-6, "polygon {i}");
+        let (ma, mb) = (
+            &obj.materials[a.material.index()],
+            &sc.materials[b.material.index()],
+        );
+        assert_eq!(ma.name, mb.name, "polygon {i}");
+        assert!(
+            close_rgb(ma.reflectance(), mb.reflectance()),
+            "polygon {i}: {ma:?} vs {mb:?}"
+        );
+        assert!(
+            close_rgb(ma.emission(), mb.emission()),
+            "polygon {i}: {ma:?} vs {mb:?}"
+        );
+    }
+    let emitters = |s: &Scene| -> BTreeSet<usize> {
+        (0..s.polygons.len())
+            .filter(|&i| {
+                !s.materials[s.polygons[i].material.index()]
+                    .emission()
+                    .is_black()
+            })
+            .collect()
+    };
+    assert_eq!(emitters(&obj), BTreeSet::from([1]));
+    assert_eq!(emitters(&obj), emitters(&sc));
+    let total = |s: &Scene| s.polygons.iter().map(|p| p.area).sum::<f64>();
+    assert!(close(total(&obj), total(&sc)));
+    // No camera in an OBJ: framed around the model.
+    assert_eq!(obj.camera_source, scene::CameraSource::AutoFramed);
+}
+
+/// A small solved Cornell box: its mesh and radiosity after a few steps.
+fn solved_cornell() -> (Mesh, Vec<Rgb>) {
+    let scene = scene::load(&scene("cornell.sc")).unwrap();
+    let mesh = mesh::build(
+        &scene,
+        &MeshOptions {
+            lenmax: 60.0,
+            inset: 0.05,
+        },
+    )
+    .unwrap();
+    let visibility = Visibility::new(&scene);
+    let mut solver = Progressive::new(
+        &scene,
+        &mesh,
+        &visibility,
+        SolverOptions {
+            max_steps: Some(6),
+            ..SolverOptions::default()
+        },
+    );
+    while !solver.is_done() {
+        solver.step();
+    }
+    assert_eq!(solver.steps(), 6);
+    (mesh.clone(), solver.radiosity().to_vec())
+}
+
+fn f32s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+fn u32_at(b: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+/// The checks of the Khronos glTF validator that concern a file like
+/// ours, done offline: the GLB container, buffer and view bounds and
+/// alignment, accessor sizes, POSITION min/max equal to the data, index
+/// range, colour range. Returns the JSON and the binary chunk.
+fn validate_glb(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    assert!(
+        bytes.len() >= 28 && bytes.len().is_multiple_of(4),
+        "GLB length {}",
+        bytes.len()
+    );
+    assert_eq!(&bytes[0..4], b"glTF");
+    assert_eq!(u32_at(bytes, 4), 2, "GLB version");
+    assert_eq!(u32_at(bytes, 8) as usize, bytes.len(), "header length");
+    let json_len = u32_at(bytes, 12) as usize;
+    assert_eq!(&bytes[16..20], b"JSON", "first chunk is JSON");
+    assert_eq!(json_len % 4, 0, "JSON chunk padded to 4 bytes");
+    let json = &bytes[20..20 + json_len];
+    assert!(std::str::from_utf8(json).is_ok(), "JSON chunk is UTF-8");
+    let doc: serde_json::Value = serde_json::from_slice(json).unwrap();
+    let at = 20 + json_len;
+    let bin_len = u32_at(bytes, at) as usize;
+    assert_eq!(&bytes[at + 4..at + 8], b"BIN\0", "second chunk is BIN");
+    assert_eq!(bin_len % 4, 0, "BIN chunk padded to 4 bytes");
+    assert_eq!(at + 8 + bin_len, bytes.len(), "nothing after the BIN chunk");
+    let bin = bytes[at + 8..].to_vec();
+
+    assert_eq!(doc["asset"]["version"], "2.0");
+    let buffers = doc["buffers"].as_array().unwrap();
+    assert_eq!(buffers.len(), 1);
+    assert!(buffers[0].get("uri").is_none(), "GLB buffer has no uri");
+    let buffer_len = buffers[0]["byteLength"].as_u64().unwrap() as usize;
+    assert!(
+        buffer_len <= bin_len && bin_len - buffer_len < 4,
+        "BIN chunk vs buffer"
+    );
+
+    let views = doc["bufferViews"].as_array().unwrap();
+    for (i, v) in views.iter().enumerate() {
+        let offset = v["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let length = v["byteLength"].as_u64().unwrap() as usize;
+        assert!(length > 0, "view {i} is empty");
+        assert_eq!(offset % 4, 0, "view {i} is aligned");
+        assert!(offset + length <= buffer_len, "view {i} fits its buffer");
+        assert!(v.get("byteStride").is_none(), "view {i} is tightly packed");
+    }
+    let accessors = doc["accessors"].as_array().unwrap();
+    let data = |a: &serde_json::Value| -> Vec<u8> {
+        let view = &views[a["bufferView"].as_u64().unwrap() as usize];
+        let offset = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + a["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let components = match a["type"].as_str().unwrap() {
+            "SCALAR" => 1,
+            "VEC3" => 3,
+            t => panic!("unexpected accessor type {t}"),
+        };
+        assert!(matches!(a["componentType"].as_u64(), Some(5126 | 5125)));
+        let len = a["count"].as_u64().unwrap() as usize * components * 4;
+        assert!(a["count"].as_u64().unwrap() >= 1);
+        assert!(
+            a["byteOffset"].as_u64().unwrap_or(0) as usize + len
+                <= view["byteLength"].as_u64().unwrap() as usize,
+            "accessor fits its view"
+        );
+        assert_eq!(offset % 4, 0, "accessor aligned to its component size");
+        bin[offset..offset + len].to_vec()
+    };
+    let primitive = &doc["meshes"][0]["primitives"][0];
+    assert_eq!(primitive["mode"], 4);
+    let attributes = primitive["attributes"].as_object().unwrap();
+    let vertex_count = accessors[attributes["POSITION"].as_u64().unwrap() as usize]["count"]
+        .as_u64()
+        .unwrap();
+    for (name, index) in attributes {
+        let a = &accessors[index.as_u64().unwrap() as usize];
+        assert_eq!(a["count"].as_u64().unwrap(), vertex_count, "{name} count");
+        assert_eq!(a["type"], "VEC3", "{name}");
+        assert_eq!(a["componentType"], 5126, "{name}");
+        let view = &views[a["bufferView"].as_u64().unwrap() as usize];
+        assert_eq!(view["target"], 34962, "{name} view is a vertex buffer");
+        let values = f32s(&data(a));
+        assert!(values.iter().all(|v| v.is_finite()), "{name} finite");
+        if name == "COLOR_0" {
+            assert!(
+                values.iter().all(|v| (0.0..=1.0).contains(v)),
+                "COLOR_0 in [0, 1]"
+            );
+        }
+        if name == "NORMAL" {
+            for n in values.chunks(3) {
+                let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                assert!((len - 1.0).abs() < 5e-4, "NORMAL is unit length");
+            }
+        }
+        if name == "POSITION" {
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for p in values.chunks(3) {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            let read = |key: &str| -> Vec<f32> {
+                a[key]
+                    .as_array()
+                    .unwrap_or_else(|| panic!("POSITION has {key}"))
+                    .iter()
+                    .map(|x| x.as_f64().unwrap() as f32)
+                    .collect()
+            };
+            assert_eq!(read("min"), lo.to_vec(), "POSITION min equals the data");
+            assert_eq!(read("max"), hi.to_vec(), "POSITION max equals the data");
+        }
+    }
+    let indices = &accessors[primitive["indices"].as_u64().unwrap() as usize];
+    assert_eq!(indices["componentType"], 5125);
+    assert_eq!(indices["type"], "SCALAR");
+    assert_eq!(indices["count"].as_u64().unwrap() % 3, 0);
+    let view = &views[indices["bufferView"].as_u64().unwrap() as usize];
+    assert_eq!(view["target"], 34963, "index view is an element buffer");
+    let idx = data(indices);
+    assert!(idx
+        .chunks_exact(4)
+        .all(|c| (u32::from_le_bytes(c.try_into().unwrap()) as u64) < vertex_count));
+    (doc, bin)
+}
+
+#[test]
+fn glb_reads_back_bit_for_bit() {
+    let (mesh, radiosity) = solved_cornell();
+    let exposure = 0.37;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cornell.glb");
+    write_mesh(&path, &mesh, &radiosity, exposure).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    validate_glb(&bytes);
+
+    // Read with an independent glTF reader (which validates the JSON).
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+    let blob = gltf.blob.as_deref().unwrap();
+    let doc = &gltf.document;
+    assert_eq!(doc.meshes().count(), 1);
+    assert_eq!(doc.scenes().count(), 1);
+    assert!(doc.extensions_used().any(|e| e == "KHR_materials_unlit"));
+    let primitive = doc.meshes().next().unwrap().primitives().next().unwrap();
+    assert!(primitive.material().unlit());
+    assert_eq!(primitive.mode(), gltf::mesh::Mode::Triangles);
+    let reader = primitive.reader(|_| Some(blob));
+
+    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    let expected: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
+    assert_eq!(bits(&positions), bits(&expected));
+
+    let colors: Vec<[f32; 3]> = reader.read_colors(0).unwrap().into_rgb_f32().collect();
+    let expected: Vec<[f32; 3]> = radiosity
+        .iter()
+        .map(|r| r.to_f32().map(|v| (v * exposure).clamp(0.0, 1.0)))
+        .collect();
+    assert_eq!(bits(&colors), bits(&expected));
+
+    let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
+    let expected: Vec<[f32; 3]> = mesh
+        .vertex_polygon
+        .iter()
+        .map(|p| mesh.polygons[p.index()].normal.to_array())
+        .collect();
+    assert_eq!(bits(&normals), bits(&expected));
+
+    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+    let expected: Vec<u32> = mesh
+        .elements
+        .iter()
+        .flat_map(|e| e.triangles())
+        .flatten()
+        .map(|v| v.0)
+        .collect();
+    assert_eq!(indices, expected);
+
+    // The custom attribute, read through its accessor and view.
+    let accessor = primitive
+        .get(&gltf::Semantic::Extras(
+            RADIOSITY_ATTRIBUTE.trim_start_matches('_').to_string(),
+        ))
+        .unwrap();
+    assert_eq!(accessor.data_type(), gltf::accessor::DataType::F32);
+    assert_eq!(accessor.dimensions(), gltf::accessor::Dimensions::Vec3);
+    let view = accessor.view().unwrap();
+    let start = view.offset() + accessor.offset();
+    let values = f32s(&blob[start..start + accessor.count() * 12]);
+    let expected: Vec<f32> = radiosity.iter().flat_map(|r| r.to_f32()).collect();
+    assert_eq!(bits1(&values), bits1(&expected));
+}
+
+fn bits(v: &[[f32; 3]]) -> Vec<[u32; 3]> {
+    v.iter().map(|a| a.map(f32::to_bits)).collect()
+}
+
+fn bits1(v: &[f32]) -> Vec<u32> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// A PLY file as read by [`read_ply`].
+struct Ply {
+    vertex_properties: Vec<(String, String)>,
+    vertices: Vec<Vec<u8>>,
+    faces: Vec<Vec<u32>>,
+}
+
+/// A small reader for binary little-endian PLY files, independent of the
+/// writer: it follows the header's declarations.
+fn read_ply(bytes: &[u8]) -> Ply {
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .expect("end_header")
+        + 11;
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    let mut lines = header.lines();
+    assert_eq!(lines.next(), Some("ply"));
+    assert_eq!(lines.next(), Some("format binary_little_endian 1.0"));
+    let size = |t: &str| match t {
+        "char" | "uchar" | "int8" | "uint8" => 1,
+        "short" | "ushort" | "int16" | "uint16" => 2,
+        "int" | "uint" | "float" | "int32" | "uint32" | "float32" => 4,
+        "double" | "float64" => 8,
+        t => panic!("unknown PLY type {t}"),
+    };
+    let mut elements: Vec<(String, usize, Vec<Vec<String>>)> = Vec::new();
+    for line in lines {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w[0] {
+            "comment" | "end_header" => {}
+            "element" => elements.push((w[1].into(), w[2].parse().unwrap(), Vec::new())),
+            "property" => elements
+                .last_mut()
+                .unwrap()
+                .2
+                .push(w[1..].iter().map(|s| s.to_string()).collect()),
+            other => panic!("unexpected header line {other}"),
+        }
+    }
+    let mut at = end;
+    let mut ply = Ply {
+        vertex_properties: Vec::new(),
+        vertices: Vec::new(),
+        faces: Vec::new(),
+    };
+    for (name, count, props) in &elements {
+        for _ in 0..*count {
+            if name == "vertex" {
+                let len: usize = props.iter().map(|p| size(&p[0])).sum();
+                ply.vertices.push(bytes[at..at + len].to_vec());
+                at += len;
+            } else {
+                assert_eq!(name, "face");
+                assert_eq!(props[0][..4], ["list", "uchar", "uint", "vertex_indices"]);
+                let n = bytes[at] as usize;
+                at += 1;
+                ply.faces
+                    .push((0..n).map(|k| u32_at(bytes, at + 4 * k)).collect());
+                at += 4 * n;
+            }
+        }
+        if name == "vertex" {
+            ply.vertex_properties = props.iter().map(|p| (p[0].clone(), p[1].clone())).collect();
+        }
+    }
+    assert_eq!(at, bytes.len(), "no bytes after the last element");
+    ply
+}
+
+#[test]
+fn ply_reads_back_bit_for_bit() {
+    let (mesh, radiosity) = solved_cornell();
+    let exposure = 0.37;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cornell.ply");
+    write_mesh(&path, &mesh, &radiosity, exposure).unwrap();
+    let ply = read_ply(&std::fs::read(&path).unwrap());
+    let names: Vec<String> = ply
+        .vertex_properties
+        .iter()
+        .map(|(t, n)| format!("{t} {n}"))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "float x",
+            "float y",
+            "float z",
+            "float radiosity_r",
+            "float radiosity_g",
+            "float radiosity_b",
+            "uchar red",
+            "uchar green",
+            "uchar blue"
+        ]
+    );
+    assert_eq!(ply.vertices.len(), mesh.vertex_count());
+    for (i, v) in ply.vertices.iter().enumerate() {
+        let f = f32s(&v[..24]);
+        assert_eq!(
+            bits1(&f[..3]),
+            bits1(&mesh.positions[i].to_array()),
+            "vertex {i}"
+        );
+        assert_eq!(bits1(&f[3..6]), bits1(&radiosity[i].to_f32()), "vertex {i}");
+        let rgb = radiosity[i].to_f32().map(|c| srgb8(c, exposure));
+        assert_eq!(v[24..27], rgb, "vertex {i}");
+    }
+    let faces: Vec<Vec<u32>> = mesh
+        .elements
+        .iter()
+        .map(|e| e.corners().iter().map(|c| c.0).collect())
+        .collect();
+    assert_eq!(ply.faces, faces);
+}
+
+#[test]
+fn obj_scene_runs_with_camera_export_log_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    write_cornell_obj(dir.path());
+    // The camera block of cornell.sc, alone in a sidecar file.
+    write(
+        dir.path(),
+        "camera.sc",
+        "camera\n  eye 278 273 -800\n  lookat 278 273 0\n  up 0 1 0\n  fov 39.31\n  size 96 96\nend\n",
+    );
+    let out = run_in(
+        dir.path(),
+        &[
+            "cornell.obj",
+            "--camera",
+            "camera.sc",
+            "--lenmax",
+            "80",
+            "--max-steps",
+            "12",
+            "--export",
+            "cornell.glb",
+            "--log",
+            "steps.csv",
+            "--plot",
+            "convergence.png",
+            "--stats",
+            "stats.json",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        listing(dir.path()),
+        [
+            "camera.sc",
+            "convergence.png",
+            "cornell.glb",
+            "cornell.mtl",
+            "cornell.obj",
+            "cornell.png",
+            "stats.json",
+            "steps.csv"
+        ]
+    );
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
+            .unwrap();
+    let steps = stats["steps"].as_u64().unwrap();
+    assert_eq!(steps, 12);
+    let picture = image::open(dir.path().join("cornell.png")).unwrap();
+    assert_eq!(
+        (picture.width(), picture.height()),
+        (96, 96),
+        "camera from camera.sc"
+    );
+
+    // CSV: the header and one well-formed row per step.
+    let csv = std::fs::read_to_string(dir.path().join("steps.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(LOG_HEADER));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len() as u64, steps);
+    let columns = LOG_HEADER.split(',').count();
+    for (i, r) in rows.iter().enumerate() {
+        assert_eq!(r.len(), columns);
+        assert_eq!(r[0], (i + 1) as f64, "step column");
+        assert!(
+            r[1] >= 0.0 && r[1] < 18.0 && r[1].fract() == 0.0,
+            "shooter index"
+        );
+        assert!(r[2] >= 1.0, "shooter line");
+        assert!(r[3] > 0.0, "shot power");
+        assert!(r[4] > 0.0 && r[4] < 1.0, "unshot fraction");
+        assert!(r[5] > 0.0, "rays");
+        assert!(r[6] > 0.0, "seconds");
+        if i > 0 {
+            assert!(r[6] >= rows[i - 1][6], "seconds grow");
+        }
+    }
+    // The light shoots first: polygon 1, its face on line 21 of the OBJ.
+    assert_eq!((rows[0][1], rows[0][2]), (1.0, 21.0));
+    let last = rows.last().unwrap();
+    assert_eq!(last[4], stats["unshot_fraction"].as_f64().unwrap());
+
+    let plot = image::open(dir.path().join("convergence.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(plot.dimensions(), PLOT_SIZE);
+    assert!(
+        plot.pixels().filter(|p| p.0 == [0, 0, 255]).count() > 200,
+        "curve drawn"
+    );
+
+    validate_glb(&std::fs::read(dir.path().join("cornell.glb")).unwrap());
+}
+
+#[test]
+fn batch_outputs_are_checked_before_solving() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    let cornell = cornell.to_str().unwrap();
+    for (args, message) in [
+        (
+            vec!["--export", "mesh.obj"],
+            "supported mesh formats are .glb, .ply",
+        ),
+        (vec!["--export", "nowhere/mesh.glb"], "does not exist"),
+        (vec!["--plot", "plot.exr"], "a plot is an 8-bit picture"),
+        (
+            vec!["--log", "same.csv", "--stats", "same.csv"],
+            "two outputs",
+        ),
+        (
+            vec!["--camera", "missing.sc"],
+            "missing.sc:1:1: error: cannot read file",
+        ),
+    ] {
+        let mut all = vec![cornell, "-o", "x.png", "-q"];
+        all.extend(args.iter().copied());
+        let out = run_in(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(message), "{args:?}: {}", stderr(&out));
+        assert!(listing(dir.path()).is_empty(), "{args:?} wrote files");
+    }
+}
+
+#[test]
+fn bad_obj_files_are_refused_with_positions() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "bad.mtl", "newmtl shiny\nKd 1.2 0.5 0.5\n");
+    write(
+        dir.path(),
+        "bad.obj",
+        "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\nusemtl shiny\nf 1 2 3\n",
+    );
+    let out = run_in(dir.path(), &["bad.obj", "-o", "bad.png"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    for expected in [
+        "bad.mtl:2:1: error: reflectance `Kd` is 1.2 in the red channel; every channel must be below 1",
+        "bad.obj:6:1: error: degenerate face: polygon has zero area",
+    ] {
+        assert!(err.contains(expected), "missing {expected:?} in:\n{err}");
+    }
+    assert_eq!(listing(dir.path()), ["bad.mtl", "bad.obj"]);
+}
+
+#[test]
+fn help_documents_the_model_options() {
+    let out = run_in(&common::root(), &["--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for option in ["--camera", "--export", "--log", "--plot", ".obj"] {
+        assert!(help.contains(option), "--help lacks {option}");
+    }
+}
