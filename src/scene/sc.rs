@@ -989,7 +989,7 @@ impl<'a> Parser<'a> {
             return;
         }
         let e = color * k_emission;
-        if !(e.max_channel() <= MAX_EMISSION) {
+        if !e.is_finite() || e.max_channel() > MAX_EMISSION {
             self.error(
                 emission_pos,
                 format!(
@@ -1109,7 +1109,7 @@ impl<'a> Parser<'a> {
         // into an infinite one with a less helpful message.
         if let Some(i) = world64
             .iter()
-            .position(|v| !(v.abs().max_element() <= MAX_COORDINATE))
+            .position(|v| !v.is_finite() || v.abs().max_element() > MAX_COORDINATE)
         {
             let e = if world64[i].is_finite() {
                 PolygonError::TooFar {
@@ -1792,7 +1792,9 @@ end
             "1:12: number `1e999` is out of range (it overflows to infinity)"
         );
         assert_eq!(
-            first_error(&format!("{WHITE}polygon white vertex 1e39 0 0 vertex 1 0 0 vertex 0 1 0 end")),
+            first_error(&format!(
+                "{WHITE}polygon white vertex 1e39 0 0 vertex 1 0 0 vertex 0 1 0 end"
+            )),
             "2:22: number `1e39` is too large for a coordinate (at most 1e12 in magnitude)"
         );
     }
