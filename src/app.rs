@@ -4,22 +4,61 @@
 //! (`--plot`).
 //!
 //! The command-line front end turns its arguments into a [`RunConfig`] and
-//! calls [`run`]; nothing here reads `argv`. A future window drives the
+//! calls [`run`] (or [`run_cancellable`] with its Ctrl-C flag); nothing
+//! here reads `argv` or installs signal handlers. The window drives the
 //! same solver and renderer.
+//!
+//! **Limits.** Before meshing, [`prepare`] computes the exact element and
+//! vertex counts ([`mesh::estimate`]) and an estimate of the memory they
+//! need ([`memory_estimate`]), and refuses a mesh over
+//! [`RunConfig::max_elements`] with the `lenmax` that would fit.
+//!
+//! **Interruption and checkpoints.** A cancellable run checks its flag
+//! during every shooting step, before rendering and before each write; once
+//! it is set, nothing more is written except the checkpoint (when asked
+//! for), and the run ends with [`RunError::Interrupted`]. With a checkpoint
+//! path the solver state is saved every [`RunConfig::checkpoint_every`],
+//! on interruption and at the end (see [`checkpoint`]); a resumed run
+//! continues to the same bits an uninterrupted one gives.
 
 use crate::color::Rgb;
-use crate::mesh::{self, Mesh, MeshError, MeshOptions};
+use crate::mesh::{self, Mesh, MeshError, MeshOptions, MeshSize};
 use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, MeshFormat, OutputError, PictureFormat};
 use crate::render::{Exposure, Frame, Rasterizer, RenderError, View, ViewError};
 use crate::scene::{self, LoadError, Scene};
+use crate::solver::checkpoint::{self, CheckpointError};
 use crate::solver::{Progressive, SolverOptions, StepReport, StopReason};
 use crate::visibility::Visibility;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+/// Default for [`RunConfig::max_elements`]: [`mesh::MAX_ELEMENTS`], 20
+/// million elements. A mesh that large needs about 3.7 GB by
+/// [`memory_estimate`]; the bundled scenes at their default `lenmax` have
+/// about 15,000.
+pub const DEFAULT_MAX_ELEMENTS: u64 = mesh::MAX_ELEMENTS;
+
+/// Bytes held per mesh vertex during a batch run, for
+/// [`memory_estimate`]: positions and sample points (24, up to twice that
+/// while the arrays grow), the owning polygon (4), the solver's radiosity
+/// and step scratch (48), the rasterizer's projected vertex (about 32) and
+/// a checkpoint's copy (24). Measured peak memory stays below this estimate:
+/// 639 MB for 4.7 million vertices and elements, estimated 863 MB (see
+/// `docs/reliability.md`).
+pub const BYTES_PER_VERTEX: u64 = 160;
+
+/// Bytes held per mesh element: its corners and owning polygon.
+pub const BYTES_PER_ELEMENT: u64 = 24;
+
+/// Default for [`RunConfig::checkpoint_every`]: one minute, so at most a
+/// minute of work is lost, and writing even a 20-million-vertex state
+/// (about 500 MB) takes a small fraction of the time.
+pub const DEFAULT_CHECKPOINT_EVERY: Duration = Duration::from_secs(60);
 
 /// The bundled default scene, compiled into the binary so it works from
 /// any directory.
@@ -88,6 +127,40 @@ pub struct RunConfig {
     pub plot: Option<PathBuf>,
     /// Show a progress bar (only drawn when stderr is a terminal).
     pub progress: bool,
+    /// Refuse meshes with more elements than this (see
+    /// [`DEFAULT_MAX_ELEMENTS`]); at most [`mesh::MAX_ADDRESSABLE_ELEMENTS`].
+    pub max_elements: u64,
+    /// Where to save the solver state during the solve, if anywhere.
+    pub checkpoint: Option<PathBuf>,
+    /// How often to save the checkpoint (wall clock).
+    pub checkpoint_every: Duration,
+    /// A checkpoint to continue from instead of starting the solve afresh.
+    pub resume: Option<PathBuf>,
+}
+
+impl RunConfig {
+    /// The configuration with every option at its default, for `scene`.
+    pub fn new(scene: SceneSource) -> RunConfig {
+        RunConfig {
+            scene,
+            output: None,
+            lenmax: None,
+            inset: mesh::DEFAULT_INSET,
+            solver: SolverOptions::default(),
+            size: None,
+            exposure: Exposure::Auto,
+            stats: None,
+            progress: false,
+            camera: None,
+            export: None,
+            log: None,
+            plot: None,
+            max_elements: DEFAULT_MAX_ELEMENTS,
+            checkpoint: None,
+            checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
+            resume: None,
+        }
+    }
 }
 
 impl RunConfig {
@@ -99,9 +172,15 @@ impl RunConfig {
 
     /// Every file the batch run writes besides the picture.
     fn extra_outputs(&self) -> impl Iterator<Item = &PathBuf> {
-        [&self.stats, &self.export, &self.log, &self.plot]
-            .into_iter()
-            .flatten()
+        [
+            &self.stats,
+            &self.export,
+            &self.log,
+            &self.plot,
+            &self.checkpoint,
+        ]
+        .into_iter()
+        .flatten()
     }
 }
 
@@ -114,6 +193,54 @@ pub enum RunError {
     /// The mesh options do not suit the scene.
     #[error("{0}")]
     Mesh(#[from] MeshError),
+    /// The mesh would have more elements than allowed.
+    #[error(
+        "lenmax {lenmax} would make {} elements and {} vertices, about {} of memory; \
+         --max-elements allows {}: {}",
+        size.elements,
+        size.vertices,
+        fmt_bytes(*bytes),
+        max,
+        match suggested {
+            Some(l) => format!("use --lenmax {l} or larger (or raise --max-elements)"),
+            None => "the scene has more polygons than that even unsubdivided".to_string(),
+        }
+    )]
+    MeshTooLarge {
+        /// The lenmax asked for, in scene units.
+        lenmax: f32,
+        /// The mesh it would make.
+        size: MeshSize,
+        /// Its estimated memory, in bytes ([`memory_estimate`]).
+        bytes: u64,
+        /// The element limit.
+        max: u64,
+        /// The smallest lenmax (to three significant digits) that fits, if
+        /// any does.
+        suggested: Option<f32>,
+    },
+    /// The checkpoint to resume from is unusable, or saving one failed.
+    #[error("{0}")]
+    Checkpoint(#[from] CheckpointError),
+    /// Ctrl-C (or the caller's flag) stopped the run; no picture or stats
+    /// were written.
+    #[error(
+        "interrupted after {steps} steps; nothing was written{}",
+        match checkpoint {
+            Some(p) => format!(
+                " but the checkpoint {}: resume with --resume {}",
+                p.display(),
+                p.display()
+            ),
+            None => String::new(),
+        }
+    )]
+    Interrupted {
+        /// Shooting steps completed.
+        steps: u64,
+        /// The checkpoint saved on the way out, if one was asked for.
+        checkpoint: Option<PathBuf>,
+    },
     /// The camera or picture size is unusable.
     #[error("{0}")]
     View(#[from] ViewError),
@@ -132,7 +259,23 @@ impl RunError {
     /// True when the user's input or options are at fault (exit code 2),
     /// false for failures of the machine (exit code 1).
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, RunError::Render(_) | RunError::Write(_))
+        !matches!(
+            self,
+            RunError::Render(_)
+                | RunError::Write(_)
+                | RunError::Interrupted { .. }
+                | RunError::Checkpoint(CheckpointError::Write(_))
+        )
+    }
+
+    /// The process exit code for this error: 130 interrupted, 2 bad input
+    /// or usage, 1 a failure of the machine.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            RunError::Interrupted { .. } => 130,
+            e if e.is_bad_input() => 2,
+            _ => 1,
+        }
     }
 }
 
@@ -227,7 +370,8 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, RunError> {
     if let Some(lenmax) = config.lenmax {
         mesh_options.lenmax = lenmax;
     }
-    let mesh = mesh::build(&scene, &mesh_options)?;
+    check_mesh_size(&scene, &mesh_options, config.max_elements)?;
+    let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
     seconds.mesh = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -242,6 +386,84 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, RunError> {
     })
 }
 
+/// Estimated peak memory of a batch run with a mesh of this size, in bytes:
+/// [`BYTES_PER_VERTEX`] per vertex and [`BYTES_PER_ELEMENT`] per element.
+pub fn memory_estimate(size: MeshSize) -> u64 {
+    size.vertices
+        .saturating_mul(BYTES_PER_VERTEX)
+        .saturating_add(size.elements.saturating_mul(BYTES_PER_ELEMENT))
+}
+
+/// Refuses, before anything is allocated, a mesh with more than
+/// `max_elements` elements, saying how much memory it would take and which
+/// lenmax would fit.
+pub fn check_mesh_size(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+) -> Result<MeshSize, RunError> {
+    let max = max_elements.min(mesh::MAX_ADDRESSABLE_ELEMENTS);
+    let size = mesh::estimate(scene, options)?;
+    if size.elements <= max {
+        return Ok(size);
+    }
+    Err(RunError::MeshTooLarge {
+        lenmax: options.lenmax,
+        size,
+        bytes: memory_estimate(size),
+        max,
+        suggested: lenmax_to_fit(scene, options, max),
+    })
+}
+
+/// The smallest lenmax, rounded up to three significant digits, whose mesh
+/// has at most `max_elements` elements; `None` when even one element per
+/// polygon is too many.
+pub fn lenmax_to_fit(scene: &Scene, options: &MeshOptions, max_elements: u64) -> Option<f32> {
+    let fits = |lenmax: f32| {
+        let o = MeshOptions { lenmax, ..*options };
+        mesh::estimate(scene, &o).is_ok_and(|s| s.elements <= max_elements)
+    };
+    // Longer than every polygon: one element per triangle or quad, a fan
+    // per larger polygon.
+    let mut hi = (scene.extent() * 2.0)
+        .max(options.lenmax)
+        .max(f32::MIN_POSITIVE);
+    if !fits(hi) {
+        return None;
+    }
+    let mut lo = options.lenmax;
+    // Bisection in log scale; the count only falls as lenmax grows.
+    for _ in 0..60 {
+        let mid = (lo * hi).sqrt();
+        if !(mid > lo && mid < hi) {
+            break;
+        }
+        if fits(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    // Round up to three significant digits for the message, keeping a
+    // value that still fits.
+    let digits = 10f64.powf((hi as f64).log10().floor() - 2.0);
+    let rounded = ((hi as f64 / digits).ceil() * digits) as f32;
+    Some(if fits(rounded) { rounded } else { hi })
+}
+
+/// `bytes` as `1.5 GB`, `320 MB`, `12 kB`.
+fn fmt_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else if b >= 1e6 {
+        format!("{:.0} MB", b / 1e6)
+    } else {
+        format!("{:.0} kB", (b / 1e3).ceil())
+    }
+}
+
 /// The picture path a batch run writes: `-o`, or `<scene-stem>.png` in
 /// the current directory.
 pub fn output_path(config: &RunConfig) -> PathBuf {
@@ -253,7 +475,8 @@ pub fn output_path(config: &RunConfig) -> PathBuf {
 
 /// Refuses unusable outputs before any time is spent solving: an unknown
 /// extension, a missing directory, a path that is an input (the scene, its
-/// camera file), or two outputs that are the same file.
+/// camera file, hard or symbolic links to them), two outputs that are the
+/// same file, or a checkpoint to resume from that cannot be read.
 pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     let output = output_path(config);
     PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
@@ -266,35 +489,52 @@ pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     let outputs: Vec<&PathBuf> = std::iter::once(&output)
         .chain(config.extra_outputs())
         .collect();
-    for out in &outputs {
-        output::check_destination(out).map_err(RunError::BadOutput)?;
-    }
-    for (i, a) in outputs.iter().enumerate() {
-        if outputs[..i].iter().any(|b| a == b || same_file(a, b)) {
-            return Err(RunError::BadOutput(OutputError::Io {
-                path: a.to_path_buf(),
-                error: std::io::Error::new(
-                    std::io::ErrorKind::InvalidInput,
-                    "two outputs would be written to this same file",
-                ),
-            }));
-        }
-    }
+    let refuse = |path: &Path, why: &str| {
+        RunError::BadOutput(OutputError::Io {
+            path: path.to_path_buf(),
+            error: std::io::Error::new(std::io::ErrorKind::InvalidInput, why.to_string()),
+        })
+    };
     let inputs = match &config.scene {
         SceneSource::File(input) => Some(input),
         SceneSource::Bundled => None,
     };
-    for input in inputs.into_iter().chain(config.camera.as_ref()) {
-        for out in &outputs {
-            if same_file(input, out) {
-                return Err(RunError::BadOutput(OutputError::Io {
-                    path: out.to_path_buf(),
-                    error: std::io::Error::new(
-                        std::io::ErrorKind::InvalidInput,
-                        "refusing to overwrite an input file",
-                    ),
-                }));
+    for (k, out) in outputs.iter().enumerate() {
+        output::check_destination(out).map_err(RunError::BadOutput)?;
+        if inputs.is_some_and(|input| same_file(input, out)) {
+            return Err(refuse(
+                out,
+                "refusing to overwrite the input scene (an input file)",
+            ));
+        }
+        if config
+            .camera
+            .as_ref()
+            .is_some_and(|camera| same_file(camera, out))
+        {
+            return Err(refuse(
+                out,
+                "refusing to overwrite the camera file (an input file)",
+            ));
+        }
+        if outputs[..k]
+            .iter()
+            .any(|earlier| *earlier == *out || same_file(earlier, out))
+        {
+            return Err(refuse(
+                out,
+                "two outputs would be written to this same file: the picture, --stats, \
+                 --checkpoint, --export, --log and --plot must be different files",
+            ));
+        }
+    }
+    if let Some(resume) = &config.resume {
+        if let Err(error) = std::fs::File::open(resume) {
+            return Err(CheckpointError::Read {
+                path: resume.clone(),
+                error,
             }
+            .into());
         }
     }
     Ok(())
@@ -302,13 +542,29 @@ pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
 
 /// Runs the whole batch pipeline once and writes the picture (and stats).
 pub fn run(config: &RunConfig) -> Result<RunStats, RunError> {
+    run_cancellable(config, &AtomicBool::new(false))
+}
+
+/// [`run`] that stops promptly once `cancel` is set (by a Ctrl-C handler,
+/// say) with [`RunError::Interrupted`], writing nothing but the
+/// checkpoint.
+pub fn run_cancellable(config: &RunConfig, cancel: &AtomicBool) -> Result<RunStats, RunError> {
     check_outputs(config)?;
     let prepared = prepare(config)?;
-    run_prepared(config, &prepared)
+    run_prepared_cancellable(config, &prepared, cancel)
 }
 
 /// The batch run from a prepared scene: solve, render, write.
 pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats, RunError> {
+    run_prepared_cancellable(config, prepared, &AtomicBool::new(false))
+}
+
+/// [`run_prepared`] that stops promptly once `cancel` is set.
+pub fn run_prepared_cancellable(
+    config: &RunConfig,
+    prepared: &Prepared,
+    cancel: &AtomicBool,
+) -> Result<RunStats, RunError> {
     check_outputs(config)?;
     let output = output_path(config);
     let mut seconds = prepared.seconds;
@@ -321,16 +577,35 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
         &prepared.visibility,
         config.solver,
     );
-    let steps = solve_with_progress(&mut solver, config.progress);
+    let fingerprint = checkpoint::fingerprint(&prepared.scene, &prepared.mesh, &config.solver);
+    if let Some(path) = &config.resume {
+        checkpoint::resume(path, fingerprint, &mut solver)?;
+    }
+    let plan = config.checkpoint.as_deref().map(|path| CheckpointPlan {
+        path,
+        every: config.checkpoint_every,
+        fingerprint,
+    });
+    let steps = solve_cancellable(&mut solver, config.progress, cancel, plan.as_ref())?;
     seconds.solve = t.elapsed().as_secs_f64();
     solver
         .validate()
         .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
 
+    let interrupted = || RunError::Interrupted {
+        steps: solver.steps(),
+        checkpoint: config.checkpoint.clone(),
+    };
+    if cancel.load(Ordering::SeqCst) {
+        return Err(interrupted());
+    }
     let t = Instant::now();
     let frame = render(&prepared.mesh, solver.radiosity(), &view)?;
     seconds.render = t.elapsed().as_secs_f64();
 
+    if cancel.load(Ordering::SeqCst) {
+        return Err(interrupted());
+    }
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree.
     let exposure = config.exposure.resolve(&frame);
@@ -384,6 +659,11 @@ pub fn run_prepared(config: &RunConfig, prepared: &Prepared) -> Result<RunStats,
     };
     stats.seconds.write = t.elapsed().as_secs_f64();
     if let Some(path) = &config.stats {
+        // The picture is complete and stays; the stats are skipped if the
+        // interrupt came while it was written.
+        if cancel.load(Ordering::SeqCst) {
+            return Err(interrupted());
+        }
         let json = serde_json::to_string_pretty(&stats).map_err(|e| {
             RunError::Write(OutputError::Io {
                 path: path.clone(),
@@ -425,12 +705,33 @@ pub fn render(mesh: &Mesh, radiosity: &[Rgb], view: &View) -> Result<Frame, Rend
     Ok(rasterizer.render(mesh, radiosity, view)?.clone())
 }
 
-/// True when both paths name the same existing file.
+/// True when both paths name the same file: the same path once made
+/// absolute, or (on Unix) the same existing file through another name, a
+/// symbolic or a hard link.
 fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return ma.dev() == mb.dev() && ma.ino() == mb.ino();
+        }
+    }
     match (a.canonicalize(), b.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
-        _ => false,
+        // Neither exists yet: compare the paths as given, made absolute.
+        _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
     }
+}
+
+/// When and where [`solve_cancellable`] saves the solver state.
+#[derive(Clone, Copy, Debug)]
+pub struct CheckpointPlan<'p> {
+    /// The checkpoint file, replaced atomically at each save.
+    pub path: &'p Path,
+    /// Wall-clock time between saves.
+    pub every: Duration,
+    /// The solve's [`checkpoint::fingerprint`].
+    pub fingerprint: u64,
 }
 
 /// Steps the solver until it stops, drawing a progress bar on stderr when
@@ -444,6 +745,37 @@ pub fn solve_with_progress(
     solver: &mut Progressive,
     progress: bool,
 ) -> Vec<(StepReport, Duration)> {
+    // Nothing can fail without a checkpoint or a cancel flag.
+    solve_cancellable(solver, progress, &AtomicBool::new(false), None).unwrap_or_default()
+}
+
+/// [`solve_with_progress`] that stops promptly once `cancel` is set, and
+/// saves checkpoints per `plan`: every `plan.every`, on interruption and
+/// when the solve stops. An interruption leaves the solver as it was after
+/// its last complete step and returns [`RunError::Interrupted`].
+pub fn solve_cancellable(
+    solver: &mut Progressive,
+    progress: bool,
+    cancel: &AtomicBool,
+    plan: Option<&CheckpointPlan>,
+) -> Result<Vec<(StepReport, Duration)>, RunError> {
+    let save = |solver: &Progressive| -> Result<(), RunError> {
+        if let Some(plan) = plan {
+            checkpoint::save(plan.path, plan.fingerprint, solver)
+                .map_err(|e| RunError::Checkpoint(e.into()))?;
+        }
+        Ok(())
+    };
+    let interrupted = |solver: &Progressive| -> RunError {
+        match save(solver) {
+            Ok(()) => RunError::Interrupted {
+                steps: solver.steps(),
+                checkpoint: plan.map(|p| p.path.to_path_buf()),
+            },
+            Err(e) => e,
+        }
+    };
+    let mut last_save = Instant::now();
     let target = if progress && std::io::stderr().is_terminal() {
         ProgressDrawTarget::stderr()
     } else {
@@ -461,9 +793,23 @@ pub fn solve_with_progress(
     let mut rate = RateEstimate::default();
     let mut steps = Vec::new();
     while !solver.is_done() {
-        let Some(report) = solver.step() else {
+        if cancel.load(Ordering::SeqCst) {
+            bar.finish_and_clear();
+            return Err(interrupted(solver));
+        }
+        let Some(report) = solver.step_cancellable(cancel) else {
+            if cancel.load(Ordering::SeqCst) {
+                bar.finish_and_clear();
+                return Err(interrupted(solver));
+            }
             break;
         };
+        if let Some(plan) = plan {
+            if last_save.elapsed() >= plan.every {
+                save(solver)?;
+                last_save = Instant::now();
+            }
+        }
         let elapsed = start.elapsed();
         steps.push((report, elapsed));
         let fraction = report.unshot_fraction.max(f64::MIN_POSITIVE);
@@ -485,7 +831,8 @@ pub fn solve_with_progress(
         ));
     }
     bar.finish_and_clear();
-    steps
+    save(solver)?;
+    Ok(steps)
 }
 
 /// The rate at which `log(1 / unshot fraction)` grows, over a sliding

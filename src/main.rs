@@ -1,6 +1,7 @@
 //! `radiosity`: the command-line front end. Parses arguments, validates
 //! them into a [`RunConfig`], runs the pipeline and maps the outcome to an
-//! exit code: 0 success, 1 a failure writing results, 2 bad input or usage.
+//! exit code: 0 success, 1 a failure writing results, 2 bad input or usage,
+//! 130 interrupted (Ctrl-C).
 
 use clap::Parser;
 use radiosity::app::{self, RunConfig, SceneSource};
@@ -12,6 +13,11 @@ use radiosity::solver::{
 use radiosity::viewer;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// Set by the Ctrl-C handler; batch runs poll it.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// Progressive-refinement radiosity renderer (ray-traced form factors after
 /// Wallace, Elmquist and Haines 1989).
@@ -121,13 +127,36 @@ struct Args {
     #[arg(long)]
     no_window: bool,
 
+    /// Refuse meshes with more elements than this, before building them;
+    /// the message says which --lenmax fits. The default allows meshes of
+    /// up to about 3.7 GB (estimated; 2.7 GB measured).
+    #[arg(long, value_name = "N", default_value_t = app::DEFAULT_MAX_ELEMENTS)]
+    max_elements: u64,
+
+    /// Save the solver state to this file every --checkpoint-every seconds,
+    /// on Ctrl-C and at the end, so an interrupted solve can be resumed.
+    /// Implies a batch run (no window).
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+
+    /// Seconds between checkpoints.
+    #[arg(long, value_name = "SECS", default_value_t = app::DEFAULT_CHECKPOINT_EVERY.as_secs_f64())]
+    checkpoint_every: f64,
+
+    /// Continue the solve saved in this checkpoint (same scene and mesh and
+    /// form-factor options) to the same result as an uninterrupted run.
+    /// Implies a batch run (no window).
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
+
     /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
 }
 
 const EXIT_CODES: &str =
-    "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage.";
+    "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage, \
+     130 interrupted (Ctrl-C; nothing is written but the --checkpoint).";
 
 /// A usage error found while validating arguments.
 fn usage(message: String) -> ExitCode {
@@ -186,6 +215,19 @@ fn config(args: &Args) -> Result<RunConfig, String> {
             }
         }
     };
+    if args.max_elements == 0 || args.max_elements > radiosity::mesh::MAX_ADDRESSABLE_ELEMENTS {
+        return Err(format!(
+            "--max-elements must be between 1 and {}, got {}",
+            radiosity::mesh::MAX_ADDRESSABLE_ELEMENTS,
+            args.max_elements
+        ));
+    }
+    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
+        return Err(format!(
+            "--checkpoint-every must be a number of seconds >= 0, got {}",
+            args.checkpoint_every
+        ));
+    }
     let exposure = match args.exposure {
         None => Exposure::Auto,
         Some(x) if x.is_finite() && x > 0.0 => Exposure::Fixed(x),
@@ -215,6 +257,10 @@ fn config(args: &Args) -> Result<RunConfig, String> {
         log: args.log.clone(),
         plot: args.plot.clone(),
         progress: !args.quiet,
+        max_elements: args.max_elements,
+        checkpoint: args.checkpoint.clone(),
+        checkpoint_every: Duration::from_secs_f64(args.checkpoint_every.min(1e9)),
+        resume: args.resume.clone(),
     })
 }
 
@@ -236,10 +282,16 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    let result = if args.output.is_none() && !args.no_window && !config.wants_batch_outputs() {
-        run_window_or_fallback(&config, args.quiet)
+    let batch = args.output.is_some()
+        || args.no_window
+        || config.wants_batch_outputs()
+        || config.checkpoint.is_some()
+        || config.resume.is_some();
+    let result = if batch {
+        catch_ctrl_c();
+        app::run_cancellable(&config, &INTERRUPTED).map(Some)
     } else {
-        app::run(&config).map(Some)
+        run_window_or_fallback(&config, args.quiet)
     };
     match result {
         Ok(None) => ExitCode::SUCCESS,
@@ -251,12 +303,15 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             // Load errors already read `FILE:LINE:COL: error: ...`.
-            if matches!(e, app::RunError::Load(_)) {
+            if matches!(
+                e,
+                app::RunError::Load(_) | app::RunError::Interrupted { .. }
+            ) {
                 eprintln!("{e}");
             } else {
                 eprintln!("error: {e}");
             }
-            ExitCode::from(if e.is_bad_input() { 2 } else { 1 })
+            ExitCode::from(e.exit_code())
         }
     }
 }
@@ -278,16 +333,36 @@ fn run_window_or_fallback(
     if let Err(why) = viewer::display_available() {
         app::check_outputs(config)?;
         fallback(&why);
-        return app::run(config).map(Some);
+        catch_ctrl_c();
+        return app::run_cancellable(config, &INTERRUPTED).map(Some);
     }
     let prepared = app::prepare(config)?;
     match viewer::run(&prepared, config) {
         Ok(()) => Ok(None),
         Err(viewer::ViewerError::CannotOpen(why)) => {
             fallback(&why);
-            app::run_prepared(config, &prepared).map(Some)
+            catch_ctrl_c();
+            app::run_prepared_cancellable(config, &prepared, &INTERRUPTED).map(Some)
         }
         Err(viewer::ViewerError::View(e)) => Err(app::RunError::View(e)),
         Err(viewer::ViewerError::Render(e)) => Err(app::RunError::Render(e)),
+    }
+}
+
+/// Makes Ctrl-C (SIGINT, and SIGTERM) stop a batch run cleanly: the first
+/// sets [`INTERRUPTED`], which the run polls during every step and before
+/// every write; a second exits at once with 130. Only batch runs install
+/// it: the window quits with its own keys, and a Ctrl-C in its terminal
+/// ends it the ordinary way.
+fn catch_ctrl_c() {
+    let installed = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            eprintln!("interrupted again: exiting now");
+            std::process::exit(130);
+        }
+        eprintln!("interrupted: stopping (Ctrl-C again to exit at once)");
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: cannot catch Ctrl-C ({e}); an interrupt will end the run abruptly");
     }
 }

@@ -47,6 +47,11 @@ pub const DEFAULT_LENMAX_FRACTION: f32 = 1.0 / 80.0;
 /// solver's arrays; asking for more is almost always a `lenmax` typo.
 pub const MAX_ELEMENTS: u64 = 20_000_000;
 
+/// The most elements any limit allows: vertex and element indices are
+/// `u32`, and a mesh has at most about twice as many vertices as elements
+/// (a strip of `n` elements has `2n + 2`).
+pub const MAX_ADDRESSABLE_ELEMENTS: u64 = u32::MAX as u64 / 4;
+
 /// A vertex counts as lying on a polygon edge when it is closer to the
 /// edge's line than this fraction of the polygon's extent.
 const ON_EDGE_TOLERANCE: f32 = 1e-5;
@@ -208,27 +213,74 @@ pub enum MeshError {
     },
 }
 
-/// Builds the element mesh of every polygon of `scene`.
+/// Element and vertex counts of a mesh, known before it is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshSize {
+    /// Elements the mesh will have.
+    pub elements: u64,
+    /// Element vertices the mesh will have.
+    pub vertices: u64,
+}
+
+/// The exact element and vertex counts [`build`] would produce, computed
+/// from the subdivision counts alone (no allocation per element), so that
+/// a driver can refuse a mesh too large for memory before building it.
+pub fn estimate(scene: &Scene, options: &MeshOptions) -> Result<MeshSize, MeshError> {
+    check_options(options)?;
+    let mut size = MeshSize {
+        elements: 0,
+        vertices: 0,
+    };
+    for p in &scene.polygons {
+        let plan = Plan::new(p, options.lenmax);
+        size.elements = size.elements.saturating_add(plan.element_count());
+        size.vertices = size.vertices.saturating_add(plan.vertex_count());
+    }
+    Ok(size)
+}
+
+/// Builds the element mesh of every polygon of `scene`, refusing more than
+/// [`MAX_ELEMENTS`] elements.
 pub fn build(scene: &Scene, options: &MeshOptions) -> Result<Mesh, MeshError> {
+    build_with_limit(scene, options, MAX_ELEMENTS)
+}
+
+fn check_options(options: &MeshOptions) -> Result<(), MeshError> {
     if !(options.lenmax.is_finite() && options.lenmax > 0.0) {
         return Err(MeshError::BadLenmax(options.lenmax));
     }
     if !(options.inset.is_finite() && (0.0..0.5).contains(&options.inset)) {
         return Err(MeshError::BadInset(options.inset));
     }
+    Ok(())
+}
+
+/// [`build`] with another element limit, itself capped at
+/// [`MAX_ADDRESSABLE_ELEMENTS`].
+pub fn build_with_limit(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+) -> Result<Mesh, MeshError> {
+    let max_elements = max_elements.min(MAX_ADDRESSABLE_ELEMENTS);
+    check_options(options)?;
     let plans: Vec<Plan> = scene
         .polygons
         .iter()
         .map(|p| Plan::new(p, options.lenmax))
         .collect();
-    let elements: u64 = plans.iter().map(Plan::element_count).sum();
-    if elements > MAX_ELEMENTS {
+    // Saturating: absurd subdivision counts must reach the limit check,
+    // not overflow on the way.
+    let elements = plans
+        .iter()
+        .fold(0u64, |sum, p| sum.saturating_add(p.element_count()));
+    if elements > max_elements {
         // Element count scales with 1/lenmax², so this factor brings it under.
-        let factor = (elements as f64 / MAX_ELEMENTS as f64).sqrt() as f32 * 1.05;
+        let factor = (elements as f64 / max_elements as f64).sqrt() as f32 * 1.05;
         return Err(MeshError::TooManyElements {
             lenmax: options.lenmax,
             elements,
-            max: MAX_ELEMENTS,
+            max: max_elements,
             suggested: options.lenmax * factor,
         });
     }
@@ -358,7 +410,23 @@ impl Plan {
                 *nu as u64 * *nv as u64
             }
             Plan::Triangle { n, .. } => *n as u64 * *n as u64,
-            Plan::Fan { rim, n, .. } => rim.len() as u64 * *n as u64 * *n as u64,
+            Plan::Fan { rim, n, .. } => (rim.len() as u64).saturating_mul(*n as u64 * *n as u64),
+        }
+    }
+
+    fn vertex_count(&self) -> u64 {
+        match self {
+            Plan::Parallelogram { nu, nv, .. } | Plan::Bilinear { nu, nv, .. } => {
+                (*nu as u64 + 1) * (*nv as u64 + 1)
+            }
+            Plan::Triangle { n, .. } => (*n as u64 + 1) * (*n as u64 + 2) / 2,
+            // The apex, each spoke's points past the apex, and each fan
+            // triangle's points off both of its spokes.
+            Plan::Fan { rim, n, .. } => {
+                let (m, n) = (rim.len() as u64, *n as u64);
+                let inner = n * n.saturating_sub(1) / 2;
+                (m.saturating_mul(n + inner)).saturating_add(1)
+            }
         }
     }
 

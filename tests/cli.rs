@@ -222,6 +222,11 @@ fn help_documents_every_option() {
         "--exposure",
         "--stats",
         "--threads",
+        "--max-elements",
+        "--checkpoint",
+        "--checkpoint-every",
+        "--resume",
+        "130 interrupted",
     ] {
         assert!(help.contains(option), "--help lacks {option}");
     }

@@ -41,6 +41,22 @@ pub const DEFAULT_NEAR_FRACTION: f32 = 1e-3;
 /// exact integer edge tests cannot overflow.
 pub const MAX_PICTURE_SIDE: u32 = 1 << 16;
 
+/// The most pixels a picture may have: 2^26 = 67,108,864 (8192 × 8192).
+///
+/// Rendering and writing a picture hold about 45 bytes per pixel at once
+/// (the linear frame, coverage, the z-buffer, luminances for the automatic
+/// exposure, the encoded copy), so this bounds a picture's memory near
+/// 3 GB; a larger request is almost always a typo.
+pub const MAX_PICTURE_PIXELS: u64 = 1 << 26;
+
+/// Whether a picture of `width × height` pixels is within
+/// [`MAX_PICTURE_SIDE`] and [`MAX_PICTURE_PIXELS`] (and not empty).
+pub fn picture_size_ok(width: u32, height: u32) -> bool {
+    (1..=MAX_PICTURE_SIDE).contains(&width)
+        && (1..=MAX_PICTURE_SIDE).contains(&height)
+        && width as u64 * height as u64 <= MAX_PICTURE_PIXELS
+}
+
 /// Why a [`Camera`] does not make a usable [`View`].
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum ViewError {
@@ -56,8 +72,12 @@ pub enum ViewError {
     /// The vertical field of view is not in `(0, pi)` radians.
     #[error("the vertical field of view {0} rad is not strictly between 0 and pi")]
     FovOutOfRange(f32),
-    /// A picture side is zero or larger than [`MAX_PICTURE_SIDE`].
-    #[error("picture size {width}x{height} is not between 1 and {MAX_PICTURE_SIDE} pixels a side")]
+    /// A picture side is zero or larger than [`MAX_PICTURE_SIDE`], or the
+    /// picture has more than [`MAX_PICTURE_PIXELS`] pixels.
+    #[error(
+        "picture size {width}x{height} is too large or empty: each side must be between 1 and \
+         {MAX_PICTURE_SIDE} pixels and the picture at most {MAX_PICTURE_PIXELS} pixels (8192x8192)"
+    )]
     BadSize {
         /// Requested width in pixels.
         width: u32,
@@ -75,7 +95,8 @@ pub enum ViewError {
 /// Invariants: `right`, `up` and `forward` are unit length and mutually
 /// orthogonal with `right = forward × up` (a right-handed world looks
 /// right-handed in the picture: world-right is picture-right); `0 < fov_y <
-/// pi`; `1 <= width, height <= MAX_PICTURE_SIDE`; `near` finite and `> 0`.
+/// pi`; `1 <= width, height <= MAX_PICTURE_SIDE` and
+/// `width × height <= MAX_PICTURE_PIXELS`; `near` finite and `> 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
     eye: Vec3,
@@ -121,7 +142,7 @@ impl View {
         if !(camera.fov_y > 0.0 && camera.fov_y < std::f32::consts::PI) {
             return Err(ViewError::FovOutOfRange(camera.fov_y));
         }
-        if width == 0 || height == 0 || width > MAX_PICTURE_SIDE || height > MAX_PICTURE_SIDE {
+        if !picture_size_ok(width, height) {
             return Err(ViewError::BadSize { width, height });
         }
         let distance = (camera.lookat - camera.eye).length();
@@ -322,6 +343,17 @@ mod tests {
         let mut c = camera();
         c.width = 0;
         assert!(matches!(View::new(&c), Err(ViewError::BadSize { .. })));
+        // Each side is allowed, the product is not: 2^32 pixels would need
+        // about 200 GB.
+        let (w, h) = (MAX_PICTURE_SIDE, MAX_PICTURE_SIDE);
+        assert!(matches!(
+            View::with_size(&camera(), w, h),
+            Err(ViewError::BadSize { .. })
+        ));
+        assert!(View::with_size(&camera(), 8192, 8192).is_ok());
+        assert!(View::with_size(&camera(), 8192, 8193).is_err());
+        assert!(View::with_size(&camera(), MAX_PICTURE_SIDE, 1).is_ok());
+        assert!(View::with_size(&camera(), MAX_PICTURE_SIDE + 1, 1).is_err());
         let mut c = camera();
         c.eye.x = f32::NAN;
         assert_eq!(View::new(&c), Err(ViewError::NotFinite));

@@ -99,6 +99,14 @@ pub(crate) fn fmt_num(x: f64) -> String {
         return format!("{x}");
     }
     let magnitude = x.abs().log10().floor();
+    if !(-4.0..7.0).contains(&magnitude) {
+        // Scientific beyond a million or below a ten-thousandth, so limits
+        // like 1e12 and 1e-9 stay readable.
+        let s = format!("{x:.2e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exponent}");
+    }
     // Three significant digits; clamp so huge or tiny values stay readable.
     let decimals = (2.0 - magnitude).clamp(0.0, 12.0) as usize;
     let s = format!("{x:.decimals$}");
@@ -149,5 +157,10 @@ mod tests {
         assert_eq!(fmt_num(1.5), "1.5");
         assert_eq!(fmt_num(-2.25), "-2.25");
         assert_eq!(fmt_num(0.0), "0");
+        assert_eq!(fmt_num(1e12), "1e12");
+        assert_eq!(fmt_num(1.8e12), "1.8e12");
+        assert_eq!(fmt_num(1e-9), "1e-9");
+        assert_eq!(fmt_num(-2.5e-12), "-2.5e-12");
+        assert_eq!(fmt_num(123456.0), "123456");
     }
 }

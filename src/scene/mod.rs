@@ -15,11 +15,11 @@ mod sc;
 pub use error::{Diagnostic, LoadError};
 pub use obj::load_obj;
 pub use polygon::{
-    PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, PARALLELOGRAM_TOLERANCE,
-    PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
+    PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
+    PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
 pub use sc::{
-    load_camera, parse_camera_str, parse_str, MAX_COORDINATE, MAX_DIAGNOSTICS,
+    load_camera, parse_bytes, parse_camera_str, parse_str, MAX_DIAGNOSTICS, MAX_EMISSION,
     UP_PARALLEL_TOLERANCE,
 };
 

@@ -43,6 +43,22 @@ pub const TURNING_TOLERANCE: f64 = 1e-3;
 /// vertex visibly.
 pub const PARALLELOGRAM_TOLERANCE: f64 = 1e-5;
 
+/// Largest magnitude of a world-space coordinate, in scene units.
+///
+/// Geometry is `f32` and the later stages multiply up to three lengths
+/// together (ray–plane tests, form factor denominators): with lengths below
+/// `1e12` those products stay far below `f32::MAX` (`3.4e38`), so nothing
+/// overflows to infinity or turns into NaN. A scene this large is a scene
+/// in the wrong unit.
+pub const MAX_COORDINATE: f64 = 1e12;
+
+/// Smallest extent (largest distance between two vertices) of a polygon,
+/// in scene units. Products of three lengths below `1e-9` come near the
+/// bottom of `f32`'s normal range (`1.2e-38`), where form factors and ray
+/// tests underflow to zero; such a polygon is an error (for instance a
+/// `scale 0.000001` applied once too often), not a silent black speck.
+pub const MIN_EXTENT: f64 = 1e-9;
+
 /// How a polygon is meshed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape {
@@ -73,6 +89,29 @@ pub enum PolygonError {
     NotFinite {
         /// Which vertex, from 1.
         vertex: usize,
+    },
+    /// A coordinate's magnitude is above [`MAX_COORDINATE`].
+    #[error(
+        "vertex {vertex} is {} units from the origin; coordinates must be at most {} in magnitude",
+        fmt_num(*.magnitude),
+        fmt_num(MAX_COORDINATE)
+    )]
+    TooFar {
+        /// Which vertex, from 1.
+        vertex: usize,
+        /// Its largest coordinate magnitude, in scene units.
+        magnitude: f64,
+    },
+    /// The polygon is smaller than [`MIN_EXTENT`].
+    #[error(
+        "polygon is too small: its vertices are at most {} units apart, below the smallest \
+         allowed size {}",
+        fmt_num(*.extent),
+        fmt_num(MIN_EXTENT)
+    )]
+    TooSmall {
+        /// Its extent, in scene units.
+        extent: f64,
     },
     /// Two consecutive vertices (also the last and the first) coincide.
     #[error("vertices {first} and {second} are equal")]
@@ -186,11 +225,23 @@ fn analyze(vertices: &[Vec3]) -> Result<Analysis, PolygonError> {
         return Err(PolygonError::NotFinite { vertex: i + 1 });
     }
     let v: Vec<DVec3> = vertices.iter().map(|p| p.as_dvec3()).collect();
+    if let Some(i) = v
+        .iter()
+        .position(|p| p.abs().max_element() > MAX_COORDINATE)
+    {
+        return Err(PolygonError::TooFar {
+            vertex: i + 1,
+            magnitude: v[i].abs().max_element(),
+        });
+    }
     let extent = diameter(&v);
     if !extent.is_finite() {
         // Finite f32 coordinates cannot overflow in f64; kept so a future
         // change of precision cannot slip a NaN past the checks below.
         return Err(PolygonError::NotFinite { vertex: 1 });
+    }
+    if extent < MIN_EXTENT {
+        return Err(PolygonError::TooSmall { extent });
     }
 
     for i in 0..n {

@@ -14,10 +14,11 @@
 
 use super::error::fmt_num;
 use super::{
-    Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, Scene, SourcePos,
-    DEFAULT_FOV_DEG, DEFAULT_SIZE,
+    Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError,
+    Scene, SourcePos, DEFAULT_FOV_DEG, DEFAULT_SIZE, MAX_COORDINATE,
 };
 use crate::color::Rgb;
+use crate::render::camera::{picture_size_ok, MAX_PICTURE_PIXELS, MAX_PICTURE_SIDE};
 use glam::{DAffine3, DMat3, DVec3, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
@@ -32,9 +33,11 @@ pub const MAX_DIAGNOSTICS: usize = 100;
 /// `f32`.
 pub const UP_PARALLEL_TOLERANCE: f64 = 1e-4;
 
-/// Largest magnitude accepted for a coordinate: geometry is stored in `f32`,
-/// so anything larger would become infinite.
-pub const MAX_COORDINATE: f64 = f32::MAX as f64;
+/// Largest emitted radiosity per channel (`k_emission` × `color`), in the
+/// scene's radiosity units. Far above any physical scene, low enough that
+/// emission × area × polygon count stays finite in `f64` and radiosities
+/// stay finite in the `f32` pictures.
+pub const MAX_EMISSION: f64 = 1e20;
 
 /// Every keyword of the format. None of them may be used as a name.
 const KEYWORDS: &[&str] = &[
@@ -114,8 +117,15 @@ pub(crate) fn load_file(path: &Path) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path)
         .map_err(|e| Diagnostic::new(&file, FILE_START, format!("cannot read file: {e}")))?;
-    let text = decode(&bytes, &file)?;
-    parse_str(text, &file)
+    parse_bytes(&bytes, &file)
+}
+
+/// Parses the raw bytes of a `.sc` file; `file` names it in diagnostics.
+/// Bytes that are not UTF-8 are reported at the first bad one; otherwise
+/// as [`parse_str`].
+pub fn parse_bytes(bytes: &[u8], file: &str) -> Result<Scene, LoadError> {
+    let text = decode(bytes, file)?;
+    parse_str(text, file)
 }
 
 /// The bytes as UTF-8 text without a leading byte-order mark.
@@ -493,7 +503,21 @@ impl<'a> Parser<'a> {
                 match (self.frames.last_mut(), t) {
                     // Post-multiplying makes the latest line act first on
                     // what follows, as a matrix stack does.
-                    (Some(frame), Some(t)) => frame.matrix *= t,
+                    (Some(frame), Some(t)) => {
+                        let product = frame.matrix * t;
+                        if product.is_finite() {
+                            frame.matrix = product;
+                        } else {
+                            self.error(
+                                kw.pos,
+                                format!(
+                                    "this `{}` makes the enclosing transforms overflow: \
+                                     the combined matrix is no longer finite",
+                                    kw.text
+                                ),
+                            );
+                        }
+                    }
                     (None, _) => self.error(
                         kw.pos,
                         format!("`{}` is only allowed inside a transform block", kw.text),
@@ -681,8 +705,9 @@ impl<'a> Parser<'a> {
                 self.error(
                     n.pos,
                     format!(
-                        "number {} is too large for a coordinate (at most {MAX_COORDINATE:e} in magnitude)",
-                        quote(n.text)
+                        "number {} is too large for a coordinate (at most {} in magnitude)",
+                        quote(n.text),
+                        fmt_num(MAX_COORDINATE)
                     ),
                 );
                 ok = false;
@@ -860,6 +885,13 @@ impl<'a> Parser<'a> {
             width,
             height,
         };
+        // What the renderer will do with it: the checks above catch every
+        // case known, this catches what they miss (rounding to f32) with
+        // a position rather than a failure after solving.
+        if let Err(e) = crate::render::View::new(&camera) {
+            self.error(open.pos, format!("unusable camera: {e}"));
+            return;
+        }
         if !second {
             self.camera = Some(camera);
         }
@@ -871,7 +903,9 @@ impl<'a> Parser<'a> {
         // Checked on the f32 value the camera keeps, so a value rounding to
         // 180 cannot slip through.
         let deg = n.value as f32;
-        if deg <= 0.0 || deg >= 180.0 {
+        // The radians too: a subnormal angle in degrees is zero in radians.
+        let rad = deg.to_radians();
+        if deg <= 0.0 || deg >= 180.0 || rad <= 0.0 || rad >= std::f32::consts::PI {
             self.error(
                 n.pos,
                 format!(
@@ -884,7 +918,8 @@ impl<'a> Parser<'a> {
         Some(deg)
     }
 
-    /// `size W H`, whole numbers of pixels, each at least 1.
+    /// `size W H`, whole numbers of pixels, each at least 1, within the
+    /// renderer's limits ([`MAX_PICTURE_SIDE`], [`MAX_PICTURE_PIXELS`]).
     fn size(&mut self, kw: Token<'a>) -> Option<(u32, u32)> {
         let nums = self.numbers(kw, 2)?;
         let mut out = [0u32; 2];
@@ -911,6 +946,17 @@ impl<'a> Parser<'a> {
             };
             self.error(n.pos, message);
             ok = false;
+        }
+        if ok && !picture_size_ok(out[0], out[1]) {
+            self.error(
+                nums[0].pos,
+                format!(
+                    "`size` {}x{} is too large: each side may be at most {MAX_PICTURE_SIDE} pixels \
+                     and the picture at most {MAX_PICTURE_PIXELS} pixels (8192x8192)",
+                    out[0], out[1]
+                ),
+            );
+            return None;
         }
         ok.then_some((out[0], out[1]))
     }
@@ -950,16 +996,32 @@ impl<'a> Parser<'a> {
         let mut color = Rgb::WHITE;
         let mut k_diffrefl = None;
         let mut k_emission = 0.0;
+        let mut emission_pos = open.pos;
         let mut bad = false;
         let closed = self.block(open, MATERIAL_FIELDS, &[], &mut |p, kw| {
             let ok = match kw.text {
                 "color" => p.color(kw).map(|c| color = c),
                 "k_diffrefl" => p.non_negative(kw).map(|k| k_diffrefl = Some((k, kw.pos))),
-                _ => p.non_negative(kw).map(|k| k_emission = k),
+                _ => p.non_negative(kw).map(|k| {
+                    k_emission = k;
+                    emission_pos = kw.pos;
+                }),
             };
             bad |= ok.is_none();
         });
         if !closed || bad {
+            return;
+        }
+        let e = color * k_emission;
+        if !e.is_finite() || e.max_channel() > MAX_EMISSION {
+            self.error(
+                emission_pos,
+                format!(
+                    "emission `k_emission` × `color` is {} in its largest channel; it must be at most {}",
+                    fmt_num(e.max_channel()),
+                    fmt_num(MAX_EMISSION)
+                ),
+            );
             return;
         }
         if let Some((k, pos)) = k_diffrefl {
@@ -1066,10 +1128,25 @@ impl<'a> Parser<'a> {
         local: &[DVec3],
     ) -> bool {
         let m = self.current_matrix();
-        let mut world: Vec<Vec3> = local
+        let world64: Vec<DVec3> = local.iter().map(|&v| m.transform_point3(v)).collect();
+        // Checked in f64, before rounding to f32 could turn a far vertex
+        // into an infinite one with a less helpful message.
+        if let Some(i) = world64
             .iter()
-            .map(|&v| m.transform_point3(v).as_vec3())
-            .collect();
+            .position(|v| !v.is_finite() || v.abs().max_element() > MAX_COORDINATE)
+        {
+            let e = if world64[i].is_finite() {
+                PolygonError::TooFar {
+                    vertex: i + 1,
+                    magnitude: world64[i].abs().max_element(),
+                }
+            } else {
+                PolygonError::NotFinite { vertex: i + 1 }
+            };
+            self.error(open.pos, format!("{e} (after the enclosing transforms)"));
+            return false;
+        }
+        let mut world: Vec<Vec3> = world64.iter().map(|v| v.as_vec3()).collect();
         if m.matrix3.determinant() < 0.0 && world.len() > 1 {
             // A mirror turns counter-clockwise into clockwise; reversing the
             // order (keeping the first vertex first) puts the front back on
@@ -1084,7 +1161,12 @@ impl<'a> Parser<'a> {
                 true
             }
             Err(e) => {
-                self.error(open.pos, e.to_string());
+                let message = if self.frames.is_empty() {
+                    e.to_string()
+                } else {
+                    format!("{e} (after the enclosing transforms)")
+                };
+                self.error(open.pos, message);
                 false
             }
         }
@@ -1741,8 +1823,10 @@ end
             "1:12: number `1e999` is out of range (it overflows to infinity)"
         );
         assert_eq!(
-            first_error(&format!("{WHITE}polygon white vertex 1e39 0 0 vertex 1 0 0 vertex 0 1 0 end")),
-            "2:22: number `1e39` is too large for a coordinate (at most 3.4028234663852886e38 in magnitude)"
+            first_error(&format!(
+                "{WHITE}polygon white vertex 1e39 0 0 vertex 1 0 0 vertex 0 1 0 end"
+            )),
+            "2:22: number `1e39` is too large for a coordinate (at most 1e12 in magnitude)"
         );
     }
 
@@ -1764,6 +1848,18 @@ end
         assert_eq!(
             at_size("99999999999 1"),
             "2:8: `size` `99999999999` is too large (at most 4294967295)"
+        );
+        assert_eq!(
+            at_size("100000 100000"),
+            "2:8: `size` 100000x100000 is too large: each side may be at most 65536 pixels \
+             and the picture at most 67108864 pixels (8192x8192)"
+        );
+        assert!(at_size("65536 1025").contains("too large"));
+        assert!(
+            parse_str("camera eye 0 0 -1 lookat 0 0 0 size 8192 8192 end", "a.sc")
+                .unwrap_err()
+                .to_string()
+                .contains("no polygons")
         );
     }
 

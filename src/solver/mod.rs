@@ -17,6 +17,7 @@
 //! per-polygon sums run in a fixed order, so the result is bit-identical
 //! whatever the thread count.
 
+pub mod checkpoint;
 pub mod formfactor;
 
 use crate::color::Rgb;
@@ -557,6 +558,42 @@ impl<'a> Progressive<'a> {
                 self.unshot[j]
             ));
         }
+        Ok(())
+    }
+
+    /// A copy of everything [`Progressive::restore`] needs to continue
+    /// this solve bit for bit (see [`checkpoint`]).
+    pub fn state(&self) -> checkpoint::SolverState {
+        checkpoint::SolverState {
+            radiosity: self.radiosity.clone(),
+            unshot: self.unshot.clone(),
+            steps: self.steps,
+            rays: self.rays,
+        }
+    }
+
+    /// Replaces the solve's state by a saved one from a solve of the same
+    /// scene, mesh and options; refuses (and changes nothing) when the
+    /// array sizes differ or a value is not finite and non-negative.
+    pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), String> {
+        if state.radiosity.len() != self.radiosity.len() || state.unshot.len() != self.unshot.len()
+        {
+            return Err(format!(
+                "it holds {} radiosity and {} unshot values; this solve has {} and {}",
+                state.radiosity.len(),
+                state.unshot.len(),
+                self.radiosity.len(),
+                self.unshot.len()
+            ));
+        }
+        let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
+        if state.radiosity.iter().chain(&state.unshot).any(bad) {
+            return Err("it holds a negative or non-finite value".into());
+        }
+        self.radiosity = state.radiosity;
+        self.unshot = state.unshot;
+        self.steps = state.steps;
+        self.rays = state.rays;
         Ok(())
     }
 }

@@ -1,0 +1,408 @@
+//! Checkpoints: the state of a progressive solve saved to a file, so that an
+//! interrupted run can continue to exactly the result an uninterrupted run
+//! gives.
+//!
+//! A solve's future depends only on its per-vertex radiosity, its unshot
+//! radiosity, and the fixed inputs (scene, mesh, solver options); the step
+//! and ray counters are carried along for the statistics. Every value is
+//! stored as its exact `f64` bits, so a resumed solve continues bit for bit.
+//!
+//! The file format (version 1), all integers little-endian:
+//!
+//! ```text
+//! offset  size        field
+//! 0       8           magic "RADCKPT\0"
+//! 8       4           version (u32) = 1
+//! 12      8           fingerprint (u64) of scene + mesh + solver options
+//! 20      8           steps taken (u64)
+//! 28      8           shadow rays cast (u64)
+//! 36      8           radiosity entries R (u64, one per mesh vertex)
+//! 44      8           unshot entries U (u64)
+//! 52      24 R        radiosity: r, g, b as f64 bits per vertex
+//! ...     24 U        unshot radiosity: r, g, b as f64 bits per entry
+//! end-8   8           checksum (u64): FNV-1a of every byte before it
+//! ```
+//!
+//! The fingerprint covers what decides the solution: polygon geometry and
+//! materials, the mesh's vertices and sample points, and the form-factor
+//! options. It leaves out the stopping rule (threshold, step limit), so a
+//! resumed run may go further than the interrupted one would have. A
+//! checkpoint whose fingerprint differs is refused with a message saying
+//! so; a truncated or corrupted one is refused by its length or checksum,
+//! before anything is allocated from its header's counts.
+
+use crate::color::Rgb;
+use crate::mesh::Mesh;
+use crate::output::{self, OutputError};
+use crate::scene::Scene;
+use crate::solver::{FormFactorMethod, Progressive, ShooterSamples, SolverOptions};
+use std::path::{Path, PathBuf};
+
+/// The first eight bytes of every checkpoint file.
+pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
+
+/// The format version this build writes and reads.
+pub const VERSION: u32 = 1;
+
+/// Bytes before the radiosity data.
+const HEADER_LEN: usize = 52;
+
+/// Bytes of one stored [`Rgb`].
+const RGB_LEN: usize = 24;
+
+/// Bytes of the trailing checksum.
+const CHECKSUM_LEN: usize = 8;
+
+/// Everything a progressive solve needs to continue exactly where it was.
+///
+/// Invariants a solver checks on restore: `radiosity` has one entry per
+/// mesh vertex, `unshot` the solver's number of unshot entries (today one
+/// per polygon), every channel finite and `>= 0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverState {
+    /// Radiosity per mesh vertex, in the scene's emission units.
+    pub radiosity: Vec<Rgb>,
+    /// Unshot radiosity, one entry per unit the solver shoots from.
+    pub unshot: Vec<Rgb>,
+    /// Shooting steps taken.
+    pub steps: u64,
+    /// Shadow rays cast.
+    pub rays: u64,
+}
+
+/// Why a checkpoint could not be read or used. Every message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    /// The file could not be read.
+    #[error("cannot read checkpoint {}: {error}", path.display())]
+    Read {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What the operating system said.
+        error: std::io::Error,
+    },
+    /// The file is not a checkpoint of a supported version, or is damaged.
+    #[error("{} is not a usable checkpoint: {reason}", path.display())]
+    Invalid {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The checkpoint was written for another scene, mesh or solver options.
+    #[error(
+        "checkpoint {} was saved for a different scene, mesh or form-factor options \
+         (give the same scene, --lenmax, --inset, --form-factor, --shooter-samples and \
+         --no-near-field as the run that saved it)",
+        path.display()
+    )]
+    Mismatch {
+        /// The checkpoint file.
+        path: PathBuf,
+    },
+    /// The state does not fit the solver (a bug if the fingerprint matched).
+    #[error("checkpoint {} does not fit this solve: {reason}", path.display())]
+    Restore {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What the solver refused.
+        reason: String,
+    },
+    /// Writing the checkpoint failed.
+    #[error("{0}")]
+    Write(#[from] OutputError),
+}
+
+/// A 64-bit FNV-1a style hash, fed whole words for speed. Stable across
+/// platforms and Rust versions, unlike `std`'s hasher; not cryptographic
+/// (it guards against mistakes, not attacks).
+#[derive(Clone, Copy, Debug)]
+struct Fnv(u64);
+
+impl Fnv {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+
+    fn new() -> Self {
+        Fnv(Self::OFFSET)
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(Self::PRIME);
+        }
+    }
+
+    fn word(&mut self, w: u64) {
+        self.bytes(&w.to_le_bytes());
+    }
+}
+
+/// The fingerprint of what decides a solve's result: the scene's polygons
+/// and materials, the mesh's vertices and sample points, and the form-factor
+/// options (not the stopping rule).
+pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
+    let mut h = Fnv::new();
+    h.bytes(b"scene");
+    h.word(scene.polygons.len() as u64);
+    for p in &scene.polygons {
+        h.word(p.material.0 as u64);
+        h.word(p.vertices.len() as u64);
+        for v in &p.vertices {
+            for c in v.to_array() {
+                h.word(c.to_bits() as u64);
+            }
+        }
+    }
+    h.word(scene.materials.len() as u64);
+    for m in &scene.materials {
+        for c in [m.color.r, m.color.g, m.color.b, m.k_diffrefl, m.k_emission] {
+            h.word(c.to_bits());
+        }
+    }
+    h.bytes(b"mesh");
+    h.word(mesh.vertex_count() as u64);
+    h.word(mesh.elements.len() as u64);
+    for (p, s) in mesh.positions.iter().zip(&mesh.sample_positions) {
+        for c in p.to_array().into_iter().chain(s.to_array()) {
+            h.word(c.to_bits() as u64);
+        }
+    }
+    for pm in &mesh.polygons {
+        h.word(pm.vertices.start as u64);
+        h.word(pm.vertices.end as u64);
+    }
+    h.bytes(b"options");
+    h.word(match options.form_factor {
+        FormFactorMethod::Wallace => 1,
+        FormFactorMethod::Center => 2,
+    });
+    h.word(match options.shooter_samples {
+        ShooterSamples::All => u64::MAX,
+        ShooterSamples::AtMost(n) => n as u64,
+    });
+    h.word(options.near_field as u64);
+    h.0
+}
+
+/// The bytes of a checkpoint of `solver`'s current state.
+pub fn encode(fingerprint: u64, solver: &Progressive) -> Vec<u8> {
+    encode_parts(
+        fingerprint,
+        solver.radiosity(),
+        solver.unshot(),
+        solver.steps(),
+        solver.rays(),
+    )
+}
+
+/// The bytes of a checkpoint of `state`.
+pub fn encode_state(fingerprint: u64, state: &SolverState) -> Vec<u8> {
+    encode_parts(
+        fingerprint,
+        &state.radiosity,
+        &state.unshot,
+        state.steps,
+        state.rays,
+    )
+}
+
+fn encode_parts(
+    fingerprint: u64,
+    radiosity: &[Rgb],
+    unshot: &[Rgb],
+    steps: u64,
+    rays: u64,
+) -> Vec<u8> {
+    let len = HEADER_LEN + RGB_LEN * (radiosity.len() + unshot.len()) + CHECKSUM_LEN;
+    let mut out = Vec::with_capacity(len);
+    out.extend_from_slice(&MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    for w in [
+        fingerprint,
+        steps,
+        rays,
+        radiosity.len() as u64,
+        unshot.len() as u64,
+    ] {
+        out.extend_from_slice(&w.to_le_bytes());
+    }
+    for c in radiosity.iter().chain(unshot) {
+        for x in [c.r, c.g, c.b] {
+            out.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+    }
+    let mut h = Fnv::new();
+    h.bytes(&out);
+    out.extend_from_slice(&h.0.to_le_bytes());
+    debug_assert_eq!(out.len(), len);
+    out
+}
+
+/// Reads the fingerprint and state from checkpoint bytes, or says what is
+/// wrong with them. Never allocates more than the input's size.
+pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), String> {
+    if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
+        return Err("it does not start like a radiosity checkpoint".into());
+    }
+    if bytes.len() < HEADER_LEN + CHECKSUM_LEN {
+        return Err(format!("it is truncated ({} bytes)", bytes.len()));
+    }
+    let u64_at = |at: usize| {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&bytes[at..at + 8]);
+        u64::from_le_bytes(b)
+    };
+    let mut v = [0u8; 4];
+    v.copy_from_slice(&bytes[8..12]);
+    let version = u32::from_le_bytes(v);
+    if version != VERSION {
+        return Err(format!(
+            "it is format version {version}; this program reads version {VERSION}"
+        ));
+    }
+    let (fingerprint, steps, rays) = (u64_at(12), u64_at(20), u64_at(28));
+    let (n_radiosity, n_unshot) = (u64_at(36), u64_at(44));
+    let expected = n_radiosity
+        .checked_add(n_unshot)
+        .and_then(|n| n.checked_mul(RGB_LEN as u64))
+        .and_then(|n| n.checked_add((HEADER_LEN + CHECKSUM_LEN) as u64));
+    if expected != Some(bytes.len() as u64) {
+        return Err(format!(
+            "its length ({} bytes) does not match its header ({n_radiosity} radiosity and \
+             {n_unshot} unshot entries): truncated or damaged",
+            bytes.len()
+        ));
+    }
+    let body = &bytes[..bytes.len() - CHECKSUM_LEN];
+    let mut h = Fnv::new();
+    h.bytes(body);
+    if h.0 != u64_at(bytes.len() - CHECKSUM_LEN) {
+        return Err("its checksum does not match: the file is damaged".into());
+    }
+    let rgb_at = |k: usize| {
+        let at = HEADER_LEN + k * RGB_LEN;
+        Rgb::new(
+            f64::from_bits(u64_at(at)),
+            f64::from_bits(u64_at(at + 8)),
+            f64::from_bits(u64_at(at + 16)),
+        )
+    };
+    let (nr, nu) = (n_radiosity as usize, n_unshot as usize);
+    Ok((
+        fingerprint,
+        SolverState {
+            radiosity: (0..nr).map(rgb_at).collect(),
+            unshot: (nr..nr + nu).map(rgb_at).collect(),
+            steps,
+            rays,
+        },
+    ))
+}
+
+/// Saves `solver`'s state to `path` atomically (temporary file + rename):
+/// the file is always either the previous checkpoint or the new one.
+pub fn save(path: &Path, fingerprint: u64, solver: &Progressive) -> Result<(), OutputError> {
+    let bytes = encode(fingerprint, solver);
+    output::write_atomically(path, |w| w.write_all(&bytes))
+}
+
+/// Reads the checkpoint at `path` and checks it was saved for a solve with
+/// `fingerprint`.
+pub fn load(path: &Path, fingerprint: u64) -> Result<SolverState, CheckpointError> {
+    let bytes = std::fs::read(path).map_err(|error| CheckpointError::Read {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let (found, state) = decode(&bytes).map_err(|reason| CheckpointError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    })?;
+    if found != fingerprint {
+        return Err(CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(state)
+}
+
+/// Loads the checkpoint at `path` into `solver`, which must be a fresh
+/// solve of the same scene, mesh and options.
+pub fn resume(
+    path: &Path,
+    fingerprint: u64,
+    solver: &mut Progressive,
+) -> Result<(), CheckpointError> {
+    let state = load(path, fingerprint)?;
+    solver
+        .restore(state)
+        .map_err(|reason| CheckpointError::Restore {
+            path: path.to_path_buf(),
+            reason,
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state() -> SolverState {
+        SolverState {
+            radiosity: vec![Rgb::new(0.1, 0.2, 0.3), Rgb::new(1.0 / 3.0, 0.0, 5e-324)],
+            unshot: vec![Rgb::new(7.0, 8.0, 9.0)],
+            steps: 42,
+            rays: 1 << 40,
+        }
+    }
+
+    #[test]
+    fn round_trip_keeps_every_bit() {
+        let bytes = encode_state(0xfeed, &state());
+        let (fp, back) = decode(&bytes).unwrap();
+        assert_eq!(fp, 0xfeed);
+        assert_eq!(back, state());
+        assert_eq!(back.radiosity[1].b.to_bits(), 5e-324f64.to_bits());
+    }
+
+    #[test]
+    fn damage_of_any_kind_is_refused() {
+        let bytes = encode_state(1, &state());
+        // Every truncation.
+        for len in 0..bytes.len() {
+            assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");
+        }
+        // Every single-bit flip: magic, version, counts, data or checksum.
+        for i in 0..bytes.len() {
+            for bit in 0..8 {
+                let mut b = bytes.clone();
+                b[i] ^= 1 << bit;
+                assert!(decode(&b).is_err(), "flip at byte {i} bit {bit}");
+            }
+        }
+        // A header promising far more data than there is allocates nothing.
+        let mut b = bytes.clone();
+        b[36..44].copy_from_slice(&u64::MAX.to_le_bytes());
+        let e = decode(&b).unwrap_err();
+        assert!(e.contains("does not match its header"), "{e}");
+        let mut b = bytes;
+        b[8] = 9;
+        assert!(decode(&b).unwrap_err().contains("version 9"));
+        assert!(decode(b"P6\n3 2\n255\n")
+            .unwrap_err()
+            .contains("does not start"));
+    }
+
+    #[test]
+    fn files_are_checked_against_the_fingerprint() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("solve.ckpt");
+        let bytes = encode_state(7, &state());
+        output::write_atomically(&path, |w| w.write_all(&bytes)).unwrap();
+        assert_eq!(load(&path, 7).unwrap(), state());
+        let e = load(&path, 8).unwrap_err();
+        assert!(matches!(e, CheckpointError::Mismatch { .. }), "{e}");
+        assert!(e.to_string().contains("different scene"), "{e}");
+        let e = load(&dir.path().join("missing"), 7).unwrap_err();
+        assert!(e.to_string().contains("cannot read checkpoint"), "{e}");
+    }
+}
