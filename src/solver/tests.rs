@@ -322,19 +322,22 @@ fn occluder_casts_a_shadow() {
     assert!(solved.radiosity[vertex_at(2.5, 0.5)].r > 0.0);
 }
 
+/// A closed box `[0, size]³` of materials 1 and 2 with a square lamp
+/// (material 0) a fifth of its width just below the middle of the ceiling.
+fn room_with_lamp(size: f32) -> Vec<crate::scene::Polygon> {
+    let mut polygons = closed_box(size, [1, 2, 1, 1, 2, 1]);
+    let (lo, hi, y) = (0.4 * size, 0.6 * size, size - 0.0025 * size);
+    polygons.push(polygon(
+        0,
+        &[[lo, y, lo], [hi, y, lo], [hi, y, hi], [lo, y, hi]],
+    ));
+    polygons
+}
+
 /// The same solve on one thread and on two gives the same bits.
 #[test]
 fn thread_count_does_not_change_the_result() {
-    let mut polygons = closed_box(2.0, [1, 2, 1, 1, 2, 1]);
-    polygons.push(polygon(
-        0,
-        &[
-            [0.8, 1.99, 0.8],
-            [1.2, 1.99, 0.8],
-            [1.2, 1.99, 1.2],
-            [0.8, 1.99, 1.2],
-        ],
-    ));
+    let mut polygons = room_with_lamp(2.0);
     polygons.push(polygon(
         1,
         &[
@@ -424,16 +427,7 @@ fn a_cancelled_step_changes_nothing() {
 /// and fewer rays are cast.
 #[test]
 fn shaft_culling_changes_no_result_bit() {
-    let mut polygons = closed_box(4.0, [1, 2, 1, 1, 2, 1]);
-    polygons.push(polygon(
-        0,
-        &[
-            [1.6, 3.99, 1.6],
-            [2.4, 3.99, 1.6],
-            [2.4, 3.99, 2.4],
-            [1.6, 3.99, 2.4],
-        ],
-    ));
+    let mut polygons = room_with_lamp(4.0);
     // A table-like slab, a block on the floor and a thin wall piece.
     polygons.push(polygon(
         1,
