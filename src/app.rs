@@ -136,6 +136,9 @@ pub struct RunConfig {
     pub checkpoint_every: Duration,
     /// A checkpoint to continue from instead of starting the solve afresh.
     pub resume: Option<PathBuf>,
+    /// Add the ambient term ([`Progressive::ambient`]) to the radiosity
+    /// shown: `None` for the default, on in the window and off for files.
+    pub ambient: Option<bool>,
 }
 
 impl RunConfig {
@@ -159,6 +162,7 @@ impl RunConfig {
             checkpoint: None,
             checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
             resume: None,
+            ambient: None,
         }
     }
 }
@@ -600,7 +604,14 @@ pub fn run_prepared_cancellable(
         return Err(interrupted());
     }
     let t = Instant::now();
-    let frame = render(&prepared.mesh, solver.radiosity(), &view)?;
+    // The ambient term only when asked for: a file shows the solution.
+    let frame = if config.ambient == Some(true) {
+        let mut shown = Vec::new();
+        solver.radiosity_with_ambient(&mut shown);
+        render(&prepared.mesh, &shown, &view)?
+    } else {
+        render(&prepared.mesh, solver.radiosity(), &view)?
+    };
     seconds.render = t.elapsed().as_secs_f64();
 
     if cancel.load(Ordering::SeqCst) {

@@ -127,6 +127,17 @@ struct Args {
     #[arg(long)]
     no_window: bool,
 
+    /// Show the ambient term (Cohen et al. 1988: the unshot power spread
+    /// evenly and reflected) on top of the solution, so early pictures are
+    /// not too dark; it fades as the solve converges and never enters the
+    /// solution. Default: on in the window, off for files.
+    #[arg(long, conflicts_with = "no_ambient")]
+    ambient: bool,
+
+    /// Never show the ambient term (see --ambient).
+    #[arg(long)]
+    no_ambient: bool,
+
     /// Refuse meshes with more elements than this, before building them;
     /// the message says which --lenmax fits. The default allows meshes of
     /// up to about 3.7 GB (estimated; 2.7 GB measured).
@@ -261,6 +272,11 @@ fn config(args: &Args) -> Result<RunConfig, String> {
         checkpoint: args.checkpoint.clone(),
         checkpoint_every: Duration::from_secs_f64(args.checkpoint_every.min(1e9)),
         resume: args.resume.clone(),
+        ambient: match (args.ambient, args.no_ambient) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        },
     })
 }
 

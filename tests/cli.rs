@@ -303,3 +303,56 @@ fn an_unreachable_display_falls_back_to_batch() {
     );
     assert!(dir.path().join("cornell.png").exists());
 }
+
+/// Reads a colour PFM: the header, then little-endian `f32` RGB.
+fn read_pfm(path: &std::path::Path) -> Vec<f32> {
+    let bytes = std::fs::read(path).unwrap();
+    // Three header lines: "PF", "W H", "-1.0".
+    let mut newlines = 0;
+    let start = bytes
+        .iter()
+        .position(|&b| {
+            newlines += (b == b'\n') as u32;
+            newlines == 3
+        })
+        .unwrap()
+        + 1;
+    bytes[start..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+/// `--ambient` brightens an early picture (never darkens a pixel), and
+/// without it a file shows the solution alone.
+#[test]
+fn ambient_term_brightens_early_pictures_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    let common = [
+        scene.to_str().unwrap(),
+        "--lenmax",
+        "80",
+        "--size",
+        "48x48",
+        "--max-steps",
+        "1",
+        "-q",
+    ];
+    let mut plain = common.to_vec();
+    plain.extend_from_slice(&["-o", "plain.pfm"]);
+    let mut with = common.to_vec();
+    with.extend_from_slice(&["-o", "ambient.pfm", "--ambient"]);
+    for args in [&plain, &with] {
+        let out = run_in(dir.path(), args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let (a, b) = (
+        read_pfm(&dir.path().join("plain.pfm")),
+        read_pfm(&dir.path().join("ambient.pfm")),
+    );
+    assert_eq!(a.len(), b.len());
+    assert!(a.iter().zip(&b).all(|(x, y)| y >= x));
+    let (sa, sb): (f32, f32) = (a.iter().sum(), b.iter().sum());
+    assert!(sb > sa * 1.2, "ambient {sb} vs plain {sa}");
+}

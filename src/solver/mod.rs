@@ -285,6 +285,52 @@ impl<'a> Progressive<'a> {
         &self.options
     }
 
+    /// The ambient term of Cohen, Chen, Wallace and Greenberg (1988): the
+    /// radiosity the unshot power would add everywhere if it were spread
+    /// evenly over the scene and reflected on and on,
+    /// `ambient = R · Σ Δb_i A_i / Σ A_i` with `R = 1 / (1 − ρ̄)` and
+    /// `ρ̄ = Σ ρ_i A_i / Σ A_i`, per channel. It estimates what is still
+    /// missing from an unconverged solution and tends to zero as the solve
+    /// converges. It is for display only: it never enters the solution.
+    pub fn ambient(&self) -> Rgb {
+        let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
+        for ((u, rho), pm) in self
+            .unshot
+            .iter()
+            .zip(&self.reflectance)
+            .zip(&self.mesh.polygons)
+        {
+            area += pm.area;
+            unshot += *u * pm.area;
+            reflected += *rho * pm.area;
+        }
+        if area <= 0.0 {
+            return Rgb::BLACK;
+        }
+        let rho = reflected / area;
+        // Every reflectance channel is below 1, so their mean is too.
+        let r = Rgb::new(
+            1.0 / (1.0 - rho.r),
+            1.0 / (1.0 - rho.g),
+            1.0 / (1.0 - rho.b),
+        );
+        r * (unshot / area)
+    }
+
+    /// The radiosity to show: per vertex `b + ρ · ambient` (see
+    /// [`Progressive::ambient`]), written into `out` (resized to the vertex
+    /// count). The solution itself is not changed.
+    pub fn radiosity_with_ambient(&self, out: &mut Vec<Rgb>) {
+        let ambient = self.ambient();
+        out.clear();
+        out.extend(
+            self.radiosity
+                .iter()
+                .zip(&self.mesh.vertex_polygon)
+                .map(|(b, p)| *b + self.reflectance[p.index()] * ambient),
+        );
+    }
+
     /// Total unshot power `Σ A_i · mean(Δb_i)`.
     pub fn unshot_power(&self) -> f64 {
         self.unshot

@@ -503,3 +503,51 @@ fn shaft_culling_changes_no_result_bit() {
     assert!(culled_rays < exact_rays, "{culled_rays} vs {exact_rays}");
     assert!(clear > 0 && clear < receivers, "{clear} of {receivers}");
 }
+
+/// In a closed box whose walls all have the same `e` and `rho`, the ambient
+/// term alone makes the very first picture exact: before any step the
+/// unshot radiosity is `e` everywhere, so `e + rho · e / (1 − rho)` is
+/// `e / (1 − rho)`. As the solve converges the term vanishes and the
+/// solution itself is untouched.
+#[test]
+fn ambient_term_completes_the_uniform_enclosure_and_vanishes() {
+    let (e, rho) = (1.0, 0.6);
+    let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]);
+    let mesh = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.25,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(&s);
+    let mut solver = Progressive::new(
+        &s,
+        &mesh,
+        &vis,
+        SolverOptions {
+            threshold: 1e-4,
+            ..Default::default()
+        },
+    );
+    let mut shown = Vec::new();
+    solver.radiosity_with_ambient(&mut shown);
+    let exact = e / (1.0 - rho);
+    assert!(
+        shown.iter().all(|b| (b.r - exact).abs() < 1e-12),
+        "{:?}",
+        shown[0]
+    );
+    assert!(solver.radiosity().iter().all(|b| b.r == e));
+    while !solver.is_done() && solver.step().is_some() {}
+    let before = solver.radiosity().to_vec();
+    solver.radiosity_with_ambient(&mut shown);
+    assert_eq!(solver.radiosity(), &before[..]);
+    assert!(solver.ambient().r < 1e-3 * exact, "{:?}", solver.ambient());
+    // Shown and solved agree to within the unshot remainder.
+    assert!(shown
+        .iter()
+        .zip(&before)
+        .all(|(a, b)| (a.r - b.r).abs() < 1e-3 * exact));
+}

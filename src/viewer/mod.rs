@@ -92,6 +92,18 @@ pub fn display_available() -> Result<(), String> {
     }
 }
 
+/// The radiosity the window shows: with the ambient term while the solve
+/// is unconverged (it fades as the solve converges), or the solution alone.
+fn shown_radiosity(solver: &Progressive, ambient: bool) -> Vec<Rgb> {
+    let mut shown = Vec::new();
+    if ambient {
+        solver.radiosity_with_ambient(&mut shown);
+    } else {
+        shown.extend_from_slice(solver.radiosity());
+    }
+    shown
+}
+
 /// What the solver thread publishes after each step.
 #[derive(Clone, Debug, Default)]
 struct Progress {
@@ -135,6 +147,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     let presses = Arc::new(Mutex::new(Vec::new()));
     window.set_input_callback(Box::new(KeyPresses(Arc::clone(&presses))));
 
+    let ambient = config.ambient.unwrap_or(true);
     let mut solver = Progressive::new(
         &prepared.scene,
         &prepared.mesh,
@@ -142,7 +155,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
         config.solver,
     );
     let progress = Mutex::new(Progress {
-        radiosity: solver.radiosity().to_vec(),
+        radiosity: shown_radiosity(&solver, ambient),
         unshot_fraction: solver.unshot_fraction(),
         stopped: solver.stop_reason(),
         ..Progress::default()
@@ -153,7 +166,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     };
 
     std::thread::scope(|scope| {
-        scope.spawn(|| solve_in_background(&mut solver, &progress, &control));
+        scope.spawn(|| solve_in_background(&mut solver, &progress, &control, ambient));
         let mut ui = Ui {
             prepared,
             window: &mut window,
@@ -179,7 +192,12 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
 
 /// The solver thread: steps until converged or told to quit, publishing
 /// after each step.
-fn solve_in_background(solver: &mut Progressive, progress: &Mutex<Progress>, control: &Control) {
+fn solve_in_background(
+    solver: &mut Progressive,
+    progress: &Mutex<Progress>,
+    control: &Control,
+    ambient: bool,
+) {
     let mut solving = Duration::ZERO;
     loop {
         if control.quit.load(Ordering::Relaxed) {
@@ -196,7 +214,11 @@ fn solve_in_background(solver: &mut Progressive, progress: &Mutex<Progress>, con
             return;
         };
         if let Some(report) = report {
-            p.radiosity.clone_from_slice(solver.radiosity());
+            if ambient {
+                solver.radiosity_with_ambient(&mut p.radiosity);
+            } else {
+                p.radiosity.clone_from_slice(solver.radiosity());
+            }
             p.step = report.step;
             p.unshot_fraction = report.unshot_fraction;
             p.rays = solver.rays();
