@@ -8,7 +8,8 @@ use radiosity::app::{self, RunConfig, SceneSource};
 use radiosity::mesh::DEFAULT_INSET;
 use radiosity::render::Exposure;
 use radiosity::solver::{
-    FormFactorMethod, ShooterSamples, SolverOptions, DEFAULT_SHOOTER_SAMPLES, DEFAULT_THRESHOLD,
+    FormFactorMethod, ShooterSamples, SolverOptions, UnshotScheme, DEFAULT_SHOOTER_SAMPLES,
+    DEFAULT_THRESHOLD,
 };
 use radiosity::viewer;
 use std::path::PathBuf;
@@ -81,6 +82,13 @@ struct Args {
     /// result; for comparison).
     #[arg(long)]
     no_shaft_culling: bool,
+
+    /// Where unshot radiosity is kept: `vertex` (one value per element
+    /// vertex; each shooter sample carries the value interpolated at its
+    /// position) or `polygon` (one per polygon, shot as if the polygon were
+    /// lit evenly: the original algorithm).
+    #[arg(long, value_name = "SCHEME", default_value = "vertex", value_parser = ["vertex", "polygon"])]
+    unshot: String,
 
     /// Picture size in pixels, overriding the scene's camera.
     #[arg(long, value_name = "WxH")]
@@ -259,6 +267,10 @@ fn config(args: &Args) -> Result<RunConfig, String> {
             max_steps: args.max_steps,
             near_field: !args.no_near_field,
             shaft_culling: !args.no_shaft_culling,
+            unshot: match args.unshot.as_str() {
+                "polygon" => UnshotScheme::Polygon,
+                _ => UnshotScheme::Vertex,
+            },
         },
         size,
         exposure,

@@ -182,6 +182,10 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         ShooterSamples::AtMost(n) => n as u64,
     });
     h.word(options.near_field as u64);
+    h.word(match options.unshot {
+        super::UnshotScheme::Polygon => 1,
+        super::UnshotScheme::Vertex => 2,
+    });
     h.0
 }
 

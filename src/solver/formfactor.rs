@@ -232,9 +232,29 @@ pub fn point_to_samples(
     ns: Vec3,
     samples: &[ShooterSample],
     near_field: bool,
-    mut occluded: impl FnMut(usize, Vec3) -> bool,
+    occluded: impl FnMut(usize, Vec3) -> bool,
 ) -> (f64, u64) {
-    let mut sum = 0.0f64;
+    let (sum, rays) = weighted_point_to_samples(x, nx, ns, samples, |_| 1.0, near_field, occluded);
+    (sum, rays)
+}
+
+/// [`point_to_samples`] with each sample's term multiplied by
+/// `weight(k)` (an unshot radiosity, say) before summing: returns
+/// `Σ_k weight(k) · F_k` and the number of visibility questions asked.
+#[inline]
+pub fn weighted_point_to_samples<W>(
+    x: Vec3,
+    nx: Vec3,
+    ns: Vec3,
+    samples: &[ShooterSample],
+    weight: impl Fn(usize) -> W,
+    near_field: bool,
+    mut occluded: impl FnMut(usize, Vec3) -> bool,
+) -> (W, u64)
+where
+    W: Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
+{
+    let mut sum = W::default();
     let mut rays = 0u64;
     for (k, s) in samples.iter().enumerate() {
         let d = x - s.position;
@@ -269,7 +289,7 @@ pub fn point_to_samples(
         }
         rays += 1;
         if !occluded(k, s.position) {
-            sum += term;
+            sum += weight(k) * term;
         }
     }
     (sum, rays)

@@ -1,6 +1,7 @@
 //! Progressive refinement radiosity with substructuring.
 //!
-//! Radiosity is kept at element vertices; unshot radiosity per polygon.
+//! Radiosity is kept at element vertices; unshot radiosity per vertex (by
+//! default) or per polygon ([`UnshotScheme`]).
 //! Each [`Progressive::step`] picks the polygon with the most unshot power
 //! `‖Δb_i‖·A_i` (‖·‖ the channel mean) and shoots it to every element
 //! vertex `l` of every other polygon `j`:
@@ -24,7 +25,7 @@ use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
-use formfactor::{point_to_samples, shooter_samples, SampleSet, ShooterSample};
+use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -92,6 +93,21 @@ pub struct SolverOptions {
     /// Cull shadow rays with shafts between shooter and receiver (same
     /// result bits; off tests every ray against the whole scene's BVH).
     pub shaft_culling: bool,
+    /// Where unshot radiosity is kept.
+    pub unshot: UnshotScheme,
+}
+
+/// Where unshot radiosity is kept between shooting steps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnshotScheme {
+    /// One value per polygon, the mean of what its vertices received: a
+    /// polygon shoots as if lit evenly (the original algorithm).
+    Polygon,
+    /// One value per element vertex: each shooter sample carries the
+    /// unshot radiosity interpolated at its position (linearly within the
+    /// element triangle holding it, as the picture shades), and a polygon's
+    /// unshot power is the sum over its vertices of unshot × vertex area.
+    Vertex,
 }
 
 impl Default for SolverOptions {
@@ -103,6 +119,7 @@ impl Default for SolverOptions {
             max_steps: None,
             near_field: true,
             shaft_culling: true,
+            unshot: UnshotScheme::Vertex,
         }
     }
 }
@@ -157,8 +174,16 @@ pub struct Progressive<'a> {
     samples: Vec<Vec<ShooterSample>>,
     /// Per vertex: radiosity `b`.
     radiosity: Vec<Rgb>,
-    /// Per polygon: unshot radiosity `Δb`.
+    /// Unshot radiosity `Δb`: per polygon or per vertex, by
+    /// [`SolverOptions::unshot`].
     unshot: Vec<Rgb>,
+    /// Per vertex: the area it stands for ([`Mesh::vertex_areas`]).
+    vertex_area: Vec<f64>,
+    /// Per polygon and shooter sample: where its unshot radiosity is read
+    /// from (per-vertex scheme only).
+    sample_sources: Vec<Vec<SampleSource>>,
+    /// Scratch: the unshot radiosity each sample of the shooter carries.
+    shot: Vec<Rgb>,
     /// Per vertex: scratch for the step's `Δrad`.
     delta: Vec<Rgb>,
     /// Per polygon: scratch, whether it receives in this step.
@@ -181,6 +206,71 @@ pub struct Progressive<'a> {
     initial_unshot_power: f64,
     steps: u64,
     rays: u64,
+}
+
+/// Where a shooter sample's unshot radiosity comes from in the per-vertex
+/// scheme.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SampleSource {
+    /// The sample is this element vertex.
+    Vertex(u32),
+    /// Linear interpolation in an element triangle: its corners and
+    /// barycentric weights (summing to 1).
+    Triangle([u32; 3], [f32; 3]),
+    /// The area-weighted mean over the polygon's vertices (the one-sample
+    /// centre estimate).
+    PolygonMean,
+}
+
+/// Where each of a polygon's shooter samples reads its unshot radiosity.
+fn sample_sources(
+    mesh: &Mesh,
+    pm: &crate::mesh::PolygonMesh,
+    samples: &[ShooterSample],
+    set: SampleSet,
+) -> Vec<SampleSource> {
+    let vertex_samples = match set {
+        SampleSet::Centre => return vec![SampleSource::PolygonMean; samples.len()],
+        SampleSet::Vertices => true,
+        SampleSet::AtMost(n) => pm.vertex_count() <= n.max(1),
+    };
+    if vertex_samples {
+        return pm.vertices.clone().map(SampleSource::Vertex).collect();
+    }
+    samples
+        .iter()
+        .map(|s| {
+            // The element triangle holding the sample: the one whose
+            // smallest barycentric weight is largest (>= 0 inside).
+            let mut best = (f32::NEG_INFINITY, SampleSource::PolygonMean);
+            for e in pm.elements.clone() {
+                for tri in mesh.elements[e as usize].triangles() {
+                    let [a, b, c] = tri.map(|v| mesh.positions[v.index()]);
+                    let w = barycentric(s.position, a, b, c);
+                    let least = w[0].min(w[1]).min(w[2]);
+                    if least > best.0 {
+                        best = (least, SampleSource::Triangle(tri.map(|v| v.0), w));
+                    }
+                }
+            }
+            best.1
+        })
+        .collect()
+}
+
+/// Barycentric weights of `p` (projected into the triangle's plane) in
+/// the triangle `a b c`; zeros for a degenerate triangle.
+fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f32; 3] {
+    let (e1, e2, d) = (b - a, c - a, p - a);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (dp1, dp2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if det <= 0.0 {
+        return [0.0; 3];
+    }
+    let v = (d22 * dp1 - d12 * dp2) / det;
+    let w = (d11 * dp2 - d12 * dp1) / det;
+    [1.0 - v - w, v, w]
 }
 
 impl<'a> Progressive<'a> {
@@ -208,7 +298,7 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|p| scene.materials[p.material.index()].reflectance())
             .collect();
-        let samples = scene
+        let samples: Vec<Vec<ShooterSample>> = scene
             .polygons
             .iter()
             .zip(&mesh.polygons)
@@ -219,7 +309,21 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|p| emission[p.index()])
             .collect();
-        let unshot = emission.clone();
+        let vertex_area = mesh.vertex_areas();
+        let (unshot, sample_sources) = match options.unshot {
+            UnshotScheme::Polygon => (emission.clone(), Vec::new()),
+            UnshotScheme::Vertex => (
+                mesh.vertex_polygon
+                    .iter()
+                    .map(|p| emission[p.index()])
+                    .collect(),
+                samples
+                    .iter()
+                    .zip(&mesh.polygons)
+                    .map(|(s, pm)| sample_sources(mesh, pm, s, set))
+                    .collect(),
+            ),
+        };
         let mut tiles = Vec::new();
         let mut tile_of = vec![0u32; mesh.vertex_count()];
         for pm in &mesh.polygons {
@@ -242,6 +346,9 @@ impl<'a> Progressive<'a> {
             samples,
             radiosity,
             unshot,
+            vertex_area,
+            sample_sources,
+            shot: Vec::new(),
             delta: vec![Rgb::BLACK; mesh.vertex_count()],
             receives: vec![false; mesh.polygons.len()],
             candidates: vec![Vec::new(); mesh.polygons.len()],
@@ -294,14 +401,9 @@ impl<'a> Progressive<'a> {
     /// converges. It is for display only: it never enters the solution.
     pub fn ambient(&self) -> Rgb {
         let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
-        for ((u, rho), pm) in self
-            .unshot
-            .iter()
-            .zip(&self.reflectance)
-            .zip(&self.mesh.polygons)
-        {
+        for (j, (rho, pm)) in self.reflectance.iter().zip(&self.mesh.polygons).enumerate() {
             area += pm.area;
-            unshot += *u * pm.area;
+            unshot += self.polygon_unshot_mean(j) * pm.area;
             reflected += *rho * pm.area;
         }
         if area <= 0.0 {
@@ -331,13 +433,36 @@ impl<'a> Progressive<'a> {
         );
     }
 
-    /// Total unshot power `Σ A_i · mean(Δb_i)`.
+    /// Total unshot power `Σ A_i · mean(Δb_i)` (per-vertex scheme: the
+    /// sum over vertices of `mean(Δb_l) · vertex area`).
     pub fn unshot_power(&self) -> f64 {
-        self.unshot
-            .iter()
-            .zip(&self.mesh.polygons)
-            .map(|(u, pm)| u.mean() * pm.area)
+        (0..self.mesh.polygons.len())
+            .map(|j| self.polygon_unshot_power(j))
             .sum()
+    }
+
+    /// Unshot power of polygon `j`, in radiosity × area units.
+    fn polygon_unshot_power(&self, j: usize) -> f64 {
+        self.polygon_unshot_mean(j).mean() * self.mesh.polygons[j].area
+    }
+
+    /// Area-weighted mean unshot radiosity of polygon `j`.
+    fn polygon_unshot_mean(&self, j: usize) -> Rgb {
+        let pm = &self.mesh.polygons[j];
+        match self.options.unshot {
+            UnshotScheme::Polygon => self.unshot[j],
+            UnshotScheme::Vertex => {
+                let mut sum = Rgb::BLACK;
+                for l in pm.vertices.clone() {
+                    sum += self.unshot[l as usize] * self.vertex_area[l as usize];
+                }
+                if pm.area > 0.0 {
+                    sum / pm.area
+                } else {
+                    Rgb::BLACK
+                }
+            }
+        }
     }
 
     /// Unshot power at the start (the emitted power).
@@ -396,8 +521,8 @@ impl<'a> Progressive<'a> {
     /// or `None` when nothing is left to shoot.
     pub fn next_shooter(&self) -> Option<PolygonId> {
         let mut best: Option<(usize, f64)> = None;
-        for (i, (u, pm)) in self.unshot.iter().zip(&self.mesh.polygons).enumerate() {
-            let power = u.mean() * pm.area;
+        for i in 0..self.mesh.polygons.len() {
+            let power = self.polygon_unshot_power(i);
             if power > 0.0 && best.is_none_or(|(_, b)| power > b) {
                 best = Some((i, power));
             }
@@ -420,8 +545,8 @@ impl<'a> Progressive<'a> {
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
         let shooter = self.next_shooter()?;
         let i = shooter.index();
-        let shot = self.unshot[i];
-        let shot_power = shot.mean() * self.mesh.polygons[i].area;
+        let shot_power = self.polygon_unshot_power(i);
+        self.fill_shot(i);
         self.mark_receivers(i);
 
         let mesh = self.mesh;
@@ -477,6 +602,7 @@ impl<'a> Progressive<'a> {
         let shooter_normal = mesh.polygons[i].normal;
         let reflectance = &self.reflectance;
         let near_field = self.options.near_field;
+        let shot = &self.shot;
         let (pairs, rays) = self
             .delta
             .par_iter_mut()
@@ -491,11 +617,12 @@ impl<'a> Progressive<'a> {
                 let x = mesh.sample_positions[l];
                 let tile = tile_of[l] as usize * groups;
                 let mut rays = 0u64;
-                let (f, pairs) = point_to_samples(
+                let (f, pairs) = weighted_point_to_samples(
                     x,
                     mesh.polygons[j.index()].normal,
                     shooter_normal,
                     samples,
+                    |k| shot[k],
                     near_field,
                     |k, s| {
                         let blockers = tile_candidates
@@ -516,7 +643,7 @@ impl<'a> Progressive<'a> {
                         }
                     },
                 );
-                *delta = reflectance[j.index()] * shot * f;
+                *delta = reflectance[j.index()] * f;
                 (pairs, rays)
             })
             .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
@@ -535,14 +662,25 @@ impl<'a> Progressive<'a> {
             for l in pm.vertices.clone() {
                 let d = self.delta[l as usize];
                 self.radiosity[l as usize] += d;
-                gathered += d;
+                match self.options.unshot {
+                    UnshotScheme::Polygon => gathered += d,
+                    UnshotScheme::Vertex => self.unshot[l as usize] += d,
+                }
             }
-            self.unshot[j] += gathered / pm.vertex_count() as f64;
+            if self.options.unshot == UnshotScheme::Polygon {
+                self.unshot[j] += gathered / pm.vertex_count() as f64;
+            }
         }
         self.pairs += pairs;
         self.receiver_pairs += receivers;
         self.clear_receiver_pairs += clear;
-        self.unshot[i] = Rgb::BLACK;
+        match self.options.unshot {
+            UnshotScheme::Polygon => self.unshot[i] = Rgb::BLACK,
+            UnshotScheme::Vertex => {
+                let range = &mesh.polygons[i].vertices;
+                self.unshot[range.start as usize..range.end as usize].fill(Rgb::BLACK);
+            }
+        }
         self.steps += 1;
         self.rays += rays;
         Some(StepReport {
@@ -555,6 +693,39 @@ impl<'a> Progressive<'a> {
             receivers,
             clear_receivers: clear,
         })
+    }
+
+    /// Fills `self.shot` with the unshot radiosity each sample of shooter
+    /// `i` carries: the polygon's value, or (per-vertex scheme) the value
+    /// read at the sample.
+    fn fill_shot(&mut self, i: usize) {
+        let n = self.samples[i].len();
+        self.shot.clear();
+        match self.options.unshot {
+            UnshotScheme::Polygon => self.shot.resize(n, self.unshot[i]),
+            UnshotScheme::Vertex => {
+                let mean = self.polygon_unshot_mean(i);
+                for source in &self.sample_sources[i] {
+                    let value = match *source {
+                        SampleSource::Vertex(l) => self.unshot[l as usize],
+                        SampleSource::Triangle(v, w) => {
+                            let mut sum = Rgb::BLACK;
+                            for (l, weight) in v.iter().zip(w) {
+                                sum += self.unshot[*l as usize] * f64::from(weight.max(0.0));
+                            }
+                            sum / f64::from(
+                                w.iter()
+                                    .map(|x| x.max(0.0))
+                                    .sum::<f32>()
+                                    .max(f32::MIN_POSITIVE),
+                            )
+                        }
+                        SampleSource::PolygonMean => mean,
+                    };
+                    self.shot.push(value);
+                }
+            }
+        }
     }
 
     /// Marks the polygons that can receive from shooter `i`: not `i`
@@ -590,7 +761,11 @@ impl<'a> Progressive<'a> {
     /// Checks the invariants; returns the first broken one.
     pub fn validate(&self) -> Result<(), String> {
         if self.radiosity.len() != self.mesh.vertex_count()
-            || self.unshot.len() != self.mesh.polygons.len()
+            || self.unshot.len()
+                != match self.options.unshot {
+                    UnshotScheme::Polygon => self.mesh.polygons.len(),
+                    UnshotScheme::Vertex => self.mesh.vertex_count(),
+                }
         {
             return Err("array sizes do not match the mesh".into());
         }

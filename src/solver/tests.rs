@@ -196,13 +196,18 @@ impl Vec3Like {
 fn uniform_enclosure() {
     let (e, rho) = (1.0, 0.6);
     let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]);
-    for form_factor in [FormFactorMethod::Wallace, FormFactorMethod::Center] {
+    for (form_factor, unshot) in [
+        (FormFactorMethod::Wallace, UnshotScheme::Polygon),
+        (FormFactorMethod::Wallace, UnshotScheme::Vertex),
+        (FormFactorMethod::Center, UnshotScheme::Polygon),
+    ] {
         let solved = solve(
             &s,
             0.1,
             crate::mesh::DEFAULT_INSET,
             SolverOptions {
                 form_factor,
+                unshot,
                 threshold: 1e-4,
                 ..Default::default()
             },
@@ -550,4 +555,173 @@ fn ambient_term_completes_the_uniform_enclosure_and_vanishes() {
         .iter()
         .zip(&before)
         .all(|(a, b)| (a.r - b.r).abs() < 1e-3 * exact));
+}
+
+/// The per-vertex scheme keeps the closed-box energy balance too, and is
+/// deterministic across thread counts.
+#[test]
+fn per_vertex_unshot_balances_energy_and_is_deterministic() {
+    let s = scene(
+        closed_box(2.0, [1, 2, 1, 0, 1, 2]),
+        vec![
+            grey("lamp", 10.0, 0.3),
+            grey("a", 0.0, 0.7),
+            grey("b", 0.0, 0.4),
+        ],
+    );
+    let options = SolverOptions {
+        threshold: 1e-5,
+        unshot: UnshotScheme::Vertex,
+        ..Default::default()
+    };
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| solve(&s, 0.1, crate::mesh::DEFAULT_INSET, options))
+    };
+    let (one, two) = (run(1), run(2));
+    assert!(one
+        .radiosity
+        .iter()
+        .zip(&two.radiosity)
+        .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+    let mut absorbed = 0.0;
+    for (p, polygon) in s.polygons.iter().enumerate() {
+        let material = &s.materials[polygon.material.index()];
+        let rho = material.reflectance().r;
+        let b = mean_radiosity(&one.mesh, &one.radiosity, p).r;
+        absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
+    }
+    let balance = (absorbed + one.unshot_power - one.initial_power).abs() / one.initial_power;
+    assert!(balance < 0.01, "energy error {balance}");
+}
+
+#[test]
+fn barycentric_weights_reproduce_the_point() {
+    let (a, b, c) = (
+        glam::Vec3::ZERO,
+        glam::Vec3::new(2.0, 0.0, 0.0),
+        glam::Vec3::new(0.0, 1.0, 1.0),
+    );
+    let p = a * 0.2 + b * 0.5 + c * 0.3;
+    let w = super::barycentric(p, a, b, c);
+    assert!(
+        (w[0] - 0.2).abs() < 1e-6 && (w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.3).abs() < 1e-6,
+        "{w:?}"
+    );
+    assert_eq!(super::barycentric(p, a, a, a), [0.0; 3]);
+}
+
+/// The sampled form factor (64 samples, near field on) from points in
+/// front of a unit square against Lambert's exact contour integral at 2,000
+/// random unoccluded points (0.05 to 2 units above it, up to a unit to the
+/// side, facing it at random). Measured: median error 0.17 %, 95th
+/// percentile 1.0 %, worst 2.2 % — at points low over the plane
+/// beside the square, facing it sideways, where one cosine per cell is a
+/// poor stand-in for the cell. The 0.5 % everywhere that the accuracy work
+/// aims at is not reached yet; this test holds what is.
+#[test]
+fn point_to_square_matches_lambert_at_random_points() {
+    use super::formfactor::{point_to_polygon, point_to_samples, shooter_samples, SampleSet};
+    let square = polygon(0, &BOTTOM);
+    let s = scene(vec![square.clone()], vec![grey("lamp", 1.0, 0.0)]);
+    let m = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.02,
+            inset: 0.0,
+        },
+    )
+    .unwrap();
+    let samples = shooter_samples(
+        &square,
+        &m.polygons[0],
+        &m,
+        SampleSet::AtMost(DEFAULT_SHOOTER_SAMPLES),
+    );
+    let corners: Vec<glam::Vec3> = square.vertices.clone();
+    let mut seed = 0xfeed_5eed_1234_5678u64;
+    let mut rand = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f32 / (1u64 << 53) as f32
+    };
+    let mut errors = Vec::new();
+    while errors.len() < 2000 {
+        let x = glam::Vec3::new(
+            -1.0 + 3.0 * rand(),
+            -1.0 + 3.0 * rand(),
+            0.05 + 2.0 * rand(),
+        );
+        let to_square = (glam::Vec3::new(0.5, 0.5, 0.0) - x).normalize();
+        let jitter = glam::Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5) * 0.8;
+        let n = (to_square + jitter).normalize();
+        // The whole square in front of the receiver's tangent plane.
+        if corners.iter().any(|c| n.dot(*c - x) <= 0.0) {
+            continue;
+        }
+        let exact = point_to_polygon(x, n, &corners);
+        let (f, _) = point_to_samples(x, n, glam::Vec3::Z, &samples, true, |_, _| false);
+        errors.push((f - exact).abs() / exact);
+    }
+    errors.sort_by(f64::total_cmp);
+    let (median, p95, worst) = (errors[1000], errors[1900], errors[1999]);
+    eprintln!("median {median}, 95th percentile {p95}, worst {worst}");
+    assert!(
+        median < 0.003 && p95 < 0.015 && worst < 0.03,
+        "median {median}, p95 {p95}, worst {worst}"
+    );
+}
+
+/// Reciprocity: for two unequal polygons, `A_i F_ij = A_j F_ji` within 1 %.
+#[test]
+fn reciprocity_of_measured_form_factors() {
+    // A 1 × 2 rectangle and a unit square facing it, offset and tilted.
+    let big = [[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]];
+    let small = [
+        [0.5, 0.2, 1.2],
+        [0.5, 1.0, 1.8],
+        [1.5, 1.0, 1.8],
+        [1.5, 0.2, 1.2],
+    ];
+    let f_small_to_big = measured_form_factor(big, small, SolverOptions::default());
+    let f_big_to_small = measured_form_factor(small, big, SolverOptions::default());
+    let (a_big, a_small) = (polygon(0, &big).area, polygon(0, &small).area);
+    let (lhs, rhs) = (a_small * f_small_to_big, a_big * f_big_to_small);
+    assert!(
+        (lhs - rhs).abs() < 0.01 * lhs.max(rhs),
+        "A_s F_sb = {lhs}, A_b F_bs = {rhs}"
+    );
+}
+
+/// Grid independence: halving lenmax changes the mean radiosity of each
+/// wall of the Cornell box by less than 1 %.
+#[test]
+fn cornell_walls_are_grid_independent() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.sc");
+    let s = crate::scene::load(&path).unwrap();
+    let coarse_lenmax = MeshOptions::for_scene(&s).lenmax;
+    let options = SolverOptions::default();
+    let coarse = solve(&s, coarse_lenmax, crate::mesh::DEFAULT_INSET, options);
+    let fine = solve(&s, coarse_lenmax / 2.0, crate::mesh::DEFAULT_INSET, options);
+    // The five walls: floor, ceiling, back, right, left (the first polygons
+    // after the light in the file are the room's; check by reflectance).
+    let mut checked = 0;
+    for (p, polygon) in s.polygons.iter().enumerate() {
+        if polygon.area < 200_000.0 {
+            continue; // blocks and the light
+        }
+        let (a, b) = (
+            mean_radiosity(&coarse.mesh, &coarse.radiosity, p),
+            mean_radiosity(&fine.mesh, &fine.radiosity, p),
+        );
+        for (x, y) in a.to_array().into_iter().zip(b.to_array()) {
+            assert!((x - y).abs() < 0.01 * y, "polygon {p}: {a:?} vs {b:?}");
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, 5);
 }
