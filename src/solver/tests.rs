@@ -235,41 +235,42 @@ fn uniform_enclosure() {
 /// `1 − rho`); the unshot power left at the end counts as not yet absorbed.
 #[test]
 fn energy_balance_in_a_closed_box() {
-    // A box whose ceiling glows and reflects, with walls of different
-    // reflectances. (A lamp hanging inside would absorb light on its black
-    // back, which no wall's balance sees.)
-    let s = scene(
+    let s = glowing_box();
+    let options = SolverOptions {
+        threshold: 1e-5,
+        unshot: UnshotScheme::Polygon,
+        ..Default::default()
+    };
+    let solved = solve(&s, 0.05, crate::mesh::DEFAULT_INSET, options);
+    let error = energy_error(&s, &solved);
+    assert!(error < 0.01, "energy error {error}");
+}
+
+/// A box whose ceiling glows and reflects, with walls of different
+/// reflectances. (A lamp hanging inside would absorb light on its black
+/// back, which no wall's balance sees.)
+fn glowing_box() -> Scene {
+    scene(
         closed_box(2.0, [1, 2, 1, 0, 1, 2]),
         vec![
             grey("lamp", 10.0, 0.3),
             grey("a", 0.0, 0.7),
             grey("b", 0.0, 0.4),
         ],
-    );
-    let solved = solve(
-        &s,
-        0.05,
-        crate::mesh::DEFAULT_INSET,
-        SolverOptions {
-            threshold: 1e-5,
-            ..Default::default()
-        },
-    );
+    )
+}
+
+/// `|absorbed + unshot − emitted| / emitted` of a solve of a closed scene
+/// whose every polygon reflects.
+fn energy_error(s: &Scene, solved: &Solved) -> f64 {
     let mut absorbed = 0.0;
     for (p, polygon) in s.polygons.iter().enumerate() {
         let material = &s.materials[polygon.material.index()];
         let rho = material.reflectance().r;
-        if rho > 0.0 {
-            let b = mean_radiosity(&solved.mesh, &solved.radiosity, p).r;
-            absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
-        }
+        let b = mean_radiosity(&solved.mesh, &solved.radiosity, p).r;
+        absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
     }
-    let emitted = solved.initial_power;
-    let balance = (absorbed + solved.unshot_power - emitted).abs() / emitted;
-    assert!(
-        balance < 0.01,
-        "emitted {emitted}, absorbed {absorbed}, error {balance}"
-    );
+    (absorbed + solved.unshot_power - solved.initial_power).abs() / solved.initial_power
 }
 
 /// A floor vertex right below an opaque black square gets no direct
@@ -561,14 +562,7 @@ fn ambient_term_completes_the_uniform_enclosure_and_vanishes() {
 /// deterministic across thread counts.
 #[test]
 fn per_vertex_unshot_balances_energy_and_is_deterministic() {
-    let s = scene(
-        closed_box(2.0, [1, 2, 1, 0, 1, 2]),
-        vec![
-            grey("lamp", 10.0, 0.3),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    );
+    let s = glowing_box();
     let options = SolverOptions {
         threshold: 1e-5,
         unshot: UnshotScheme::Vertex,
@@ -587,15 +581,8 @@ fn per_vertex_unshot_balances_energy_and_is_deterministic() {
         .iter()
         .zip(&two.radiosity)
         .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
-    let mut absorbed = 0.0;
-    for (p, polygon) in s.polygons.iter().enumerate() {
-        let material = &s.materials[polygon.material.index()];
-        let rho = material.reflectance().r;
-        let b = mean_radiosity(&one.mesh, &one.radiosity, p).r;
-        absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
-    }
-    let balance = (absorbed + one.unshot_power - one.initial_power).abs() / one.initial_power;
-    assert!(balance < 0.01, "energy error {balance}");
+    let error = energy_error(&s, &one);
+    assert!(error < 0.01, "energy error {error}");
 }
 
 #[test]
