@@ -257,10 +257,10 @@ fn without_a_display_it_says_why_and_writes_the_picture() {
 fn no_window_flag_runs_in_batch_even_with_a_display() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene("cornell.sc");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .current_dir(dir.path())
-        .env("DISPLAY", ":12345")
-        .args([
+    let out = run_with_display(
+        dir.path(),
+        ":12345",
+        &[
             scene.to_str().unwrap(),
             "--no-window",
             "--lenmax",
@@ -270,9 +270,8 @@ fn no_window_flag_runs_in_batch_even_with_a_display() {
             "--max-steps",
             "2",
             "-q",
-        ])
-        .output()
-        .unwrap();
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(dir.path().join("cornell.png").exists());
 }
@@ -281,10 +280,10 @@ fn no_window_flag_runs_in_batch_even_with_a_display() {
 fn an_unreachable_display_falls_back_to_batch() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene("cornell.sc");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .current_dir(dir.path())
-        .env("DISPLAY", ":12345")
-        .args([
+    let out = run_with_display(
+        dir.path(),
+        ":12345",
+        &[
             scene.to_str().unwrap(),
             "--lenmax",
             "120",
@@ -292,9 +291,8 @@ fn an_unreachable_display_falls_back_to_batch() {
             "32x32",
             "--max-steps",
             "2",
-        ])
-        .output()
-        .unwrap();
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("cannot open a window"),

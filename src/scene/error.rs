@@ -65,6 +65,17 @@ pub struct LoadError {
 }
 
 impl LoadError {
+    /// The diagnostics as an error: sorted by file, then position (stable,
+    /// so several messages at one place keep their order), at most
+    /// [`MAX_DIAGNOSTICS`](super::MAX_DIAGNOSTICS).
+    pub fn from_diagnostics(mut diagnostics: Vec<Diagnostic>) -> LoadError {
+        diagnostics.sort_by(|a, b| {
+            (a.file.as_str(), a.line, a.col).cmp(&(b.file.as_str(), b.line, b.col))
+        });
+        diagnostics.truncate(super::MAX_DIAGNOSTICS);
+        LoadError { diagnostics }
+    }
+
     /// The first problem, the one a user should fix first.
     pub fn first(&self) -> Option<&Diagnostic> {
         self.diagnostics.first()

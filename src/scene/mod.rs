@@ -209,20 +209,23 @@ impl Scene {
     /// Axis-aligned bounds `(min, max)` of all vertices, in scene units.
     /// For an empty scene both are zero.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut it = self
-            .polygons
-            .iter()
-            .flat_map(|p| p.vertices.iter().copied());
-        match it.next() {
-            None => (Vec3::ZERO, Vec3::ZERO),
-            Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),
-        }
+        polygon_bounds(&self.polygons)
     }
 
     /// Length of the diagonal of [`Scene::bounds`], in scene units.
     pub fn extent(&self) -> f32 {
         let (lo, hi) = self.bounds();
         (hi - lo).length()
+    }
+}
+
+/// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, in
+/// scene units; both zero when there are none.
+pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
+    let mut it = polygons.iter().flat_map(|p| p.vertices.iter().copied());
+    match it.next() {
+        None => (Vec3::ZERO, Vec3::ZERO),
+        Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),
     }
 }
 

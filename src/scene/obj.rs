@@ -111,7 +111,7 @@ pub(crate) fn parse_obj(
     let scan = scan_obj(text, file);
     let mut diags = scan.diags.clone();
     if diags.len() >= MAX_DIAGNOSTICS {
-        return Err(finish_diags(diags));
+        return Err(LoadError::from_diagnostics(diags));
     }
 
     // tobj reads the text through a reader that remembers how far it got,
@@ -172,7 +172,7 @@ pub(crate) fn parse_obj(
     let models = match loaded {
         Ok((models, _)) => models,
         // The scan found the mistake already, with its column.
-        Err(_) if !scan.diags.is_empty() => return Err(finish_diags(diags)),
+        Err(_) if !scan.diags.is_empty() => return Err(LoadError::from_diagnostics(diags)),
         Err(e) => {
             let line = line_at(text, consumed.get());
             diags.push(Diagnostic::new(
@@ -183,7 +183,7 @@ pub(crate) fn parse_obj(
                 },
                 format!("cannot read OBJ: {e}"),
             ));
-            return Err(finish_diags(diags));
+            return Err(LoadError::from_diagnostics(diags));
         }
     };
 
@@ -264,7 +264,7 @@ pub(crate) fn parse_obj(
                     FILE_START,
                     "internal error: the OBJ reader returned more faces than the file has `f` lines",
                 ));
-                return Err(finish_diags(diags));
+                return Err(LoadError::from_diagnostics(diags));
             };
             if face.is_line {
                 // An `l` line with three or more vertices comes out of
@@ -292,12 +292,12 @@ pub(crate) fn parse_obj(
         diags.push(Diagnostic::new(file, FILE_START, "OBJ file has no faces"));
     }
     if !diags.is_empty() {
-        return Err(finish_diags(diags));
+        return Err(LoadError::from_diagnostics(diags));
     }
     let (camera, camera_source) = match camera {
         Some(c) => (c, CameraSource::File),
         None => {
-            let (lo, hi) = bounds(&polygons);
+            let (lo, hi) = super::polygon_bounds(&polygons);
             (Camera::frame(lo, hi), CameraSource::AutoFramed)
         }
     };
@@ -307,26 +307,6 @@ pub(crate) fn parse_obj(
         camera,
         camera_source,
     })
-}
-
-/// The diagnostics as an error: sorted by file, then position (stable, so
-/// several messages at one place keep their order), at most
-/// [`MAX_DIAGNOSTICS`].
-fn finish_diags(mut diags: Vec<Diagnostic>) -> LoadError {
-    diags.sort_by(|a, b| (a.file.as_str(), a.line, a.col).cmp(&(b.file.as_str(), b.line, b.col)));
-    diags.truncate(MAX_DIAGNOSTICS);
-    LoadError { diagnostics: diags }
-}
-
-fn bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
-    polygons
-        .iter()
-        .flat_map(|p| p.vertices.iter().copied())
-        .fold(None, |acc: Option<(Vec3, Vec3)>, v| match acc {
-            None => Some((v, v)),
-            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
-        })
-        .unwrap_or((Vec3::ZERO, Vec3::ZERO))
 }
 
 // ------------------------------------------------------------ faces --

@@ -1225,7 +1225,7 @@ impl<'a> Parser<'a> {
         let (camera, camera_source) = match self.camera {
             Some(c) => (c, CameraSource::File),
             None => {
-                let (lo, hi) = bounds(&self.polygons);
+                let (lo, hi) = super::polygon_bounds(&self.polygons);
                 (Camera::frame(lo, hi), CameraSource::AutoFramed)
             }
         };
@@ -1256,26 +1256,10 @@ impl<'a> Parser<'a> {
             self.error(FILE_START, "scene has no polygons");
         }
         if !self.diags.is_empty() {
-            // Stable, so messages at one position keep the order they were
-            // found in.
-            let mut diags = std::mem::take(&mut self.diags);
-            diags.sort_by_key(|d| (d.line, d.col));
-            diags.truncate(MAX_DIAGNOSTICS);
-            return Err(LoadError { diagnostics: diags });
+            return Err(LoadError::from_diagnostics(std::mem::take(&mut self.diags)));
         }
         Ok(())
     }
-}
-
-fn bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
-    polygons
-        .iter()
-        .flat_map(|p| p.vertices.iter().copied())
-        .fold(None, |acc: Option<(Vec3, Vec3)>, v| match acc {
-            None => Some((v, v)),
-            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
-        })
-        .unwrap_or((Vec3::ZERO, Vec3::ZERO))
 }
 
 /// The six faces of the box `lo..hi`, each counter-clockwise seen from

@@ -553,6 +553,8 @@ impl<'a> Progressive<'a> {
         let visibility = self.visibility;
         let culling = self.options.shaft_culling;
         let receives = &self.receives;
+        // Shooter samples are culled in groups of SHOOTER_GROUP.
+        let groups = self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1);
         if culling {
             self.candidates
                 .par_iter_mut()
@@ -566,7 +568,6 @@ impl<'a> Progressive<'a> {
                 });
             // Thin shafts between small groups of shooter samples and of
             // receiver vertices, searched among their polygons' candidates.
-            let groups = self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1);
             self.group_points.clear();
             self.group_points
                 .extend(self.samples[i].iter().map(|s| s.position));
@@ -595,7 +596,6 @@ impl<'a> Progressive<'a> {
                     }
                 });
         }
-        let groups = self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1);
         let tile_candidates = &self.tile_candidates;
         let tile_of = &self.tile_of;
         let samples = &self.samples[i];

@@ -340,6 +340,32 @@ fn room_with_lamp(size: f32) -> Vec<crate::scene::Polygon> {
     polygons
 }
 
+/// A lamp (material 0) and two grey reflectors (1 and 2).
+fn lamp_materials() -> Vec<crate::scene::Material> {
+    vec![
+        grey("lamp", 10.0, 0.0),
+        grey("a", 0.0, 0.7),
+        grey("b", 0.0, 0.4),
+    ]
+}
+
+/// Runs `f` on a pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// True when the two radiosity arrays are equal bit for bit.
+fn same_bits(a: &[Rgb], b: &[Rgb]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.to_array().map(f64::to_bits) == y.to_array().map(f64::to_bits))
+}
+
 /// The same solve on one thread and on two gives the same bits.
 #[test]
 fn thread_count_does_not_change_the_result() {
@@ -353,37 +379,17 @@ fn thread_count_does_not_change_the_result() {
             [0.5, 0.5, 1.5],
         ],
     ));
-    let s = scene(
-        polygons,
-        vec![
-            grey("lamp", 10.0, 0.0),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    );
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| {
-                solve(
-                    &s,
-                    0.15,
-                    crate::mesh::DEFAULT_INSET,
-                    SolverOptions {
-                        max_steps: Some(20),
-                        ..Default::default()
-                    },
-                )
-                .radiosity
-            })
+    let s = scene(polygons, lamp_materials());
+    let options = SolverOptions {
+        max_steps: Some(20),
+        ..Default::default()
     };
-    let (one, two) = (run(1), run(2));
-    assert!(one
-        .iter()
-        .zip(&two)
-        .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+    let run = |threads| {
+        on_threads(threads, || {
+            solve(&s, 0.15, crate::mesh::DEFAULT_INSET, options)
+        })
+    };
+    assert!(same_bits(&run(1).radiosity, &run(2).radiosity));
 }
 
 #[test]
@@ -462,14 +468,7 @@ fn shaft_culling_changes_no_result_bit() {
             [3.2, 2.5, 0.2],
         ],
     ));
-    let s = scene(
-        polygons,
-        vec![
-            grey("lamp", 10.0, 0.0),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    );
+    let s = scene(polygons, lamp_materials());
     let mesh = mesh::build(
         &s,
         &MeshOptions {
@@ -500,10 +499,7 @@ fn shaft_culling_changes_no_result_bit() {
     };
     let (culled, culled_rays, culled_pairs, (receivers, clear)) = run(true);
     let (exact, exact_rays, exact_pairs, _) = run(false);
-    assert!(culled
-        .iter()
-        .zip(&exact)
-        .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+    assert!(same_bits(&culled, &exact));
     assert_eq!(culled_pairs, exact_pairs);
     assert_eq!(exact_rays, exact_pairs);
     assert!(culled_rays < exact_rays, "{culled_rays} vs {exact_rays}");
@@ -568,19 +564,13 @@ fn per_vertex_unshot_balances_energy_and_is_deterministic() {
         unshot: UnshotScheme::Vertex,
         ..Default::default()
     };
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| solve(&s, 0.1, crate::mesh::DEFAULT_INSET, options))
+    let run = |threads| {
+        on_threads(threads, || {
+            solve(&s, 0.1, crate::mesh::DEFAULT_INSET, options)
+        })
     };
     let (one, two) = (run(1), run(2));
-    assert!(one
-        .radiosity
-        .iter()
-        .zip(&two.radiosity)
-        .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+    assert!(same_bits(&one.radiosity, &two.radiosity));
     let error = energy_error(&s, &one);
     assert!(error < 0.01, "energy error {error}");
 }

@@ -28,6 +28,18 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Output {
         .expect("the radiosity binary runs")
 }
 
+/// Runs the `radiosity` binary with `args` in `dir` with `DISPLAY` set to
+/// `display` (a display that need not exist).
+pub fn run_with_display(dir: &Path, display: &str, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .current_dir(dir)
+        .env("DISPLAY", display)
+        .env_remove("WAYLAND_DISPLAY")
+        .args(args)
+        .output()
+        .expect("the radiosity binary runs")
+}
+
 /// Standard error of a run, as text.
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
