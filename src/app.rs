@@ -22,6 +22,7 @@
 //! continues to the same bits an uninterrupted one gives.
 
 use crate::color::Rgb;
+use crate::mesh::refine::{RefineOptions, Refiner};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions, MeshSize};
 use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, MeshFormat, OutputError, PictureFormat};
@@ -32,6 +33,7 @@ use crate::solver::{Progressive, SolverOptions, StepReport, StopReason};
 use crate::visibility::Visibility;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
+use std::borrow::Cow;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -139,6 +141,11 @@ pub struct RunConfig {
     /// Add the ambient term ([`Progressive::ambient`]) to the radiosity
     /// shown: `None` for the default, on in the window and off for files.
     pub ambient: Option<bool>,
+    /// Refine the mesh where the solution changes sharply and solve again
+    /// ([`mesh::refine`]), or `None` to solve on the regular mesh only.
+    pub adaptive: Option<RefineOptions>,
+    /// Draw the element mesh over the picture (8-bit pictures only).
+    pub mesh_lines: bool,
 }
 
 impl RunConfig {
@@ -163,15 +170,18 @@ impl RunConfig {
             checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
             resume: None,
             ambient: None,
+            adaptive: None,
+            mesh_lines: false,
         }
     }
 }
 
 impl RunConfig {
     /// True when the run asks for results only a batch run writes (the
-    /// mesh export, the log or the plot), so no window should open.
+    /// mesh export, the log, the plot or mesh lines on the picture), so no
+    /// window should open.
     pub fn wants_batch_outputs(&self) -> bool {
-        self.export.is_some() || self.log.is_some() || self.plot.is_some()
+        self.export.is_some() || self.log.is_some() || self.plot.is_some() || self.mesh_lines
     }
 
     /// Every file the batch run writes besides the picture.
@@ -248,6 +258,9 @@ pub enum RunError {
     /// The camera or picture size is unusable.
     #[error("{0}")]
     View(#[from] ViewError),
+    /// Options that cannot be combined.
+    #[error("{0}")]
+    Options(String),
     /// An output path is unusable before anything was computed.
     #[error("{0}")]
     BadOutput(OutputError),
@@ -332,8 +345,206 @@ pub struct RunStats {
     pub exposure: f32,
     /// True when the threshold was reached (false: step limit).
     pub converged: bool,
+    /// With `--adaptive`, one entry per solve, the coarsest first; the
+    /// counts above are the last solve's. Empty (and not written) without.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub adaptive: Vec<PassStats>,
     /// Seconds per phase.
     pub seconds: PhaseSeconds,
+}
+
+/// One solve of an adaptive run (see [`RunStats::adaptive`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PassStats {
+    /// Mesh elements of this solve.
+    pub elements: usize,
+    /// Mesh vertices of this solve.
+    pub vertices: usize,
+    /// Shooting steps it took.
+    pub steps: u64,
+    /// Shadow rays it cast.
+    pub rays: u64,
+    /// Seconds it took, refinement of its result included.
+    pub seconds: f64,
+    /// Elements its result marked for splitting (0 for the last solve).
+    pub split: usize,
+    /// Further elements split to keep the mesh conforming.
+    pub closure: usize,
+}
+
+/// A solve's result, detached from the solver (and its mesh borrow).
+#[derive(Clone, Debug)]
+pub struct Solved {
+    /// Radiosity per vertex of the mesh it was solved on.
+    pub radiosity: Vec<Rgb>,
+    /// The radiosity to draw: with the ambient term when
+    /// [`RunConfig::ambient`] asks for it, else the radiosity.
+    pub shown: Vec<Rgb>,
+    /// Shooting steps taken.
+    pub steps: u64,
+    /// Shadow rays cast.
+    pub rays: u64,
+    /// Sample–vertex pairs whose visibility mattered.
+    pub pairs: u64,
+    /// Shooter–receiver polygon pairs, and how many had a clear shaft.
+    pub receiver_pairs: (u64, u64),
+    /// Unshot power left as a fraction of the emitted power.
+    pub unshot_fraction: f64,
+    /// True when the threshold was reached (false: step limit).
+    pub converged: bool,
+    /// Every step, with the time from the start of the solve.
+    pub steps_taken: Vec<(StepReport, Duration)>,
+}
+
+/// The result of [`solve`]: the mesh the solution lives on (the prepared
+/// one, or its adaptive refinement) and the solution.
+#[derive(Clone, Debug)]
+pub struct Solution<'p> {
+    /// The mesh of the last solve.
+    pub mesh: Cow<'p, Mesh>,
+    /// The last solve.
+    pub solved: Solved,
+    /// One entry per solve with [`RunConfig::adaptive`], else empty.
+    pub passes: Vec<PassStats>,
+}
+
+/// Solves the prepared scene as `config` says: once on the prepared mesh,
+/// or (with [`RunConfig::adaptive`]) adaptively, refining and solving
+/// again. Stops promptly with [`RunError::Interrupted`] once `cancel` is
+/// set. Checkpoints are refused with adaptive refinement.
+pub fn solve<'p>(
+    config: &RunConfig,
+    prepared: &'p Prepared,
+    cancel: &AtomicBool,
+) -> Result<Solution<'p>, RunError> {
+    match config.adaptive {
+        None => Ok(Solution {
+            mesh: Cow::Borrowed(&prepared.mesh),
+            solved: solve_mesh(config, prepared, &prepared.mesh, cancel)?,
+            passes: Vec::new(),
+        }),
+        Some(options) => {
+            if config.checkpoint.is_some() || config.resume.is_some() {
+                return Err(RunError::Options(
+                    "--adaptive cannot be combined with --checkpoint or --resume: \
+                     a checkpoint holds one mesh, and refinement changes it"
+                        .into(),
+                ));
+            }
+            let (mesh, solved, passes) = solve_adaptive(config, prepared, &options, cancel)?;
+            Ok(Solution {
+                mesh: Cow::Owned(mesh),
+                solved,
+                passes,
+            })
+        }
+    }
+}
+
+/// Solves on `mesh` (the prepared mesh or a refinement of it), resuming
+/// and saving checkpoints as `config` asks.
+fn solve_mesh(
+    config: &RunConfig,
+    prepared: &Prepared,
+    mesh: &Mesh,
+    cancel: &AtomicBool,
+) -> Result<Solved, RunError> {
+    let mut solver = Progressive::new(&prepared.scene, mesh, &prepared.visibility, config.solver);
+    let fingerprint = checkpoint::fingerprint(&prepared.scene, mesh, &config.solver);
+    if let Some(path) = &config.resume {
+        checkpoint::resume(path, fingerprint, &mut solver)?;
+    }
+    let plan = config.checkpoint.as_deref().map(|path| CheckpointPlan {
+        path,
+        every: config.checkpoint_every,
+        fingerprint,
+    });
+    let steps_taken = solve_cancellable(&mut solver, config.progress, cancel, plan.as_ref())?;
+    solver
+        .validate()
+        .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
+    // The ambient term only when asked for: a file shows the solution.
+    let shown = if config.ambient == Some(true) {
+        let mut shown = Vec::new();
+        solver.radiosity_with_ambient(&mut shown);
+        shown
+    } else {
+        solver.radiosity().to_vec()
+    };
+    Ok(Solved {
+        radiosity: solver.radiosity().to_vec(),
+        shown,
+        steps: solver.steps(),
+        rays: solver.rays(),
+        pairs: solver.pairs(),
+        receiver_pairs: solver.receiver_pairs(),
+        unshot_fraction: solver.unshot_fraction(),
+        converged: solver.stop_reason() == Some(StopReason::Converged),
+        steps_taken,
+    })
+}
+
+/// Solves, refines where the solution's luminance changes sharply, and
+/// solves again on the refined mesh, until nothing needs splitting or
+/// `options.levels` refinements are done. Each solve starts afresh: a
+/// converged solve on the final mesh, as if it had been built that way.
+fn solve_adaptive(
+    config: &RunConfig,
+    prepared: &Prepared,
+    options: &RefineOptions,
+    cancel: &AtomicBool,
+) -> Result<(Mesh, Solved, Vec<PassStats>), RunError> {
+    let mut refiner = Refiner::new(&prepared.mesh);
+    let mut mesh = prepared.mesh.clone();
+    let mut passes = Vec::new();
+    loop {
+        let t = Instant::now();
+        let solved = solve_mesh(config, prepared, &mesh, cancel)?;
+        let mut pass = PassStats {
+            elements: mesh.elements.len(),
+            vertices: mesh.vertex_count(),
+            steps: solved.steps,
+            rays: solved.rays,
+            seconds: 0.0,
+            split: 0,
+            closure: 0,
+        };
+        let next = if refiner.passes() < options.levels {
+            let luminance: Vec<f64> = solved.radiosity.iter().map(|b| b.luminance()).collect();
+            refiner.refine(&prepared.scene, &luminance, options)
+        } else {
+            None
+        };
+        pass.seconds = t.elapsed().as_secs_f64();
+        if config.progress {
+            eprintln!(
+                "adaptive pass {}: {} elements, {} steps, {:.2} s{}",
+                passes.len() + 1,
+                pass.elements,
+                pass.steps,
+                pass.seconds,
+                match &next {
+                    Some((_, r)) => format!(
+                        "; splitting {} elements (+{} to stay conforming)",
+                        r.marked, r.closure
+                    ),
+                    None => "; final".to_string(),
+                }
+            );
+        }
+        match next {
+            Some((refined, report)) => {
+                pass.split = report.marked;
+                pass.closure = report.closure;
+                passes.push(pass);
+                mesh = refined;
+            }
+            None => {
+                passes.push(pass);
+                return Ok((mesh, solved, passes));
+            }
+        }
+    }
 }
 
 /// A scene loaded, meshed and put in a BVH: what both the batch run and
@@ -483,7 +694,13 @@ pub fn output_path(config: &RunConfig) -> PathBuf {
 /// same file, or a checkpoint to resume from that cannot be read.
 pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     let output = output_path(config);
-    PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
+    let format = PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
+    if config.mesh_lines && matches!(format, PictureFormat::Exr | PictureFormat::Pfm) {
+        return Err(RunError::BadOutput(OutputError::UnknownFormat {
+            path: output,
+            reason: "mesh lines are drawn on 8-bit pictures: use .png, .tif or .tiff".into(),
+        }));
+    }
     if let Some(export) = &config.export {
         MeshFormat::from_path(export).map_err(RunError::BadOutput)?;
     }
@@ -575,43 +792,24 @@ pub fn run_prepared_cancellable(
     let view = prepared.view(config)?;
 
     let t = Instant::now();
-    let mut solver = Progressive::new(
-        &prepared.scene,
-        &prepared.mesh,
-        &prepared.visibility,
-        config.solver,
-    );
-    let fingerprint = checkpoint::fingerprint(&prepared.scene, &prepared.mesh, &config.solver);
-    if let Some(path) = &config.resume {
-        checkpoint::resume(path, fingerprint, &mut solver)?;
-    }
-    let plan = config.checkpoint.as_deref().map(|path| CheckpointPlan {
-        path,
-        every: config.checkpoint_every,
-        fingerprint,
-    });
-    let steps = solve_cancellable(&mut solver, config.progress, cancel, plan.as_ref())?;
+    let Solution {
+        mesh,
+        solved,
+        passes,
+    } = solve(config, prepared, cancel)?;
     seconds.solve = t.elapsed().as_secs_f64();
-    solver
-        .validate()
-        .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
+    let mesh: &Mesh = &mesh;
 
     let interrupted = || RunError::Interrupted {
-        steps: solver.steps(),
+        steps: solved.steps,
         checkpoint: config.checkpoint.clone(),
     };
     if cancel.load(Ordering::SeqCst) {
         return Err(interrupted());
     }
     let t = Instant::now();
-    // The ambient term only when asked for: a file shows the solution.
-    let frame = if config.ambient == Some(true) {
-        let mut shown = Vec::new();
-        solver.radiosity_with_ambient(&mut shown);
-        render(&prepared.mesh, &shown, &view)?
-    } else {
-        render(&prepared.mesh, solver.radiosity(), &view)?
-    };
+    let mut rasterizer = Rasterizer::new();
+    let frame = rasterizer.render(mesh, &solved.shown, &view)?;
     seconds.render = t.elapsed().as_secs_f64();
 
     if cancel.load(Ordering::SeqCst) {
@@ -619,13 +817,26 @@ pub fn run_prepared_cancellable(
     }
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree.
-    let exposure = config.exposure.resolve(&frame);
-    output::write_picture(&output, &frame, Exposure::Fixed(exposure)).map_err(RunError::Write)?;
-    if let Some(path) = &config.export {
-        output::write_mesh(path, &prepared.mesh, solver.radiosity(), exposure)
+    let exposure = config.exposure.resolve(frame);
+    if config.mesh_lines {
+        let mut picture = crate::render::to_srgb8(frame, exposure);
+        crate::render::draw_mesh_edges(
+            &mut picture,
+            mesh,
+            &view,
+            rasterizer.inv_depth(),
+            crate::render::MESH_COLOR,
+        );
+        output::write_rgb8(&output, &picture).map_err(RunError::Write)?;
+    } else {
+        output::write_picture(&output, frame, Exposure::Fixed(exposure))
             .map_err(RunError::Write)?;
     }
-    let records: Vec<StepRecord> = steps
+    if let Some(path) = &config.export {
+        output::write_mesh(path, mesh, &solved.radiosity, exposure).map_err(RunError::Write)?;
+    }
+    let records: Vec<StepRecord> = solved
+        .steps_taken
         .iter()
         .map(|&(report, elapsed)| StepRecord {
             report,
@@ -649,23 +860,24 @@ pub fn run_prepared_cancellable(
         scene: config.scene.display_name(),
         output: output.display().to_string(),
         polygons: prepared.scene.polygons.len(),
-        elements: prepared.mesh.elements.len(),
-        vertices: prepared.mesh.vertex_count(),
+        elements: mesh.elements.len(),
+        vertices: mesh.vertex_count(),
         lenmax: prepared.lenmax,
-        steps: solver.steps(),
-        rays: solver.rays(),
-        pairs: solver.pairs(),
+        steps: solved.steps,
+        rays: solved.rays,
+        pairs: solved.pairs,
         clear_shaft_fraction: {
-            let (all, clear) = solver.receiver_pairs();
+            let (all, clear) = solved.receiver_pairs;
             if all > 0 {
                 clear as f64 / all as f64
             } else {
                 0.0
             }
         },
-        unshot_fraction: solver.unshot_fraction(),
+        unshot_fraction: solved.unshot_fraction,
         exposure,
-        converged: solver.stop_reason() == Some(StopReason::Converged),
+        converged: solved.converged,
+        adaptive: passes,
         seconds,
     };
     stats.seconds.write = t.elapsed().as_secs_f64();

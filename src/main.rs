@@ -5,6 +5,7 @@
 
 use clap::Parser;
 use radiosity::app::{self, RunConfig, SceneSource};
+use radiosity::mesh::refine::{self, RefineOptions};
 use radiosity::mesh::DEFAULT_INSET;
 use radiosity::render::Exposure;
 use radiosity::solver::{
@@ -89,6 +90,29 @@ struct Args {
     /// lit evenly: the original algorithm).
     #[arg(long, value_name = "SCHEME", default_value = "vertex", value_parser = ["vertex", "polygon"])]
     unshot: String,
+
+    /// Adaptive subdivision: once the solve converges, split the elements
+    /// whose vertex luminances differ by more than --adaptive-threshold
+    /// (relative to the largest), keep the mesh crack-free, and solve again
+    /// on the refined mesh; repeat up to --adaptive-levels times. Sharpens
+    /// shadow boundaries where the regular mesh blurs them.
+    #[arg(long, conflicts_with_all = ["checkpoint", "resume"])]
+    adaptive: bool,
+
+    /// Split an element when its vertex luminances differ by more than this
+    /// fraction of the largest of them (with --adaptive).
+    #[arg(long, value_name = "T", default_value_t = refine::DEFAULT_THRESHOLD, requires = "adaptive")]
+    adaptive_threshold: f64,
+
+    /// Split each initial element at most this many times, each halving
+    /// its edges (with --adaptive).
+    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS, requires = "adaptive")]
+    adaptive_levels: u32,
+
+    /// Draw the element mesh over the written picture (.png or .tiff), as
+    /// the window's `m` key does.
+    #[arg(long)]
+    mesh_lines: bool,
 
     /// Picture size in pixels, overriding the scene's camera.
     #[arg(long, value_name = "WxH")]
@@ -177,6 +201,10 @@ const EXIT_CODES: &str =
     "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage, \
      130 interrupted (Ctrl-C; nothing is written but the --checkpoint).";
 
+/// Most refinement levels accepted: each can quadruple the elements where
+/// it splits, and six halve an element's edges 64 times.
+const MAX_ADAPTIVE_LEVELS: u32 = 6;
+
 /// A usage error found while validating arguments.
 fn usage(message: String) -> ExitCode {
     eprintln!("error: {message}");
@@ -247,6 +275,21 @@ fn config(args: &Args) -> Result<RunConfig, String> {
             args.checkpoint_every
         ));
     }
+    if !(args.adaptive_threshold.is_finite()
+        && args.adaptive_threshold > 0.0
+        && args.adaptive_threshold < 1.0)
+    {
+        return Err(format!(
+            "--adaptive-threshold must be above 0 and below 1, got {}",
+            args.adaptive_threshold
+        ));
+    }
+    if !(1..=MAX_ADAPTIVE_LEVELS).contains(&args.adaptive_levels) {
+        return Err(format!(
+            "--adaptive-levels must be between 1 and {MAX_ADAPTIVE_LEVELS}, got {}",
+            args.adaptive_levels
+        ));
+    }
     let exposure = match args.exposure {
         None => Exposure::Auto,
         Some(x) if x.is_finite() && x > 0.0 => Exposure::Fixed(x),
@@ -289,6 +332,11 @@ fn config(args: &Args) -> Result<RunConfig, String> {
             (_, true) => Some(false),
             _ => None,
         },
+        adaptive: args.adaptive.then_some(RefineOptions {
+            threshold: args.adaptive_threshold,
+            levels: args.adaptive_levels,
+        }),
+        mesh_lines: args.mesh_lines,
     })
 }
 

@@ -184,6 +184,14 @@ fn bad_options_are_usage_errors() {
         &["--size", "10by10"],
         &["--threshold", "2"],
         &["--form-factor", "magic"],
+        &["--adaptive-levels", "2"],
+        &["--adaptive", "--adaptive-levels", "0"],
+        &["--adaptive", "--adaptive-levels", "7"],
+        &["--adaptive", "--adaptive-threshold", "1.5"],
+        &["--adaptive", "--adaptive-threshold", "0"],
+        &["--adaptive", "--checkpoint", "state.ckpt"],
+        &["--adaptive", "--resume", "state.ckpt"],
+        &["--mesh-lines", "-o", "out.exr"],
     ] {
         let out = run_in(dir.path(), args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
@@ -226,6 +234,10 @@ fn help_documents_every_option() {
         "--checkpoint",
         "--checkpoint-every",
         "--resume",
+        "--adaptive",
+        "--adaptive-threshold",
+        "--adaptive-levels",
+        "--mesh-lines",
         "130 interrupted",
     ] {
         assert!(help.contains(option), "--help lacks {option}");
@@ -353,4 +365,73 @@ fn ambient_term_brightens_early_pictures_only_when_asked() {
     assert!(a.iter().zip(&b).all(|(x, y)| y >= x));
     let (sa, sb): (f32, f32) = (a.iter().sum(), b.iter().sum());
     assert!(sb > sa * 1.2, "ambient {sb} vs plain {sa}");
+}
+
+#[test]
+fn adaptive_runs_refine_and_report_each_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    let out = run_in(
+        dir.path(),
+        &[
+            scene.to_str().unwrap(),
+            "-o",
+            "out.png",
+            "--lenmax",
+            "60",
+            "--adaptive",
+            "--mesh-lines",
+            "--stats",
+            "stats.json",
+            "--export",
+            "mesh.ply",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("adaptive pass 3"), "{}", stderr(&out));
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
+            .unwrap();
+    let passes = stats["adaptive"].as_array().unwrap();
+    assert_eq!(passes.len(), 3, "{passes:?}");
+    let vertices: Vec<u64> = passes
+        .iter()
+        .map(|p| p["vertices"].as_u64().unwrap())
+        .collect();
+    assert!(vertices.windows(2).all(|w| w[1] > w[0]), "{vertices:?}");
+    assert!(passes[0]["split"].as_u64().unwrap() > 0);
+    assert_eq!(passes[2]["split"].as_u64(), Some(0));
+    // The totals describe the last, finest solve, and the export holds it.
+    assert_eq!(stats["vertices"].as_u64(), Some(vertices[2]));
+    let ply = std::fs::read(dir.path().join("mesh.ply")).unwrap();
+    let header = String::from_utf8_lossy(&ply[..ply.len().min(400)]).to_string();
+    assert!(
+        header.contains(&format!("element vertex {}", vertices[2])),
+        "{header}"
+    );
+    // Mesh lines are drawn: the cyan of the window's `m`.
+    let img = image::open(dir.path().join("out.png")).unwrap().to_rgb8();
+    let cyan = img.pixels().filter(|p| p.0 == [40, 220, 255]).count();
+    assert!(cyan > 1000, "{cyan} mesh-line pixels");
+
+    // Without --adaptive the stats have no passes.
+    let out = run_in(
+        dir.path(),
+        &[
+            scene.to_str().unwrap(),
+            "-o",
+            "plain.png",
+            "--lenmax",
+            "60",
+            "--stats",
+            "plain.json",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let plain: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("plain.json")).unwrap())
+            .unwrap();
+    assert!(plain.get("adaptive").is_none());
+    assert_eq!(plain["vertices"].as_u64(), Some(vertices[0]));
 }

@@ -182,3 +182,81 @@ fn window_writes_a_picture_and_quits_on_keys() {
         "stdout: {stdout}"
     );
 }
+
+#[test]
+fn window_refines_adaptively_and_shows_the_refined_mesh() {
+    if which("Xvfb").is_none() || which("xdotool").is_none() {
+        skip("Xvfb or xdotool is not installed");
+        return;
+    }
+    let Some((_xvfb, display)) = start_xvfb() else {
+        skip("no X server could be started");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::scene("cornell.sc");
+    let run = |adaptive: bool| {
+        let mut args = vec![
+            scene.to_str().unwrap().to_string(),
+            "--lenmax".into(),
+            "80".into(),
+            "--size".into(),
+            "160x120".into(),
+        ];
+        if adaptive {
+            args.push("--adaptive".into());
+        }
+        let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+            .args(&args)
+            .current_dir(dir.path())
+            .env("DISPLAY", &display)
+            .env_remove("WAYLAND_DISPLAY")
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut program = Reaper(child);
+        let window = wait_for(Duration::from_secs(20), || {
+            xdotool(&display, &["search", "--name", "^radiosity.*cornell"])
+                .and_then(|ids| ids.lines().next().map(str::to_string))
+        })
+        .expect("the window appears");
+        let title = wait_for(Duration::from_secs(60), || {
+            let title = xdotool(&display, &["getwindowname", &window])?;
+            title.contains("converged").then_some(title)
+        })
+        .expect("the solve converges");
+        xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus");
+        xdotool(&display, &["key", "m"]).expect("key m");
+        xdotool(&display, &["key", "w"]).expect("key w");
+        let tiff = dir.path().join("cornell-001.tiff");
+        wait_for(Duration::from_secs(10), || tiff.exists().then_some(()))
+            .expect("w writes cornell-001.tiff");
+        let img = image::open(&tiff).unwrap().to_rgb8();
+        std::fs::remove_file(&tiff).unwrap();
+        xdotool(&display, &["key", "q"]).expect("key q");
+        let status = wait_for(Duration::from_secs(5), || {
+            program.0.try_wait().ok().flatten()
+        })
+        .expect("the program exits within 5 s of q");
+        assert!(status.success(), "exit status {status}");
+        let lines = img
+            .pixels()
+            .filter(|p| p.0 == radiosity::render::MESH_COLOR)
+            .count();
+        (title, lines)
+    };
+    let (plain_title, plain_lines) = run(false);
+    let (title, lines) = run(true);
+    assert!(!plain_title.contains("refinement"), "{plain_title}");
+    assert!(
+        title.contains("converged after 2 refinements"),
+        "the title says the refinements: {title}"
+    );
+    // The refined mesh has more edges on screen than the regular one.
+    assert!(
+        lines > plain_lines + plain_lines / 10,
+        "mesh line pixels: {lines} refined, {plain_lines} regular"
+    );
+}

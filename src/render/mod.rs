@@ -22,6 +22,6 @@ pub mod raster;
 pub mod tonemap;
 
 pub use camera::{View, ViewError};
-pub use overlay::draw_mesh_edges;
+pub use overlay::{draw_mesh_edges, MESH_COLOR};
 pub use raster::{Frame, Rasterizer, RenderError};
 pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};

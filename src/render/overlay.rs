@@ -12,6 +12,10 @@ use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
 use image::RgbImage;
 
+/// Colour of element mesh lines, in the window and in pictures: a cyan
+/// that stands out from the warm and grey tones of lit interiors.
+pub const MESH_COLOR: [u8; 3] = [40, 220, 255];
+
 /// An edge pixel is drawn when its `1/z` is at least the surface's times
 /// `1 − LINE_DEPTH_BIAS`: edges lie exactly on their surface, and the
 /// picture's depth is interpolated per triangle, so equality needs slack.

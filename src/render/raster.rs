@@ -641,6 +641,8 @@ mod tests {
                 normal,
                 area: 1.0,
                 min_edge: 1.0,
+                inset: 0.0,
+                levels: 0,
             });
             self
         }

@@ -9,7 +9,8 @@
 //! ```text
 //! Δrad_l = rho_j · Δb_i · F(l → i)        (F from `formfactor`)
 //! b_l  += Δrad_l
-//! Δb_j += Δrad_l / n_j                     (n_j: vertices of j)
+//! Δb_j += Δrad_l / n_j                     (n_j: vertices of j; on a
+//!                                           refined mesh, × area share)
 //! Δb_i  = 0
 //! ```
 //!
@@ -179,6 +180,9 @@ pub struct Progressive<'a> {
     unshot: Vec<Rgb>,
     /// Per vertex: the area it stands for ([`Mesh::vertex_areas`]).
     vertex_area: Vec<f64>,
+    /// Per vertex: its weight in its polygon's mean
+    /// ([`Mesh::polygon_vertex_weights`]), for the per-polygon scheme.
+    mean_weight: Vec<f64>,
     /// Per polygon and shooter sample: where its unshot radiosity is read
     /// from (per-vertex scheme only).
     sample_sources: Vec<Vec<SampleSource>>,
@@ -310,6 +314,11 @@ impl<'a> Progressive<'a> {
             .map(|p| emission[p.index()])
             .collect();
         let vertex_area = mesh.vertex_areas();
+        let mean_weight = mesh
+            .polygons
+            .iter()
+            .flat_map(|pm| mesh.polygon_vertex_weights(pm))
+            .collect();
         let (unshot, sample_sources) = match options.unshot {
             UnshotScheme::Polygon => (emission.clone(), Vec::new()),
             UnshotScheme::Vertex => (
@@ -347,6 +356,7 @@ impl<'a> Progressive<'a> {
             radiosity,
             unshot,
             vertex_area,
+            mean_weight,
             sample_sources,
             shot: Vec::new(),
             delta: vec![Rgb::BLACK; mesh.vertex_count()],
@@ -663,12 +673,19 @@ impl<'a> Progressive<'a> {
                 let d = self.delta[l as usize];
                 self.radiosity[l as usize] += d;
                 match self.options.unshot {
-                    UnshotScheme::Polygon => gathered += d,
+                    UnshotScheme::Polygon if pm.levels == 0 => gathered += d,
+                    UnshotScheme::Polygon => gathered += d * self.mean_weight[l as usize],
                     UnshotScheme::Vertex => self.unshot[l as usize] += d,
                 }
             }
             if self.options.unshot == UnshotScheme::Polygon {
-                self.unshot[j] += gathered / pm.vertex_count() as f64;
+                // A regular mesh divides by n exactly as the original
+                // algorithm; a refined one weights by area.
+                self.unshot[j] += if pm.levels == 0 {
+                    gathered / pm.vertex_count() as f64
+                } else {
+                    gathered
+                };
             }
         }
         self.pairs += pairs;

@@ -9,6 +9,11 @@
 //! for a step: a long step only delays the next new picture, and quitting
 //! cancels it ([`Progressive::step_cancellable`]).
 //!
+//! With adaptive subdivision the worker refines the mesh once a solve
+//! converges and solves again on the refined mesh; meanwhile the window
+//! keeps showing the last converged solution (the title says which pass
+//! is running) and switches to the finer one when it converges.
+//!
 //! Keys: `q`/Escape quit · `w` write the picture as TIFF · space pause or
 //! resume · `+`/`-` exposure · `m` element mesh · `r` reset the camera ·
 //! `h` help · arrows and `a`/`d` (or Shift+W/A/S/D) walk · `PageUp`/`PageDown`
@@ -19,6 +24,8 @@ pub mod controls;
 
 use crate::app::{Prepared, RunConfig};
 use crate::color::Rgb;
+use crate::mesh::refine::Refiner;
+use crate::mesh::Mesh;
 use crate::output;
 use crate::render::{self, Exposure, Rasterizer, View};
 use crate::solver::{Progressive, StopReason};
@@ -47,8 +54,6 @@ pub const ZOOM_PER_NOTCH: f32 = 0.9;
 pub const WALK_STEP: f32 = 0.05;
 /// Exposure factor of one `+` or `-` press (a third of a stop).
 pub const EXPOSURE_STEP: f32 = 1.26;
-/// Colour of the element mesh lines.
-pub const MESH_COLOR: [u8; 3] = [40, 220, 255];
 
 /// The key help printed by `h`.
 pub const KEY_HELP: &str = "\
@@ -107,6 +112,9 @@ fn shown_radiosity(solver: &Progressive, ambient: bool) -> Vec<Rgb> {
 /// What the solver thread publishes after each step.
 #[derive(Clone, Debug, Default)]
 struct Progress {
+    /// The mesh [`Progress::radiosity`] belongs to: `None` for the
+    /// prepared mesh, else the latest adaptive refinement.
+    mesh: Option<Arc<Mesh>>,
     radiosity: Vec<Rgb>,
     step: u64,
     unshot_fraction: f64,
@@ -114,6 +122,9 @@ struct Progress {
     /// Seconds spent shooting (pauses excluded).
     solving: f64,
     stopped: Option<StopReason>,
+    /// The adaptive pass running (1 for the first solve), and how many
+    /// refinements may follow it at most; `(1, 0)` without refinement.
+    pass: (u32, u32),
     /// Bumped on every change.
     version: u64,
 }
@@ -148,25 +159,14 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     window.set_input_callback(Box::new(KeyPresses(Arc::clone(&presses))));
 
     let ambient = config.ambient.unwrap_or(true);
-    let mut solver = Progressive::new(
-        &prepared.scene,
-        &prepared.mesh,
-        &prepared.visibility,
-        config.solver,
-    );
-    let progress = Mutex::new(Progress {
-        radiosity: shown_radiosity(&solver, ambient),
-        unshot_fraction: solver.unshot_fraction(),
-        stopped: solver.stop_reason(),
-        ..Progress::default()
-    });
+    let progress = Mutex::new(Progress::default());
     let control = Control {
         quit: AtomicBool::new(false),
         paused: AtomicBool::new(false),
     };
 
     std::thread::scope(|scope| {
-        scope.spawn(|| solve_in_background(&mut solver, &progress, &control, ambient));
+        scope.spawn(|| solve_in_background(prepared, config, &progress, &control, ambient));
         let mut ui = Ui {
             prepared,
             window: &mut window,
@@ -179,6 +179,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
             picture: RgbImage::new(home.width, home.height),
             buffer: vec![0; w * h],
             radiosity: Vec::new(),
+            mesh: None,
             last_mouse: None,
             written: 0,
             presses,
@@ -190,45 +191,131 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     })
 }
 
-/// The solver thread: steps until converged or told to quit, publishing
-/// after each step.
+/// The solver thread: solves (and, with adaptive subdivision, refines and
+/// solves again) until done or told to quit, publishing after each step.
 fn solve_in_background(
-    solver: &mut Progressive,
+    prepared: &Prepared,
+    config: &RunConfig,
     progress: &Mutex<Progress>,
     control: &Control,
     ambient: bool,
 ) {
+    let mut refiner = config.adaptive.map(|o| (Refiner::new(&prepared.mesh), o));
+    let levels = config.adaptive.map_or(0, |o| o.levels);
+    // The refined mesh of the current pass (`None`: the prepared mesh).
+    let mut refined: Option<Arc<Mesh>> = None;
     let mut solving = Duration::ZERO;
+    let mut rays_before = 0;
+    for pass in 1.. {
+        let mesh = refined.as_deref().unwrap_or(&prepared.mesh);
+        let mut solver =
+            Progressive::new(&prepared.scene, mesh, &prepared.visibility, config.solver);
+        // The first pass is shown as it converges; a refined pass only once
+        // it has converged, so the picture never falls back to darkness.
+        let shown = pass == 1;
+        if let Ok(mut p) = progress.lock() {
+            if shown {
+                p.radiosity = shown_radiosity(&solver, ambient);
+                p.mesh = refined.clone();
+            }
+            p.unshot_fraction = solver.unshot_fraction();
+            p.stopped = None;
+            p.pass = (pass, levels);
+            p.version += 1;
+        }
+        let stop = solve_pass(
+            &mut solver,
+            progress,
+            control,
+            ambient,
+            shown,
+            &mut solving,
+            rays_before,
+        );
+        let Some(stop) = stop else {
+            return;
+        };
+        rays_before += solver.rays();
+        let next = match refiner.as_mut() {
+            Some((r, options)) if stop == StopReason::Converged && r.passes() < options.levels => {
+                let luminance: Vec<f64> =
+                    solver.radiosity().iter().map(|b| b.luminance()).collect();
+                r.refine(&prepared.scene, &luminance, options)
+            }
+            _ => None,
+        };
+        let Ok(mut p) = progress.lock() else {
+            return;
+        };
+        if !shown {
+            p.radiosity = shown_radiosity(&solver, ambient);
+            p.mesh = refined.clone();
+        }
+        match next {
+            Some((mesh, _)) => {
+                drop(p);
+                drop(solver);
+                refined = Some(Arc::new(mesh));
+            }
+            None => {
+                p.stopped = Some(stop);
+                p.version += 1;
+                break;
+            }
+        }
+    }
+    while !control.quit.load(Ordering::Relaxed) {
+        std::thread::sleep(FRAME_INTERVAL);
+    }
+}
+
+/// Steps one solve until it stops (returning why) or the window quits
+/// (returning `None`). Publishes the step count and unshot fraction after
+/// each step, and the radiosity too when `shown`.
+fn solve_pass(
+    solver: &mut Progressive,
+    progress: &Mutex<Progress>,
+    control: &Control,
+    ambient: bool,
+    shown: bool,
+    solving: &mut Duration,
+    rays_before: u64,
+) -> Option<StopReason> {
     loop {
         if control.quit.load(Ordering::Relaxed) {
-            return;
+            return None;
         }
-        if control.paused.load(Ordering::Relaxed) || solver.is_done() {
+        if let Some(stop) = solver.stop_reason() {
+            return Some(stop);
+        }
+        if control.paused.load(Ordering::Relaxed) {
             std::thread::sleep(FRAME_INTERVAL);
             continue;
         }
         let t = Instant::now();
         let report = solver.step_cancellable(&control.quit);
-        solving += t.elapsed();
+        *solving += t.elapsed();
         let Ok(mut p) = progress.lock() else {
-            return;
+            return None;
         };
-        if let Some(report) = report {
+        let Some(report) = report else {
+            if control.quit.load(Ordering::Relaxed) {
+                return None;
+            }
+            // Nothing left to shoot.
+            return Some(StopReason::Converged);
+        };
+        if shown {
             if ambient {
                 solver.radiosity_with_ambient(&mut p.radiosity);
             } else {
                 p.radiosity.clone_from_slice(solver.radiosity());
             }
-            p.step = report.step;
-            p.unshot_fraction = report.unshot_fraction;
-            p.rays = solver.rays();
-        } else if control.quit.load(Ordering::Relaxed) {
-            return;
         }
+        p.step = report.step;
+        p.unshot_fraction = report.unshot_fraction;
+        p.rays = rays_before + solver.rays();
         p.solving = solving.as_secs_f64();
-        p.stopped = solver
-            .stop_reason()
-            .or(report.is_none().then_some(StopReason::Converged));
         p.version += 1;
     }
 }
@@ -246,6 +333,8 @@ struct Ui<'a> {
     picture: RgbImage,
     buffer: Vec<u32>,
     radiosity: Vec<Rgb>,
+    /// The mesh [`Ui::radiosity`] belongs to (`None`: the prepared one).
+    mesh: Option<Arc<Mesh>>,
     last_mouse: Option<(f32, f32)>,
     written: u32,
     presses: Arc<Mutex<Vec<Key>>>,
@@ -298,15 +387,17 @@ impl Ui<'_> {
                     p.rays,
                     p.solving,
                     p.stopped,
+                    p.pass,
                 )
             });
-            let Ok((version, step, unshot, rays, solving, stopped)) = snapshot else {
+            let Ok((version, step, unshot, rays, solving, stopped, pass)) = snapshot else {
                 break;
             };
             let fresh = version != shown_version && last_draw.elapsed() >= REDRAW_INTERVAL;
             if fresh || dirty {
                 if let Ok(p) = progress.lock() {
                     self.radiosity.clone_from(&p.radiosity);
+                    self.mesh.clone_from(&p.mesh);
                 }
                 shown_version = version;
                 self.draw()?;
@@ -314,18 +405,25 @@ impl Ui<'_> {
                 dirty = false;
             }
             let state = match stopped {
-                Some(StopReason::Converged) => " · converged",
-                Some(StopReason::MaxSteps) => " · step limit",
-                None if control.paused.load(Ordering::Relaxed) => " · paused",
-                None => "",
+                Some(StopReason::Converged) if pass.0 > 1 => {
+                    format!(" · converged after {} refinements", pass.0 - 1)
+                }
+                Some(StopReason::Converged) => " · converged".into(),
+                Some(StopReason::MaxSteps) => " · step limit".into(),
+                None if control.paused.load(Ordering::Relaxed) => " · paused".into(),
+                None => String::new(),
             };
             let rate = if solving > 0.0 {
                 rays as f64 / solving / 1e6
             } else {
                 0.0
             };
+            let refining = match pass {
+                (1, _) | (_, 0) => String::new(),
+                (k, levels) => format!("refinement {}/{levels} · ", k - 1),
+            };
             let new_title = format!(
-                "radiosity — {} — step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state}",
+                "radiosity — {} — {refining}step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state}",
                 self.stem,
                 unshot * 100.0
             );
@@ -349,7 +447,12 @@ impl Ui<'_> {
     /// picture and the window buffer.
     fn draw(&mut self) -> Result<(), ViewerError> {
         let view = View::new(self.camera.camera())?;
-        let mesh = &self.prepared.mesh;
+        let mesh = self.mesh.as_deref().unwrap_or(&self.prepared.mesh);
+        if self.radiosity.len() != mesh.vertex_count() {
+            // Before the solver thread's first publication: nothing yet.
+            self.buffer.fill(0);
+            return Ok(());
+        }
         let frame = self.rasterizer.render(mesh, &self.radiosity, &view)?;
         let exposure = self.exposure.resolve(frame) * self.exposure_scale;
         self.picture = render::to_srgb8(frame, exposure);
@@ -359,7 +462,7 @@ impl Ui<'_> {
                 mesh,
                 &view,
                 self.rasterizer.inv_depth(),
-                MESH_COLOR,
+                render::MESH_COLOR,
             );
         }
         for (out, p) in self.buffer.iter_mut().zip(self.picture.pixels()) {

@@ -32,6 +32,8 @@ use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 use std::ops::Range;
 
+pub mod refine;
+
 /// Default inset of boundary vertices, as a fraction of the polygon's
 /// shortest element edge (see the module docs). Five percent moves the
 /// sample far above `f32` rounding yet leaves it inside its elements.
@@ -129,6 +131,14 @@ pub struct PolygonMesh {
     pub area: f64,
     /// Length of its shortest element edge, in scene units.
     pub min_edge: f32,
+    /// Distance its boundary vertices' evaluation points are moved inward
+    /// ([`Mesh::sample_positions`]), in scene units; refinement moves new
+    /// boundary vertices by the same distance.
+    pub inset: f32,
+    /// Adaptive refinement passes that split some of its elements (see
+    /// [`refine`]); 0 for the regular subdivision of [`build`], whose
+    /// vertices are evenly spaced.
+    pub levels: u32,
 }
 
 impl PolygonMesh {
@@ -317,6 +327,8 @@ pub fn build_with_limit(
             normal: polygon.normal,
             area: polygon.area,
             min_edge,
+            inset: options.inset * min_edge,
+            levels: 0,
         });
     }
     Ok(mesh)
@@ -702,6 +714,31 @@ impl Mesh {
             for c in e.corners() {
                 areas[c.index()] += share;
             }
+        }
+        areas
+    }
+
+    /// Each of polygon `pm`'s vertices' weight in the polygon's mean
+    /// (summing to 1, in vertex order): `1/n` on a regular mesh
+    /// (`levels == 0`), where every vertex stands for the same area as in
+    /// the original algorithm; its share of the polygon's area
+    /// ([`Mesh::vertex_areas`]) on a refined one, where vertices crowd
+    /// the refined parts and an even weight would over-count them.
+    pub fn polygon_vertex_weights(&self, pm: &PolygonMesh) -> Vec<f64> {
+        let n = pm.vertex_count() as usize;
+        if pm.levels == 0 || n == 0 {
+            return vec![1.0 / n.max(1) as f64; n];
+        }
+        let mut areas = vec![0.0; n];
+        for e in &self.elements[pm.elements.start as usize..pm.elements.end as usize] {
+            let share = self.element_area(e) / e.corners().len() as f64;
+            for c in e.corners() {
+                areas[(c.0 - pm.vertices.start) as usize] += share;
+            }
+        }
+        let total: f64 = areas.iter().sum();
+        if total > 0.0 {
+            areas.iter_mut().for_each(|a| *a /= total);
         }
         areas
     }

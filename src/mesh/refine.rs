@@ -1,0 +1,750 @@
+//! Adaptive refinement: split the elements across which a scalar field
+//! (the solver's luminance) changes sharply, keeping the mesh conforming.
+//!
+//! A [`Refiner`] remembers the *leaf* elements of every refinement so far:
+//! the triangles and quadrilaterals the regular mesh started with, and
+//! their children. Each [`Refiner::refine`] pass
+//!
+//! 1. **marks** every leaf whose field values (at its corners and at any
+//!    vertex lying on its edges) differ by more than the threshold relative
+//!    to the largest of them, `(max − min) / max(max, floor) > threshold`,
+//!    unless it has already been split [`RefineOptions::levels`] times. The
+//!    `floor` is [`DARK_FLOOR`] times the area-weighted mean of the field,
+//!    so that noise in the near-black parts of a scene does not split them;
+//! 2. **splits** each marked leaf into four: a quadrilateral at its edge
+//!    midpoints and its centre, a triangle at its edge midpoints;
+//! 3. **closes** the split: a leaf whose edge carries more than one new
+//!    vertex (its neighbour is two levels finer), or whose new vertices lie
+//!    on edges that no single corner can see past (opposite edges of a
+//!    quadrilateral, two edges of a triangle), is split too, until none is
+//!    left;
+//! 4. **emits** a conforming mesh: a leaf with a vertex on an edge (a
+//!    *hanging* vertex, where the neighbour was split) is drawn as a fan of
+//!    triangles through that vertex, so the picture has no crack and no
+//!    T-vertex seam: every vertex's radiosity is computed, and every triangle
+//!    that touches the vertex interpolates it.
+//!
+//! New vertices are the midpoints of their straight edges (and the centre of
+//! a quadrilateral is the mean of its corners, which is the bilinear patch's
+//! centre), so they lie exactly on the polygon. A new vertex on the polygon's
+//! boundary gets the same inset as the polygon's other boundary vertices.
+
+use super::{inset_positions, Element, Mesh, PolygonMesh, VertexId};
+use crate::scene::{PolygonId, Scene};
+use glam::Vec3;
+use std::collections::HashMap;
+
+/// Default [`RefineOptions::threshold`]: a leaf is split when its vertex
+/// luminances differ by more than a quarter of the largest. A smooth
+/// gradient across an element of the default mesh stays well under it
+/// (a few percent); the edge of a shadow is far over it.
+pub const DEFAULT_THRESHOLD: f64 = 0.25;
+
+/// Default [`RefineOptions::levels`]: elements are split at most twice, to a
+/// quarter of the initial edge length.
+pub const DEFAULT_LEVELS: u32 = 2;
+
+/// Values below this fraction of the field's area-weighted mean count as
+/// black when comparing a leaf's values (see the module docs).
+pub const DARK_FLOOR: f64 = 0.02;
+
+/// How to refine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefineOptions {
+    /// Split a leaf whose values differ by more than this fraction of the
+    /// largest of them; in `(0, 1)`.
+    pub threshold: f64,
+    /// Split an initial element at most this many times (each halves the
+    /// edge length); at least 1.
+    pub levels: u32,
+}
+
+impl Default for RefineOptions {
+    fn default() -> Self {
+        RefineOptions {
+            threshold: DEFAULT_THRESHOLD,
+            levels: DEFAULT_LEVELS,
+        }
+    }
+}
+
+/// What one refinement pass did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RefineReport {
+    /// Leaves split because their values differ by more than the threshold.
+    pub marked: usize,
+    /// Leaves split to keep the mesh conforming (closure).
+    pub closure: usize,
+    /// Leaves after the pass.
+    pub leaves: usize,
+    /// Leaves drawn as fans around hanging vertices.
+    pub fans: usize,
+}
+
+/// One leaf element: 3 or 4 corners in pool vertex ids, counter-clockwise.
+#[derive(Clone, Copy, Debug)]
+struct Leaf {
+    corners: [u32; 4],
+    len: u8,
+    level: u8,
+    polygon: PolygonId,
+}
+
+impl Leaf {
+    fn corners(&self) -> &[u32] {
+        &self.corners[..self.len as usize]
+    }
+
+    /// Its edges as `(from, to)`, counter-clockwise.
+    fn edges(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let c = self.corners();
+        (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()]))
+    }
+}
+
+/// The refinement state of one mesh: leaves, vertices and the midpoint of
+/// every split edge. Built from a mesh of [`super::build`]; each
+/// [`Refiner::refine`] returns the next mesh.
+pub struct Refiner {
+    /// Every vertex so far, in pool ids; the meshes renumber them.
+    positions: Vec<Vec3>,
+    vertex_polygon: Vec<PolygonId>,
+    leaves: Vec<Leaf>,
+    /// The midpoint of each split edge, keyed by its end points in
+    /// ascending order.
+    midpoints: HashMap<(u32, u32), u32>,
+    /// The initial per-polygon data (normal, area, inset, grid counts).
+    polygons: Vec<PolygonMesh>,
+    /// Pool id of each vertex of the last mesh returned (or of the mesh
+    /// the refiner was built from).
+    mesh_to_pool: Vec<u32>,
+    passes: u32,
+}
+
+fn edge_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+impl Refiner {
+    /// Starts from an unrefined mesh (every polygon at level 0, as
+    /// [`super::build`] makes them).
+    pub fn new(mesh: &Mesh) -> Refiner {
+        let leaves = mesh
+            .elements
+            .iter()
+            .zip(&mesh.element_polygon)
+            .map(|(e, &polygon)| {
+                let mut corners = [0u32; 4];
+                for (slot, c) in corners.iter_mut().zip(e.corners()) {
+                    *slot = c.0;
+                }
+                Leaf {
+                    corners,
+                    len: e.corners().len() as u8,
+                    level: 0,
+                    polygon,
+                }
+            })
+            .collect();
+        Refiner {
+            positions: mesh.positions.clone(),
+            vertex_polygon: mesh.vertex_polygon.clone(),
+            leaves,
+            midpoints: HashMap::new(),
+            polygons: mesh.polygons.clone(),
+            mesh_to_pool: (0..mesh.vertex_count() as u32).collect(),
+            passes: 0,
+        }
+    }
+
+    /// Refinement passes that split something so far.
+    pub fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    /// One pass: marks and splits the leaves over the threshold, closes the
+    /// split and returns the new conforming mesh, or `None` when no leaf
+    /// needs splitting (then nothing changes).
+    ///
+    /// `values` holds the field per vertex of the last mesh (the one this
+    /// refiner was built from, or the last one returned), finite and
+    /// non-negative; `scene` is the scene the mesh was built from.
+    pub fn refine(
+        &mut self,
+        scene: &Scene,
+        values: &[f64],
+        options: &RefineOptions,
+    ) -> Option<(Mesh, RefineReport)> {
+        assert_eq!(
+            values.len(),
+            self.mesh_to_pool.len(),
+            "one value per vertex of the last mesh"
+        );
+        let mut pool_values = vec![0.0; self.positions.len()];
+        for (&pool, &v) in self.mesh_to_pool.iter().zip(values) {
+            pool_values[pool as usize] = if v.is_finite() { v.max(0.0) } else { 0.0 };
+        }
+        let floor = DARK_FLOOR * self.mean(&pool_values);
+        let max_level = options.levels.min(u8::MAX as u32) as u8;
+
+        let mut ring = Vec::new();
+        let marked: Vec<usize> = (0..self.leaves.len())
+            .filter(|&k| {
+                let leaf = self.leaves[k];
+                if leaf.level >= max_level {
+                    return false;
+                }
+                self.ring(&leaf, &mut ring);
+                let (lo, hi) = ring.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &v| {
+                    let x = pool_values[v as usize];
+                    (lo.min(x), hi.max(x))
+                });
+                hi > 0.0 && (hi - lo) / hi.max(floor) > options.threshold
+            })
+            .collect();
+        if marked.is_empty() {
+            return None;
+        }
+        let mut report = RefineReport {
+            marked: marked.len(),
+            ..RefineReport::default()
+        };
+        // Split from the back so that the indices still to split stay valid
+        // (children are appended at the end, the first child in place).
+        for &k in marked.iter().rev() {
+            self.split(k);
+        }
+        report.closure = self.close();
+        self.passes += 1;
+        for leaf in &self.leaves {
+            let p = &mut self.polygons[leaf.polygon.index()];
+            p.levels = p.levels.max(leaf.level as u32);
+        }
+        let (mesh, fans) = self.emit(scene);
+        report.leaves = self.leaves.len();
+        report.fans = fans;
+        Some((mesh, report))
+    }
+
+    /// Area-weighted mean of a per-pool-vertex field over the leaves.
+    fn mean(&self, values: &[f64]) -> f64 {
+        let (mut sum, mut area) = (0.0, 0.0);
+        for leaf in &self.leaves {
+            let a = self.leaf_area(leaf);
+            let mean = leaf
+                .corners()
+                .iter()
+                .map(|&c| values[c as usize])
+                .sum::<f64>()
+                / leaf.len as f64;
+            sum += a * mean;
+            area += a;
+        }
+        if area > 0.0 {
+            sum / area
+        } else {
+            0.0
+        }
+    }
+
+    fn leaf_area(&self, leaf: &Leaf) -> f64 {
+        let p = |k: usize| self.positions[leaf.corners[k] as usize].as_dvec3();
+        let tri = |a: usize, b: usize, c: usize| (p(b) - p(a)).cross(p(c) - p(a)).length() * 0.5;
+        tri(0, 1, 2) + if leaf.len == 4 { tri(0, 2, 3) } else { 0.0 }
+    }
+
+    /// The vertices along edge `a → b` strictly between its ends, in order
+    /// from `a`: the midpoints of every split of it and of its halves.
+    fn hanging(&self, a: u32, b: u32, out: &mut Vec<u32>) {
+        if let Some(&m) = self.midpoints.get(&edge_key(a, b)) {
+            self.hanging(a, m, out);
+            out.push(m);
+            self.hanging(m, b, out);
+        }
+    }
+
+    /// The leaf's boundary: its corners with the hanging vertices between
+    /// them, counter-clockwise from its first corner.
+    fn ring(&self, leaf: &Leaf, out: &mut Vec<u32>) {
+        out.clear();
+        for (a, b) in leaf.edges() {
+            out.push(a);
+            self.hanging(a, b, out);
+        }
+    }
+
+    fn midpoint(&mut self, a: u32, b: u32) -> u32 {
+        let key = edge_key(a, b);
+        if let Some(&m) = self.midpoints.get(&key) {
+            return m;
+        }
+        let p = (self.positions[a as usize] + self.positions[b as usize]) * 0.5;
+        let m = self.vertex(p, self.vertex_polygon[a as usize]);
+        self.midpoints.insert(key, m);
+        m
+    }
+
+    fn vertex(&mut self, p: Vec3, polygon: PolygonId) -> u32 {
+        self.positions.push(p);
+        self.vertex_polygon.push(polygon);
+        (self.positions.len() - 1) as u32
+    }
+
+    /// Splits leaf `k` into four; the first child takes its place.
+    fn split(&mut self, k: usize) {
+        let leaf = self.leaves[k];
+        let level = leaf.level + 1;
+        let child = |corners: &[u32]| {
+            let mut c = [corners[0]; 4];
+            c[..corners.len()].copy_from_slice(corners);
+            Leaf {
+                corners: c,
+                len: corners.len() as u8,
+                level,
+                polygon: leaf.polygon,
+            }
+        };
+        let c = leaf.corners;
+        let children: Vec<Leaf> = if leaf.len == 4 {
+            let m01 = self.midpoint(c[0], c[1]);
+            let m12 = self.midpoint(c[1], c[2]);
+            let m23 = self.midpoint(c[2], c[3]);
+            let m30 = self.midpoint(c[3], c[0]);
+            let centre = c.iter().map(|&v| self.positions[v as usize]).sum::<Vec3>() * 0.25;
+            let o = self.vertex(centre, leaf.polygon);
+            vec![
+                child(&[c[0], m01, o, m30]),
+                child(&[m01, c[1], m12, o]),
+                child(&[o, m12, c[2], m23]),
+                child(&[m30, o, m23, c[3]]),
+            ]
+        } else {
+            let m01 = self.midpoint(c[0], c[1]);
+            let m12 = self.midpoint(c[1], c[2]);
+            let m20 = self.midpoint(c[2], c[0]);
+            vec![
+                child(&[c[0], m01, m20]),
+                child(&[m01, c[1], m12]),
+                child(&[m20, m12, c[2]]),
+                child(&[m01, m12, m20]),
+            ]
+        };
+        self.leaves[k] = children[0];
+        self.leaves.extend_from_slice(&children[1..]);
+    }
+
+    /// Which edges of a leaf carry hanging vertices, as a bit mask, or
+    /// `None` when the leaf must be split: an edge carries more than one,
+    /// or no fan can take them all.
+    fn hanging_edges(&self, leaf: &Leaf) -> Option<u8> {
+        let mut mask = 0u8;
+        for (k, (a, b)) in leaf.edges().enumerate() {
+            if let Some(&m) = self.midpoints.get(&edge_key(a, b)) {
+                if self.midpoints.contains_key(&edge_key(a, m))
+                    || self.midpoints.contains_key(&edge_key(m, b))
+                {
+                    return None;
+                }
+                mask |= 1 << k;
+            }
+        }
+        match (leaf.len, mask.count_ones()) {
+            (_, 0 | 1) => Some(mask),
+            // Two adjacent edges of a quadrilateral: the corner opposite
+            // their common corner sees past both.
+            (4, 2) if mask != 0b0101 && mask != 0b1010 => Some(mask),
+            _ => None,
+        }
+    }
+
+    /// Splits leaves until every leaf can be drawn conforming; returns how
+    /// many were split.
+    fn close(&mut self) -> usize {
+        let mut split = 0;
+        loop {
+            let before = split;
+            let mut k = 0;
+            while k < self.leaves.len() {
+                if self.hanging_edges(&self.leaves[k]).is_none() {
+                    self.split(k);
+                    split += 1;
+                    // The first child now sits at `k`: check it again.
+                    continue;
+                }
+                k += 1;
+            }
+            if split == before {
+                return split;
+            }
+        }
+    }
+
+    /// The conforming mesh of the current leaves; returns it and how many
+    /// leaves were drawn as fans.
+    fn emit(&mut self, scene: &Scene) -> (Mesh, usize) {
+        let polygon_count = self.polygons.len();
+        let mut vertices_of: Vec<Vec<u32>> = vec![Vec::new(); polygon_count];
+        for (v, p) in self.vertex_polygon.iter().enumerate() {
+            vertices_of[p.index()].push(v as u32);
+        }
+        let mut leaves_of: Vec<Vec<usize>> = vec![Vec::new(); polygon_count];
+        for (k, leaf) in self.leaves.iter().enumerate() {
+            leaves_of[leaf.polygon.index()].push(k);
+        }
+        let mut mesh = Mesh {
+            positions: Vec::with_capacity(self.positions.len()),
+            sample_positions: Vec::with_capacity(self.positions.len()),
+            vertex_polygon: Vec::with_capacity(self.positions.len()),
+            elements: Vec::with_capacity(self.leaves.len()),
+            element_polygon: Vec::with_capacity(self.leaves.len()),
+            polygons: Vec::with_capacity(polygon_count),
+        };
+        let mut pool_to_mesh = vec![0u32; self.positions.len()];
+        self.mesh_to_pool.clear();
+        let mut fans = 0;
+        let mut ring = Vec::new();
+        for (p, (polygon, initial)) in scene.polygons.iter().zip(&self.polygons).enumerate() {
+            let id = PolygonId(p as u32);
+            let v_start = mesh.positions.len() as u32;
+            for &v in &vertices_of[p] {
+                pool_to_mesh[v as usize] = mesh.positions.len() as u32;
+                self.mesh_to_pool.push(v);
+                mesh.positions.push(self.positions[v as usize]);
+                mesh.vertex_polygon.push(id);
+            }
+            mesh.sample_positions.extend(inset_positions(
+                polygon,
+                &mesh.positions[v_start as usize..],
+                initial.inset,
+            ));
+            let e_start = mesh.elements.len() as u32;
+            let at = |v: u32| VertexId(pool_to_mesh[v as usize]);
+            for &k in &leaves_of[p] {
+                let leaf = self.leaves[k];
+                let mask = self.hanging_edges(&leaf).unwrap_or(0);
+                if mask == 0 {
+                    let c = leaf.corners;
+                    mesh.elements.push(if leaf.len == 4 {
+                        Element::quad(at(c[0]), at(c[1]), at(c[2]), at(c[3]))
+                    } else {
+                        Element::triangle(at(c[0]), at(c[1]), at(c[2]))
+                    });
+                    mesh.element_polygon.push(id);
+                    continue;
+                }
+                fans += 1;
+                self.ring(&leaf, &mut ring);
+                // The fan's apex: the hanging vertex when there is one edge
+                // with one (the most even triangles), else the corner not
+                // on either hanging edge (see `hanging_edges`).
+                let apex = if mask.count_ones() == 1 {
+                    let edge = mask.trailing_zeros() as usize;
+                    ring.iter()
+                        .position(|&v| v == self.hanging_vertex(&leaf, edge))
+                        .unwrap_or(0)
+                } else {
+                    let n = leaf.len as u32;
+                    let hanging = |e: u32| mask & (1 << (e % n)) != 0;
+                    // Corner `c` lies on edges `c` and `c - 1`.
+                    let corner = (0..n)
+                        .find(|&c| !hanging(c) && !hanging(c + n - 1))
+                        .unwrap_or(0);
+                    ring.iter()
+                        .position(|&v| v == leaf.corners[corner as usize])
+                        .unwrap_or(0)
+                };
+                let n = ring.len();
+                for s in 1..n - 1 {
+                    let (b, c) = (ring[(apex + s) % n], ring[(apex + s + 1) % n]);
+                    mesh.elements
+                        .push(Element::triangle(at(ring[apex]), at(b), at(c)));
+                    mesh.element_polygon.push(id);
+                }
+            }
+            let mut pm = initial.clone();
+            pm.vertices = v_start..mesh.positions.len() as u32;
+            pm.elements = e_start..mesh.elements.len() as u32;
+            pm.min_edge = min_edge(&mesh, &pm).unwrap_or(initial.min_edge);
+            mesh.polygons.push(pm);
+        }
+        (mesh, fans)
+    }
+
+    /// The hanging vertex on edge `edge` of a leaf (which has one).
+    fn hanging_vertex(&self, leaf: &Leaf, edge: usize) -> u32 {
+        let n = leaf.len as usize;
+        let (a, b) = (leaf.corners[edge], leaf.corners[(edge + 1) % n]);
+        self.midpoints[&edge_key(a, b)]
+    }
+}
+
+/// The shortest element edge of a polygon's mesh, in scene units.
+fn min_edge(mesh: &Mesh, pm: &PolygonMesh) -> Option<f32> {
+    mesh.elements[pm.elements.start as usize..pm.elements.end as usize]
+        .iter()
+        .flat_map(|e| {
+            let c = e.corners();
+            (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()]))
+        })
+        .map(|(a, b)| mesh.positions[a.index()].distance(mesh.positions[b.index()]))
+        .reduce(f32::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{build, MeshOptions};
+    use crate::testutil;
+
+    /// A parallelogram, a bilinear quad, a triangle and a hexagon (a fan),
+    /// in four parallel planes.
+    fn shapes() -> Scene {
+        let polygons = vec![
+            testutil::polygon(0, &[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]]),
+            testutil::polygon(
+                0,
+                &[[0., 0., 1.], [2., 0., 1.], [1.5, 1., 1.], [0.2, 1.3, 1.]],
+            ),
+            testutil::polygon(0, &[[0., 0., 2.], [1., 0., 2.], [0.3, 1.7, 2.]]),
+            testutil::polygon(
+                0,
+                &[
+                    [1., 0., 3.],
+                    [0.5, 0.87, 3.],
+                    [-0.5, 0.87, 3.],
+                    [-1., 0., 3.],
+                    [-0.5, -0.87, 3.],
+                    [0.5, -0.87, 3.],
+                ],
+            ),
+        ];
+        testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
+    }
+
+    fn options() -> MeshOptions {
+        MeshOptions {
+            lenmax: 0.3,
+            inset: 0.05,
+        }
+    }
+
+    /// A field with a sharp step along the line `x = 0.63` (a shadow edge).
+    fn step(mesh: &Mesh) -> Vec<f64> {
+        mesh.positions
+            .iter()
+            .map(|p| if p.x < 0.63 { 0.1 } else { 1.0 })
+            .collect()
+    }
+
+    /// No vertex of a polygon lies inside an edge of one of its elements
+    /// (a T-vertex), and the elements tile the polygon without overlap.
+    fn assert_conforming(scene: &Scene, mesh: &Mesh) {
+        mesh.validate().unwrap();
+        for (p, pm) in mesh.polygons.iter().enumerate() {
+            let range = pm.vertices.start as usize..pm.vertices.end as usize;
+            let area: f64 = mesh.elements[pm.elements.start as usize..pm.elements.end as usize]
+                .iter()
+                .map(|e| mesh.element_area(e))
+                .sum();
+            let expected = scene.polygons[p].area;
+            assert!(
+                (area - expected).abs() < 1e-4 * expected,
+                "polygon {p}: elements cover {area}, polygon {expected}"
+            );
+            for e in &mesh.elements[pm.elements.start as usize..pm.elements.end as usize] {
+                // Counter-clockwise from the front: no flipped element.
+                for [a, b, c] in e.triangles() {
+                    let [a, b, c] = [a, b, c].map(|v| mesh.positions[v.index()]);
+                    let n = (b - a).cross(c - a);
+                    assert!(
+                        n.dot(pm.normal) > 0.0,
+                        "polygon {p}: a degenerate or flipped triangle"
+                    );
+                }
+                let c = e.corners();
+                for k in 0..c.len() {
+                    let (a, b) = (
+                        mesh.positions[c[k].index()],
+                        mesh.positions[c[(k + 1) % c.len()].index()],
+                    );
+                    let len = a.distance(b);
+                    for (v, &x) in mesh.positions[range.clone()].iter().enumerate() {
+                        let v = VertexId(pm.vertices.start + v as u32);
+                        if c.contains(&v) {
+                            continue;
+                        }
+                        let t = (x - a).dot(b - a) / (len * len);
+                        let off = (a + t * (b - a)).distance(x);
+                        assert!(
+                            !(t > 1e-4 && t < 1.0 - 1e-4 && off < 1e-5 * len.max(1.0)),
+                            "polygon {p}: vertex {} hangs on an element edge",
+                            v.0
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_uniform_field_needs_no_refinement() {
+        let scene = shapes();
+        let mesh = build(&scene, &options()).unwrap();
+        let mut refiner = Refiner::new(&mesh);
+        let flat = vec![0.7; mesh.vertex_count()];
+        assert!(refiner
+            .refine(&scene, &flat, &RefineOptions::default())
+            .is_none());
+        // Below the threshold is not enough either: a 20 % gradient.
+        let gentle: Vec<f64> = mesh
+            .positions
+            .iter()
+            .map(|p| 1.0 + 0.1 * p.x as f64)
+            .collect();
+        assert!(refiner
+            .refine(&scene, &gentle, &RefineOptions::default())
+            .is_none());
+        assert_eq!(refiner.passes(), 0);
+    }
+
+    #[test]
+    fn a_step_is_refined_along_its_edge_only_and_stays_conforming() {
+        let scene = shapes();
+        let mesh = build(&scene, &options()).unwrap();
+        let mut refiner = Refiner::new(&mesh);
+        let (once, report) = refiner
+            .refine(&scene, &step(&mesh), &RefineOptions::default())
+            .unwrap();
+        assert!(report.marked > 0 && report.fans > 0, "{report:?}");
+        assert_conforming(&scene, &once);
+        assert_eq!(once.polygons.iter().map(|p| p.levels).max(), Some(1));
+        // The new vertices crowd the step: none is far from x = 0.63.
+        let initial_edge = 0.3;
+        for p in &once.positions[..] {
+            if !mesh.positions.contains(p) {
+                assert!((p.x - 0.63).abs() < 2.0 * initial_edge, "new vertex at {p}");
+            }
+        }
+        let (twice, _) = refiner
+            .refine(&scene, &step(&once), &RefineOptions::default())
+            .unwrap();
+        assert_conforming(&scene, &twice);
+        assert!(twice.vertex_count() > once.vertex_count());
+        // Two levels: nothing more to split, however sharp the step.
+        assert!(refiner
+            .refine(&scene, &step(&twice), &RefineOptions::default())
+            .is_none());
+        for (pm, initial) in twice.polygons.iter().zip(&mesh.polygons) {
+            assert!(pm.min_edge >= initial.min_edge / 4.0 * 0.999, "{pm:?}");
+        }
+    }
+
+    #[test]
+    fn closure_splits_what_a_fan_cannot_take() {
+        // A bright band between x = 0.4 and x = 1.0 on the first polygon
+        // (columns of width 2/7): the columns holding its two edges split,
+        // the column between them does not, and is left with hanging
+        // vertices on two opposite edges, which no fan takes: the closure
+        // must split it.
+        let scene = shapes();
+        let mut mesh = build(&scene, &options()).unwrap();
+        let mut refiner = Refiner::new(&mesh);
+        let options = RefineOptions {
+            threshold: 0.25,
+            levels: 3,
+        };
+        let band = |m: &Mesh| -> Vec<f64> {
+            m.positions
+                .iter()
+                .map(|p| if p.x > 0.4 && p.x < 1.0 { 1.0 } else { 0.1 })
+                .collect()
+        };
+        let mut closure = 0;
+        while let Some((next, report)) = refiner.refine(&scene, &band(&mesh), &options) {
+            closure += report.closure;
+            assert_conforming(&scene, &next);
+            mesh = next;
+        }
+        assert_eq!(refiner.passes(), 3);
+        assert_eq!(mesh.polygons[0].levels, 3);
+        assert!(closure > 0, "the band needs closure splits");
+    }
+
+    #[test]
+    fn untouched_polygons_keep_their_mesh_and_new_boundary_vertices_are_inset() {
+        let scene = shapes();
+        let mesh = build(&scene, &options()).unwrap();
+        let mut refiner = Refiner::new(&mesh);
+        // A step on the first polygon only (the others are at z > 0).
+        let values: Vec<f64> = mesh
+            .positions
+            .iter()
+            .map(|p| if p.z == 0.0 && p.x < 0.63 { 0.1 } else { 1.0 })
+            .collect();
+        let (refined, _) = refiner
+            .refine(&scene, &values, &RefineOptions::default())
+            .unwrap();
+        for p in 1..mesh.polygons.len() {
+            let (a, b) = (&mesh.polygons[p], &refined.polygons[p]);
+            assert_eq!(a.vertex_count(), b.vertex_count());
+            assert_eq!(b.levels, 0);
+            let shift = b.vertices.start as i64 - a.vertices.start as i64;
+            for (v, w) in a.vertices.clone().zip(b.vertices.clone()) {
+                assert_eq!(mesh.positions[v as usize], refined.positions[w as usize]);
+                assert_eq!(
+                    mesh.sample_positions[v as usize],
+                    refined.sample_positions[w as usize]
+                );
+            }
+            for (e, f) in a.elements.clone().zip(b.elements.clone()) {
+                let moved: Vec<i64> = mesh.elements[e as usize]
+                    .corners()
+                    .iter()
+                    .map(|c| c.0 as i64 + shift)
+                    .collect();
+                let got: Vec<i64> = refined.elements[f as usize]
+                    .corners()
+                    .iter()
+                    .map(|c| c.0 as i64)
+                    .collect();
+                assert_eq!(moved, got);
+            }
+        }
+        // New vertices on the first polygon's edge y = 0 are evaluated
+        // inside it, as far in as the old ones.
+        let pm = &refined.polygons[0];
+        let mut boundary = 0;
+        for v in pm.vertices.clone() {
+            let (p, s) = (
+                refined.positions[v as usize],
+                refined.sample_positions[v as usize],
+            );
+            if p.y == 0.0 {
+                boundary += 1;
+                assert!((s.y - pm.inset).abs() < 1e-6, "{p} evaluated at {s}");
+            }
+        }
+        assert!(boundary > mesh.polygons[0].nu as usize + 1);
+    }
+
+    #[test]
+    fn dark_noise_is_not_refined() {
+        // Values differing by 100 % but all under the dark floor of a
+        // bright scene: nothing to see, nothing to split.
+        let scene = shapes();
+        let mesh = build(&scene, &options()).unwrap();
+        let mut refiner = Refiner::new(&mesh);
+        let values: Vec<f64> = mesh
+            .positions
+            .iter()
+            .map(|p| match (p.z == 0.0, p.x < 0.63) {
+                (true, true) => 0.0,
+                (true, false) => 0.001,
+                _ => 1.0,
+            })
+            .collect();
+        assert!(refiner
+            .refine(&scene, &values, &RefineOptions::default())
+            .is_none());
+    }
+}
