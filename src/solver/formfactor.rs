@@ -15,34 +15,49 @@
 //! (never above 1 per sample) when a receiver is close to the shooter.
 //! A negative cosine counts as occluded and casts no ray.
 //!
-//! **Near field.** The disc approximation assumes the receiver is far
-//! compared with the sample's size. Where a receiver is within
-//! [`NEAR_FIELD_RATIO`] cell diameters of a grid sample (two walls meeting
-//! at a corner, a lamp just below the ceiling), the sample's term is
-//! replaced by the exact form factor from the point to the sample's cell
-//! (Lambert's contour integral over the cell clipped to the receiver's
-//! front half-space), still times the one ray's visibility. Far from every
-//! cell nothing changes. Without it the form factor between two unit
-//! squares sharing an edge comes out 8 % low at 64 samples, and a closed
-//! room loses that much energy at every bounce.
+//! **Near and middle field.** The disc term is a one-point rule: its error
+//! grows as `(size / distance)²`, and the `+ a_k` that bounds it biases it
+//! low wherever the sample is not seen head-on (about −0.4 % on a wall
+//! meeting the shooter at a right angle, which a closed room then loses at
+//! every bounce). So for the grid samples, which know their cells, the term
+//! depends on the distance `r` to the sample, in cell diameters `d`:
+//!
+//! - `r ≥` [`NEAR_FIELD_RATIO`]` · d`: the point term
+//!   `cosθ_i cosθ_j a_k / (π r²)`, unbiased to second order;
+//! - [`EXACT_RATIO`]` · d ≤ r <` [`NEAR_FIELD_RATIO`]` · d`: the sample is
+//!   subdivided: the cell's point terms at a second-order quadrature rule's
+//!   points (2 × 2 Gauss points of a quadrilateral, weighted by its area
+//!   element; the three-point rule of a triangle), each with its own
+//!   cosines;
+//! - `r <` [`EXACT_RATIO`]` · d`: the exact form factor from the point to
+//!   the cell (Lambert's contour integral over the cell clipped to the
+//!   receiver's front half-space), which stays finite as the receiver
+//!   touches the shooter.
+//!
+//! Each still takes the visibility of the one ray to the sample. Against
+//! Lambert's formula at 2,000 random points around a unit square with 64
+//! cells, the worst error is 0.3 % (the disc sum alone: 2.2 %). Vertex
+//! samples (a shooter with few element vertices) have no cell and keep the
+//! disc term; so does every sample with the near field switched off.
 
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
 
-/// A receiver closer to a grid sample than this many cell diameters gets
-/// the exact point-to-cell form factor instead of the disc approximation.
-/// At three diameters the disc sum is close enough that a closed box
-/// balances its energy within 1 % (two gave 1.1 %).
-pub const NEAR_FIELD_RATIO: f32 = 3.0;
+/// A receiver within this many cell diameters of a grid sample gets the
+/// cell's quadrature (or, closer, the exact) form factor instead of the
+/// point term. Measured on a unit square of 8 × 8 cells (worst error over
+/// 2,000 random receivers / over a perpendicular wall): 3 diameters give
+/// 0.8 % / 0.8 %, 4 give 0.6 % / 0.6 %, 6 give 0.27 % / 0.33 %. The extra
+/// terms cost arithmetic only, never a ray.
+pub const NEAR_FIELD_RATIO: f32 = 6.0;
 
-/// Within the near-field radius, receivers closer than this fraction of it
-/// (in squared distance: 1/4, i.e. half the radius) get the exact contour
-/// integral; the rest get the disc sum over the cell's four quarters,
-/// whose disc error at twice their own ratio of distance to size is as
-/// small as the exact term's neighbours need, at a fraction of its cost.
-pub const EXACT_SHARE: f32 = 0.25;
+/// A receiver within this many cell diameters of a grid sample gets the
+/// exact point-to-cell form factor: close enough that a quadrature's points
+/// are no longer far compared with their spacing (1 and 2 diameters gave
+/// the same errors as 1.5).
+pub const EXACT_RATIO: f32 = 1.5;
 
 /// A point of a shooting polygon and the area it stands for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,9 +70,16 @@ pub struct ShooterSample {
     /// The cell it stands for (3 or 4 corners, counter-clockwise from the
     /// front; a triangle repeats its last corner), for grid samples.
     pub cell: Option<[Vec3; 4]>,
-    /// Squared distance within which the near-field form factor is used,
-    /// in square scene units (0 without a cell).
+    /// Squared distance within which the cell's quadrature is used, in
+    /// square scene units (0 without a cell).
     pub near_r2: f32,
+    /// Squared distance within which the exact point-to-cell form factor is
+    /// used, in square scene units (0 without a cell).
+    pub exact_r2: f32,
+    /// Quadrature points over the cell and the areas they stand for
+    /// (summing to [`ShooterSample::area`]; a triangle's fourth is unused
+    /// and stands for 0).
+    pub quadrature: [(Vec3, f32); 4],
 }
 
 impl ShooterSample {
@@ -68,28 +90,81 @@ impl ShooterSample {
             area,
             cell: None,
             near_r2: 0.0,
+            exact_r2: 0.0,
+            quadrature: [(position, 0.0); 4],
         }
     }
 
-    /// A sample at the centre of a cell.
+    /// A sample at the centre of a cell (3 or 4 corners counter-clockwise;
+    /// a triangle repeats its last corner) of `area` square scene units.
     pub fn cell(position: Vec3, area: f64, cell: [Vec3; 4]) -> Self {
         let diameter2 = cell[0]
             .distance_squared(cell[2])
-            .max(cell[1].distance_squared(cell[3]));
+            .max(cell[1].distance_squared(cell[3]))
+            .max(cell[0].distance_squared(cell[1]))
+            .max(cell[1].distance_squared(cell[2]));
         ShooterSample {
             position,
             area,
             cell: Some(cell),
             near_r2: NEAR_FIELD_RATIO * NEAR_FIELD_RATIO * diameter2,
+            exact_r2: EXACT_RATIO * EXACT_RATIO * diameter2,
+            quadrature: quadrature(&cell, area),
         }
     }
+}
+
+/// A second-order quadrature rule over a cell: for a quadrilateral the
+/// 2 × 2 Gauss points of its bilinear map, each weighted by the area
+/// element there (exact for a planar bilinear cell); for a triangle (last
+/// corner repeated) the three points at barycentric `(2/3, 1/6, 1/6)` and
+/// its permutations, a third of the area each. Areas sum to `area`.
+fn quadrature(cell: &[Vec3; 4], area: f64) -> [(Vec3, f32); 4] {
+    let [a, b, c, d] = *cell;
+    if c == d {
+        let third = (area / 3.0) as f32;
+        let at = |u: f32, v: f32, w: f32| (a * u + b * v + c * w, third);
+        let (big, small) = (2.0 / 3.0, 1.0 / 6.0);
+        return [
+            at(big, small, small),
+            at(small, big, small),
+            at(small, small, big),
+            (a, 0.0),
+        ];
+    }
+    let g = 0.5 / 3f32.sqrt();
+    let mut points = [(a, 0.0f32); 4];
+    let mut total = 0.0f64;
+    for (slot, (u, w)) in points.iter_mut().zip([
+        (0.5 - g, 0.5 - g),
+        (0.5 + g, 0.5 - g),
+        (0.5 + g, 0.5 + g),
+        (0.5 - g, 0.5 + g),
+    ]) {
+        let p = (1.0 - u) * (1.0 - w) * a + u * (1.0 - w) * b + u * w * c + (1.0 - u) * w * d;
+        let du = (1.0 - w) * (b - a) + w * (c - d);
+        let dw = (1.0 - u) * (d - a) + u * (c - b);
+        let jacobian = du.cross(dw).length() as f64;
+        total += jacobian;
+        *slot = (p, jacobian as f32);
+    }
+    for slot in &mut points {
+        slot.1 = if total > 0.0 {
+            (f64::from(slot.1) / total * area) as f32
+        } else {
+            (area / 4.0) as f32
+        };
+    }
+    points
 }
 
 /// Which points of a shooter carry its power.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SampleSet {
     /// Its element vertices (evaluation positions), each standing for
-    /// `A / n`: the scheme of the original algorithm.
+    /// `A / n`: the scheme of the original algorithm (on an adaptively
+    /// refined polygon, each for its share of the area: see
+    /// [`Mesh::polygon_vertex_weights`]).
     Vertices,
     /// A regular grid of at most this many points over the polygon, each
     /// at the centre of its cell and standing for that cell's area. Used
@@ -113,13 +188,12 @@ pub fn shooter_samples(
             polygon.area,
         )],
         SampleSet::AtMost(n) if pm.vertex_count() > n.max(1) => grid_samples(polygon, n.max(1)),
-        SampleSet::Vertices | SampleSet::AtMost(_) => {
-            let each = polygon.area / pm.vertex_count() as f64;
-            mesh.sample_positions[pm.vertices.start as usize..pm.vertices.end as usize]
-                .iter()
-                .map(|&position| ShooterSample::point(position, each))
-                .collect()
-        }
+        SampleSet::Vertices | SampleSet::AtMost(_) => mesh.sample_positions
+            [pm.vertices.start as usize..pm.vertices.end as usize]
+            .iter()
+            .zip(mesh.polygon_vertex_weights(pm))
+            .map(|(&position, weight)| ShooterSample::point(position, polygon.area * weight))
+            .collect(),
     }
 }
 
@@ -267,16 +341,14 @@ where
         let term = match s.cell {
             // A receiver in the shooter's plane at its edge still sees it
             // (half of its hemisphere, at a right-angled corner).
-            Some(cell) if near_field && r2 < s.near_r2 * EXACT_SHARE => {
-                point_to_polygon(x, nx, &cell)
-            }
-            Some(cell) if near_field && r2 < s.near_r2 => {
-                if cos_s <= 0.0 || cos_x <= 0.0 {
-                    continue;
-                }
-                quartered_disc_sum(x, nx, ns, &cell, s.area)
-            }
+            Some(cell) if near_field && r2 < s.exact_r2 => point_to_polygon(x, nx, &cell),
+            // The cosines vary over the cell: each point has its own.
+            Some(_) if near_field && r2 < s.near_r2 => quadrature_sum(x, nx, ns, &s.quadrature),
             _ if cos_s <= 0.0 || cos_x <= 0.0 => continue,
+            Some(_) if near_field => {
+                let r2 = r2 as f64;
+                cos_s as f64 * cos_x as f64 * s.area / (PI * r2 * r2)
+            }
             _ => {
                 let r2 = r2 as f64;
                 // (cos_s / r)(cos_x / r) with d unnormalised.
@@ -295,33 +367,21 @@ where
     (sum, rays)
 }
 
-/// The disc sum over the four quarters of a cell (split at the midpoints of
-/// its sides; a triangle's fourth corner repeats its third), each quarter
-/// standing for a quarter of `area`: twice the ratio of distance to sample
-/// size of the plain disc term, for four cheap terms.
+/// The point terms `cosθ_i cosθ_j a / (π r²)` at a cell's quadrature
+/// points ([`ShooterSample::quadrature`]), those behind either surface
+/// left out.
 #[inline]
-fn quartered_disc_sum(x: Vec3, nx: Vec3, ns: Vec3, cell: &[Vec3; 4], area: f64) -> f64 {
-    let [a, b, c, d] = *cell;
-    let centre = if c == d {
-        (a + b + c) / 3.0
-    } else {
-        (a + b + c + d) * 0.25
-    };
-    let quarter = area * 0.25;
-    let mut sum = 0.0;
-    // The centres of the four quarters: halfway between each corner and
-    // the cell's centre (exactly for parallelograms, closely otherwise).
-    for corner in [a, b, c, if c == d { (a + b + c) / 3.0 } else { d }] {
-        let p = (corner + centre) * 0.5;
-        let dv = x - p;
-        let r2 = dv.length_squared();
-        let (cs, cx) = (ns.dot(dv), -nx.dot(dv));
+fn quadrature_sum(x: Vec3, nx: Vec3, ns: Vec3, points: &[(Vec3, f32); 4]) -> f64 {
+    let mut sum = 0.0f32;
+    for &(p, a) in points {
+        let d = x - p;
+        let r2 = d.length_squared();
+        let (cs, cx) = (ns.dot(d), -nx.dot(d));
         if cs > 0.0 && cx > 0.0 && r2 > 0.0 {
-            let r2 = r2 as f64;
-            sum += cs as f64 * cx as f64 / r2 * quarter / (PI * r2 + quarter);
+            sum += cs * cx * a / (std::f32::consts::PI * r2 * r2);
         }
     }
-    sum
+    f64::from(sum)
 }
 
 /// Exact unoccluded form factor from a differential area at `x` with unit

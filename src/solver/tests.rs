@@ -20,7 +20,14 @@ struct Solved {
 }
 
 fn solve(s: &Scene, lenmax: f32, inset: f32, options: SolverOptions) -> Solved {
-    let mesh = mesh::build(s, &MeshOptions { lenmax, inset }).unwrap();
+    solve_on(
+        s,
+        mesh::build(s, &MeshOptions { lenmax, inset }).unwrap(),
+        options,
+    )
+}
+
+fn solve_on(s: &Scene, mesh: Mesh, options: SolverOptions) -> Solved {
     let vis = Visibility::new(s);
     let mut solver = Progressive::new(s, &mesh, &vis, options);
     while !solver.is_done() {
@@ -36,6 +43,40 @@ fn solve(s: &Scene, lenmax: f32, inset: f32, options: SolverOptions) -> Solved {
         unshot_power: solver.unshot_power(),
         mesh,
     }
+}
+
+/// The regular mesh of `s` refined twice across the plane `x = cut`, as
+/// adaptive subdivision would refine it across a shadow edge there: split
+/// elements, fans around hanging vertices and unsplit elements side by
+/// side on every polygon the plane crosses.
+fn refined_across(s: &Scene, lenmax: f32, cut: f32) -> Mesh {
+    use crate::mesh::refine::{RefineOptions, Refiner};
+    let mut m = mesh::build(
+        s,
+        &MeshOptions {
+            lenmax,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let mut refiner = Refiner::new(&m);
+    let options = RefineOptions {
+        threshold: 0.25,
+        levels: 2,
+    };
+    loop {
+        let field: Vec<f64> = m
+            .positions
+            .iter()
+            .map(|p| if p.x < cut { 0.2 } else { 1.0 })
+            .collect();
+        match refiner.refine(s, &field, &options) {
+            Some((next, _)) => m = next,
+            None => break,
+        }
+    }
+    assert!(m.polygons.iter().any(|p| p.levels == 2));
+    m
 }
 
 /// Area-weighted mean radiosity of polygon `p`.
@@ -83,17 +124,14 @@ const SIDE: [[f32; 3]; 4] = [[0., 0., 0.], [0., 1., 0.], [0., 1., 1.], [0., 0., 
 // Tolerances. The receiver is integrated on a 51 × 51 vertex grid with
 // the default inset; integrating the *exact* point form factor on that
 // grid gives 0.20005 for the perpendicular pair (0.005 % off), so the
-// quadrature is not what is measured. The shooter's 64 samples (8 × 8
-// disc approximations, exact cells in the near field) then give 0.18 %
-// low for the parallel pair and 0.27 % low for the perpendicular pair, whose
-// receivers near the shared edge see the shooter at grazing angles where
-// a cell just outside the near-field radius is still approximated by a
-// disc. Hence 0.5 % and 1 %.
+// quadrature is not what is measured. Both pairs must be within 0.5 % at
+// the default sample count.
 
 #[test]
 fn parallel_unit_squares() {
     let f = measured_form_factor(BOTTOM, TOP, SolverOptions::default());
     let err = (f - F_PARALLEL_UNIT_SQUARES).abs() / F_PARALLEL_UNIT_SQUARES;
+    eprintln!("parallel: F = {f}, exact {F_PARALLEL_UNIT_SQUARES}");
     assert!(
         err < 0.005,
         "F = {f}, exact {F_PARALLEL_UNIT_SQUARES}, error {err}"
@@ -104,8 +142,9 @@ fn parallel_unit_squares() {
 fn perpendicular_unit_squares() {
     let f = measured_form_factor(BOTTOM, SIDE, SolverOptions::default());
     let err = (f - F_PERPENDICULAR_UNIT_SQUARES).abs() / F_PERPENDICULAR_UNIT_SQUARES;
+    eprintln!("perpendicular: F = {f}, exact {F_PERPENDICULAR_UNIT_SQUARES}");
     assert!(
-        err < 0.01,
+        err < 0.005,
         "F = {f}, exact {F_PERPENDICULAR_UNIT_SQUARES}, error {err}"
     );
 }
@@ -191,59 +230,149 @@ impl Vec3Like {
 }
 
 /// In a closed box whose walls all have the same `e` and `rho`, the exact
-/// solution is uniform: `B = e / (1 − rho)`.
+/// solution is uniform: `B = e / (1 − rho)`. Every vertex must be within
+/// 1 %, with either unshot scheme, on the regular mesh and on one refined
+/// as adaptive subdivision refines (fans and uneven vertex areas).
 #[test]
 fn uniform_enclosure() {
     let (e, rho) = (1.0, 0.6);
     let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]);
-    for (form_factor, unshot) in [
-        (FormFactorMethod::Wallace, UnshotScheme::Polygon),
-        (FormFactorMethod::Wallace, UnshotScheme::Vertex),
-        (FormFactorMethod::Center, UnshotScheme::Polygon),
-    ] {
-        let solved = solve(
-            &s,
-            0.1,
-            crate::mesh::DEFAULT_INSET,
-            SolverOptions {
-                form_factor,
+    let exact = e / (1.0 - rho);
+    for refined in [false, true] {
+        for unshot in [UnshotScheme::Polygon, UnshotScheme::Vertex] {
+            let options = SolverOptions {
                 unshot,
                 threshold: 1e-4,
                 ..Default::default()
-            },
-        );
-        if form_factor == FormFactorMethod::Center {
-            // The one-sample estimate is far too coarse for walls that
-            // meet at an edge; it only has to stay physical.
-            for p in 0..6 {
-                let b = mean_radiosity(&solved.mesh, &solved.radiosity, p).r;
-                assert!(b > e && b < e / (1.0 - rho), "wall {p}: {b}");
-            }
-            continue;
+            };
+            let solved = if refined {
+                solve_on(&s, refined_across(&s, 0.1, 0.37), options)
+            } else {
+                solve(&s, 0.1, crate::mesh::DEFAULT_INSET, options)
+            };
+            let worst = solved
+                .radiosity
+                .iter()
+                .map(|b| (b.r - exact).abs() / exact)
+                .fold(0.0, f64::max);
+            eprintln!("{unshot:?}, refined {refined}: worst vertex error {worst}");
+            assert!(worst < 0.01, "{unshot:?}, refined {refined}: {worst}");
+            assert!(solved.steps > 6);
         }
-        let exact = e / (1.0 - rho);
-        for p in 0..6 {
-            let b = mean_radiosity(&solved.mesh, &solved.radiosity, p).r;
-            assert!((b - exact).abs() < 0.02 * exact, "wall {p}: {b} vs {exact}");
-        }
-        assert!(solved.steps > 6);
+    }
+}
+
+/// The one-sample centre estimate is far too coarse for walls that meet at
+/// an edge; in the uniform enclosure it only has to stay physical.
+#[test]
+fn centre_estimate_stays_physical() {
+    let (e, rho) = (1.0, 0.6);
+    let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]);
+    let solved = solve(
+        &s,
+        0.1,
+        crate::mesh::DEFAULT_INSET,
+        SolverOptions {
+            form_factor: FormFactorMethod::Center,
+            unshot: UnshotScheme::Polygon,
+            threshold: 1e-4,
+            ..Default::default()
+        },
+    );
+    for p in 0..6 {
+        let b = mean_radiosity(&solved.mesh, &solved.radiosity, p).r;
+        assert!(b > e && b < e / (1.0 - rho), "wall {p}: {b}");
     }
 }
 
 /// In a closed room the power emitted equals the power absorbed, where a
 /// polygon absorbs `A (1 − rho)/rho · (B − e)` (its irradiance times
 /// `1 − rho`); the unshot power left at the end counts as not yet absorbed.
+/// Within 0.5 %, with either scheme, on regular and refined meshes.
 #[test]
 fn energy_balance_in_a_closed_box() {
     let s = glowing_box();
-    let options = SolverOptions {
-        threshold: 1e-5,
-        unshot: UnshotScheme::Polygon,
-        ..Default::default()
-    };
-    let solved = solve(&s, 0.05, crate::mesh::DEFAULT_INSET, options);
-    let error = energy_error(&s, &solved);
-    assert!(error < 0.01, "energy error {error}");
+    for refined in [false, true] {
+        for unshot in [UnshotScheme::Polygon, UnshotScheme::Vertex] {
+            let options = SolverOptions {
+                threshold: 1e-5,
+                unshot,
+                ..Default::default()
+            };
+            let solved = if refined {
+                solve_on(&s, refined_across(&s, 0.1, 0.77), options)
+            } else {
+                solve(&s, 0.05, crate::mesh::DEFAULT_INSET, options)
+            };
+            let error = energy_error(&s, &solved);
+            eprintln!("{unshot:?}, refined {refined}: energy error {error}");
+            assert!(error < 0.005, "{unshot:?}, refined {refined}: {error}");
+        }
+    }
+}
+
+/// In an open scene, emitted power = absorbed + escaped. A box without its
+/// top: light leaves through the opening, and the power escaping from a
+/// point `x` of a wall is `B(x) · F(x → opening)`, with `F` the exact
+/// (Lambert) form factor to the missing square, since nothing inside the
+/// convex box blocks it (evaluated where the solver evaluates `B`). Summed
+/// over every vertex's area, absorbed plus escaped plus unshot must equal
+/// emitted within 0.5 % with per-vertex unshot (the default).
+#[test]
+fn energy_balance_in_an_open_box() {
+    use super::formfactor::point_to_polygon;
+    let size = 2.0;
+    let mut walls = closed_box(size, [1, 2, 1, 0, 1, 2]);
+    // Lambert's integral is unsigned: the opening's orientation is moot.
+    let opening = walls.pop().unwrap();
+    let s = scene(
+        walls,
+        vec![
+            grey("lamp", 10.0, 0.3),
+            grey("a", 0.0, 0.7),
+            grey("b", 0.0, 0.4),
+        ],
+    );
+    for unshot in [UnshotScheme::Polygon, UnshotScheme::Vertex] {
+        let solved = solve(
+            &s,
+            0.1,
+            crate::mesh::DEFAULT_INSET,
+            SolverOptions {
+                threshold: 1e-5,
+                unshot,
+                ..Default::default()
+            },
+        );
+        let areas = solved.mesh.vertex_areas();
+        let (mut absorbed, mut escaped) = (0.0, 0.0);
+        for (p, polygon) in s.polygons.iter().enumerate() {
+            let material = &s.materials[polygon.material.index()];
+            let (rho, e) = (material.reflectance().r, material.emission().r);
+            let pm = &solved.mesh.polygons[p];
+            for l in pm.vertices.clone() {
+                let (b, a) = (solved.radiosity[l as usize].r, areas[l as usize]);
+                absorbed += a * (1.0 - rho) / rho * (b - e);
+                let x = solved.mesh.sample_positions[l as usize];
+                escaped += a * b * point_to_polygon(x, pm.normal, &opening.vertices);
+            }
+        }
+        let emitted = solved.initial_power;
+        let error = (absorbed + escaped + solved.unshot_power - emitted).abs() / emitted;
+        eprintln!(
+            "{unshot:?}: emitted {emitted}, absorbed {absorbed}, escaped {escaped}, error {error}"
+        );
+        assert!(escaped > 0.2 * emitted, "the opening lets light out");
+        let bound = match unshot {
+            UnshotScheme::Vertex => 0.005,
+            // Measured 0.8 %, the same with area weights and on a mesh
+            // twice as fine: the scheme re-emits each wall's light evenly,
+            // while the walls are darker near the opening, so more light
+            // leaves through it than the solution's own radiosities say.
+            UnshotScheme::Polygon => 0.012,
+        };
+        assert!(error < bound, "{unshot:?}: energy error {error}");
+    }
 }
 
 /// A box whose ceiling glows and reflects, with walls of different
@@ -572,7 +701,7 @@ fn per_vertex_unshot_balances_energy_and_is_deterministic() {
     let (one, two) = (run(1), run(2));
     assert!(same_bits(&one.radiosity, &two.radiosity));
     let error = energy_error(&s, &one);
-    assert!(error < 0.01, "energy error {error}");
+    assert!(error < 0.005, "energy error {error}");
 }
 
 #[test]
@@ -594,11 +723,11 @@ fn barycentric_weights_reproduce_the_point() {
 /// The sampled form factor (64 samples, near field on) from points in
 /// front of a unit square against Lambert's exact contour integral at 2,000
 /// random unoccluded points (0.05 to 2 units above it, up to a unit to the
-/// side, facing it at random). Measured: median error 0.17 %, 95th
-/// percentile 1.0 %, worst 2.2 % — at points low over the plane
-/// beside the square, facing it sideways, where one cosine per cell is a
-/// poor stand-in for the cell. The 0.5 % everywhere that the accuracy work
-/// aims at is not reached yet; this test holds what is.
+/// side, facing it at random). Every point must be within 0.5 %. Measured:
+/// median 0.064 %, 95th percentile 0.21 %, worst 0.27 % (with the disc
+/// term alone at every distance the worst was 2.2 %, at points low over
+/// the plane beside the square where one cosine per cell is a poor
+/// stand-in for the cell).
 #[test]
 fn point_to_square_matches_lambert_at_random_points() {
     use super::formfactor::{point_to_polygon, point_to_samples, shooter_samples, SampleSet};
@@ -647,10 +776,56 @@ fn point_to_square_matches_lambert_at_random_points() {
     errors.sort_by(f64::total_cmp);
     let (median, p95, worst) = (errors[1000], errors[1900], errors[1999]);
     eprintln!("median {median}, 95th percentile {p95}, worst {worst}");
-    assert!(
-        median < 0.003 && p95 < 0.015 && worst < 0.03,
-        "median {median}, p95 {p95}, worst {worst}"
+    assert!(worst < 0.005, "median {median}, p95 {p95}, worst {worst}");
+}
+
+/// Receivers much closer to the shooter than its sample spacing (a table
+/// leg's foot on the floor, a lamp just under the ceiling): from 10⁻⁴ to
+/// 0.05 units above a unit square of 8 × 8 cells (spacing 0.125), over it
+/// and just beyond its edges, facing it. No spike: every estimate is within
+/// 0.5 % of Lambert's exact value, and never above 1 (but for rounding).
+#[test]
+fn close_receivers_match_lambert_without_spikes() {
+    use super::formfactor::{point_to_polygon, point_to_samples, shooter_samples, SampleSet};
+    let square = polygon(0, &BOTTOM);
+    let s = scene(vec![square.clone()], vec![grey("lamp", 1.0, 0.0)]);
+    let m = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.02,
+            inset: 0.0,
+        },
+    )
+    .unwrap();
+    let samples = shooter_samples(
+        &square,
+        &m.polygons[0],
+        &m,
+        SampleSet::AtMost(DEFAULT_SHOOTER_SAMPLES),
     );
+    let mut worst = 0.0f64;
+    for i in 0..=60 {
+        for k in 0..=60 {
+            for height in [1e-4f32, 1e-3, 0.01, 0.05] {
+                // -0.1 .. 1.1: beyond the edges too, where the receiver
+                // sees the square at grazing angles.
+                let x = glam::Vec3::new(
+                    -0.1 + 1.2 * i as f32 / 60.0,
+                    -0.1 + 1.2 * k as f32 / 60.0,
+                    height,
+                );
+                let n = -glam::Vec3::Z;
+                let exact = point_to_polygon(x, n, &square.vertices);
+                let (f, _) = point_to_samples(x, n, glam::Vec3::Z, &samples, true, |_, _| false);
+                assert!(f <= 1.0 + 1e-6, "F = {f} at {x}");
+                if exact > 1e-3 {
+                    worst = worst.max((f - exact).abs() / exact);
+                }
+            }
+        }
+    }
+    eprintln!("worst relative error {worst}");
+    assert!(worst < 0.005, "worst relative error {worst}");
 }
 
 /// Reciprocity: for two unequal polygons, `A_i F_ij = A_j F_ji` within 1 %.
