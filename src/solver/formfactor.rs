@@ -42,7 +42,7 @@
 
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec4};
 use std::f64::consts::PI;
 
 /// A receiver within this many cell diameters of a grid sample gets the
@@ -79,7 +79,34 @@ pub struct ShooterSample {
     /// Quadrature points over the cell and the areas they stand for
     /// (summing to [`ShooterSample::area`]; a triangle's fourth is unused
     /// and stands for 0).
-    pub quadrature: [(Vec3, f32); 4],
+    pub quadrature: Quadrature,
+}
+
+/// Four quadrature points and their areas, one per SIMD lane: `x[k]`,
+/// `y[k]`, `z[k]` the position of point `k` in scene units, `area[k]` the
+/// square scene units it stands for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quadrature {
+    /// x coordinates.
+    pub x: Vec4,
+    /// y coordinates.
+    pub y: Vec4,
+    /// z coordinates.
+    pub z: Vec4,
+    /// Areas.
+    pub area: Vec4,
+}
+
+impl Quadrature {
+    fn new(points: [(Vec3, f32); 4]) -> Self {
+        let lane = |f: fn(&(Vec3, f32)) -> f32| Vec4::from_array(points.each_ref().map(f));
+        Quadrature {
+            x: lane(|p| p.0.x),
+            y: lane(|p| p.0.y),
+            z: lane(|p| p.0.z),
+            area: lane(|p| p.1),
+        }
+    }
 }
 
 impl ShooterSample {
@@ -91,7 +118,7 @@ impl ShooterSample {
             cell: None,
             near_r2: 0.0,
             exact_r2: 0.0,
-            quadrature: [(position, 0.0); 4],
+            quadrature: Quadrature::new([(position, 0.0); 4]),
         }
     }
 
@@ -109,7 +136,7 @@ impl ShooterSample {
             cell: Some(cell),
             near_r2: NEAR_FIELD_RATIO * NEAR_FIELD_RATIO * diameter2,
             exact_r2: EXACT_RATIO * EXACT_RATIO * diameter2,
-            quadrature: quadrature(&cell, area),
+            quadrature: Quadrature::new(quadrature(&cell, area)),
         }
     }
 }
@@ -369,19 +396,21 @@ where
 
 /// The point terms `cosθ_i cosθ_j a / (π r²)` at a cell's quadrature
 /// points ([`ShooterSample::quadrature`]), those behind either surface
-/// left out.
+/// left out; the four at once, one per SIMD lane.
 #[inline]
-fn quadrature_sum(x: Vec3, nx: Vec3, ns: Vec3, points: &[(Vec3, f32); 4]) -> f64 {
-    let mut sum = 0.0f32;
-    for &(p, a) in points {
-        let d = x - p;
-        let r2 = d.length_squared();
-        let (cs, cx) = (ns.dot(d), -nx.dot(d));
-        if cs > 0.0 && cx > 0.0 && r2 > 0.0 {
-            sum += cs * cx * a / (std::f32::consts::PI * r2 * r2);
-        }
-    }
-    f64::from(sum)
+fn quadrature_sum(x: Vec3, nx: Vec3, ns: Vec3, q: &Quadrature) -> f64 {
+    let dx = Vec4::splat(x.x) - q.x;
+    let dy = Vec4::splat(x.y) - q.y;
+    let dz = Vec4::splat(x.z) - q.z;
+    let r2 = dx * dx + dy * dy + dz * dz;
+    let cs = dx * ns.x + dy * ns.y + dz * ns.z;
+    let cx = -(dx * nx.x + dy * nx.y + dz * nx.z);
+    let zero = Vec4::ZERO;
+    let seen = cs.cmpgt(zero) & cx.cmpgt(zero) & r2.cmpgt(zero);
+    // Lanes left out divide by 1, not by a zero distance.
+    let denominator = Vec4::select(seen, r2 * r2 * std::f32::consts::PI, Vec4::ONE);
+    let terms = Vec4::select(seen, cs * cx * q.area / denominator, zero);
+    f64::from(terms.element_sum())
 }
 
 /// Exact unoccluded form factor from a differential area at `x` with unit
