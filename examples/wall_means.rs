@@ -3,72 +3,77 @@
 //!
 //! ```sh
 //! cargo run --release --example wall_means -- scenes/cornell.sc vertex 12
+//! cargo run --release --example wall_means -- scenes/cornell.sc vertex 12 adaptive
 //! ```
 //!
-//! Arguments: the scene, the unshot scheme (`vertex` or `polygon`), and
-//! `lenmax` in scene units (optional; default as the program's).
+//! Arguments: the scene, the unshot scheme (`vertex` or `polygon`),
+//! `lenmax` in scene units (optional; `-` or absent for the program's
+//! default), and `adaptive` to solve with the default adaptive subdivision.
 
+use radiosity::app::{self, RunConfig, SceneSource};
 use radiosity::color::Rgb;
-use radiosity::mesh::{self, MeshOptions};
-use radiosity::scene;
-use radiosity::solver::{Progressive, SolverOptions, UnshotScheme};
-use radiosity::visibility::Visibility;
-use std::path::Path;
+use radiosity::mesh::refine::RefineOptions;
+use radiosity::solver::UnshotScheme;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (Some(path), Some(scheme)) = (args.get(1), args.get(2)) else {
-        eprintln!("usage: wall_means SCENE vertex|polygon [LENMAX]");
+        eprintln!("usage: wall_means SCENE vertex|polygon [LENMAX|-] [adaptive]");
         std::process::exit(2);
     };
-    let scene = match scene::load(Path::new(path)) {
-        Ok(s) => s,
+    let mut config = RunConfig::new(SceneSource::File(PathBuf::from(path)));
+    config.lenmax = args.get(3).and_then(|l| l.parse().ok());
+    config.solver.unshot = if scheme == "polygon" {
+        UnshotScheme::Polygon
+    } else {
+        UnshotScheme::Vertex
+    };
+    if args.get(4).is_some_and(|a| a == "adaptive") {
+        config.adaptive = Some(RefineOptions::default());
+    }
+    let prepared = match app::prepare(&config) {
+        Ok(p) => p,
         Err(e) => {
             eprintln!("{e}");
             std::process::exit(2);
         }
     };
-    let mut options = MeshOptions::for_scene(&scene);
-    if let Some(l) = args.get(3).and_then(|l| l.parse().ok()) {
-        options.lenmax = l;
-    }
-    let unshot = if scheme == "polygon" {
-        UnshotScheme::Polygon
-    } else {
-        UnshotScheme::Vertex
-    };
-    let mesh = match mesh::build(&scene, &options) {
-        Ok(m) => m,
+    let start = std::time::Instant::now();
+    let solution = match app::solve(&config, &prepared, &AtomicBool::new(false)) {
+        Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
-            std::process::exit(2);
+            eprintln!("{e}");
+            std::process::exit(1);
         }
     };
-    let visibility = Visibility::new(&scene);
-    let mut solver = Progressive::new(
-        &scene,
-        &mesh,
-        &visibility,
-        SolverOptions {
-            unshot,
-            ..Default::default()
-        },
-    );
-    let start = std::time::Instant::now();
-    while !solver.is_done() && solver.step().is_some() {}
+    let mesh = &solution.mesh;
+    let radiosity = &solution.solved.radiosity;
     let areas = mesh.vertex_areas();
     println!(
-        "# {path}: --unshot {scheme}, lenmax {}, {} vertices, {} steps, {:.2} s",
-        options.lenmax,
+        "# {path}: --unshot {scheme}, lenmax {}{}, {} vertices, {} steps (last solve), {:.2} s",
+        prepared.lenmax,
+        if config.adaptive.is_some() {
+            ", --adaptive"
+        } else {
+            ""
+        },
         mesh.vertex_count(),
-        solver.steps(),
+        solution.solved.steps,
         start.elapsed().as_secs_f64()
     );
     println!("polygon,line,area,r,g,b");
-    for (p, (polygon, pm)) in scene.polygons.iter().zip(&mesh.polygons).enumerate() {
+    for (p, (polygon, pm)) in prepared
+        .scene
+        .polygons
+        .iter()
+        .zip(&mesh.polygons)
+        .enumerate()
+    {
         let mut sum = Rgb::BLACK;
         for l in pm.vertices.clone() {
-            sum += solver.radiosity()[l as usize] * areas[l as usize];
+            sum += radiosity[l as usize] * areas[l as usize];
         }
         let mean = sum / pm.area;
         println!(

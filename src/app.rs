@@ -366,6 +366,8 @@ pub struct PassStats {
     pub rays: u64,
     /// Seconds it took, refinement of its result included.
     pub seconds: f64,
+    /// Of those, seconds spent refining the mesh after the solve.
+    pub refine_seconds: f64,
     /// Elements its result marked for splitting (0 for the last solve).
     pub split: usize,
     /// Further elements split to keep the mesh conforming.
@@ -506,15 +508,18 @@ fn solve_adaptive(
             steps: solved.steps,
             rays: solved.rays,
             seconds: 0.0,
+            refine_seconds: 0.0,
             split: 0,
             closure: 0,
         };
+        let refining = Instant::now();
         let next = if refiner.passes() < options.levels {
             let luminance: Vec<f64> = solved.radiosity.iter().map(|b| b.luminance()).collect();
             refiner.refine(&prepared.scene, &luminance, options)
         } else {
             None
         };
+        pass.refine_seconds = refining.elapsed().as_secs_f64();
         pass.seconds = t.elapsed().as_secs_f64();
         if config.progress {
             eprintln!(
@@ -1087,10 +1092,16 @@ impl RateEstimate {
 
 /// A one-line summary of a finished run.
 pub fn summary(stats: &RunStats) -> String {
+    let steps = match (stats.adaptive.first(), stats.adaptive.len()) {
+        (Some(first), solves) if solves > 1 => format!(
+            "{solves} solves refining {} to {} vertices, {} steps in the last",
+            first.vertices, stats.vertices, stats.steps
+        ),
+        _ => format!("{} steps", stats.steps),
+    };
     format!(
-        "{}: {} steps, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {}",
+        "{}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {}",
         stats.scene,
-        stats.steps,
         stats.seconds.solve,
         stats.rays as f64 / 1e6,
         stats.unshot_fraction * 100.0,

@@ -406,6 +406,13 @@ impl Refiner {
         for (p, (polygon, initial)) in scene.polygons.iter().zip(&self.polygons).enumerate() {
             let id = PolygonId(p as u32);
             let v_start = mesh.positions.len() as u32;
+            if initial.levels > 0 {
+                // New vertices were numbered as they were made, scattered
+                // over the polygon; the solver groups runs of consecutive
+                // vertices into shafts, which must stay thin. A Z-order
+                // curve keeps neighbours together.
+                sort_along_z_curve(&mut vertices_of[p], &self.positions);
+            }
             for &v in &vertices_of[p] {
                 pool_to_mesh[v as usize] = mesh.positions.len() as u32;
                 self.mesh_to_pool.push(v);
@@ -476,6 +483,30 @@ impl Refiner {
         let (a, b) = (leaf.corners[edge], leaf.corners[(edge + 1) % n]);
         self.midpoints[&edge_key(a, b)]
     }
+}
+
+/// Sorts vertex ids by the Z-order (Morton) code of their positions
+/// within the bounding box of them all, 10 bits per axis; ties by id.
+fn sort_along_z_curve(ids: &mut [u32], positions: &[Vec3]) {
+    let (lo, hi) = ids.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &v| (lo.min(positions[v as usize]), hi.max(positions[v as usize])),
+    );
+    let scale = (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+    let spread = |mut x: u32| {
+        // Insert two zero bits between each of the low 10 bits.
+        x &= 0x3ff;
+        x = (x | (x << 16)) & 0x0300_00ff;
+        x = (x | (x << 8)) & 0x0300_f00f;
+        x = (x | (x << 4)) & 0x030c_30c3;
+        (x | (x << 2)) & 0x0924_9249
+    };
+    let code = |v: u32| {
+        let q =
+            ((positions[v as usize] - lo) / scale * 1023.0).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+        spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2)
+    };
+    ids.sort_by_key(|&v| (code(v), v));
 }
 
 /// The shortest element edge of a polygon's mesh, in scene units.
