@@ -172,7 +172,9 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         h.word(pm.vertices.start as u64);
         h.word(pm.vertices.end as u64);
     }
-    h.bytes(b"options");
+    // The form-factor rules themselves: a checkpoint from a build that
+    // estimated them otherwise would not continue to the same bits.
+    h.bytes(b"options: cell quadrature, cells on every shooter");
     h.word(match options.form_factor {
         FormFactorMethod::Wallace => 1,
         FormFactorMethod::Center => 2,

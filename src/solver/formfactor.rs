@@ -37,8 +37,9 @@
 //! Each still takes the visibility of the one ray to the sample. Against
 //! Lambert's formula at 2,000 random points around a unit square with 64
 //! cells, the worst error is 0.3 % (the disc sum alone: 2.2 %). Vertex
-//! samples (a shooter with few element vertices) have no cell and keep the
-//! disc term; so does every sample with the near field switched off.
+//! samples ([`SampleSet::Vertices`], the original algorithm) have no cell
+//! and keep the disc term; so does every sample with the near field
+//! switched off.
 
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
@@ -193,9 +194,9 @@ pub enum SampleSet {
     /// refined polygon, each for its share of the area: see
     /// [`Mesh::polygon_vertex_weights`]).
     Vertices,
-    /// A regular grid of at most this many points over the polygon, each
-    /// at the centre of its cell and standing for that cell's area. Used
-    /// only when the polygon has more element vertices than this.
+    /// A regular grid of at most this many points over the polygon, and
+    /// no more than it has element vertices, each at the centre of its
+    /// cell and standing for that cell's area.
     AtMost(u32),
     /// One point at the area centroid standing for the whole polygon: the
     /// cheap point-to-disc approximation.
@@ -214,8 +215,11 @@ pub fn shooter_samples(
             area_centroid(&polygon.vertices),
             polygon.area,
         )],
-        SampleSet::AtMost(n) if pm.vertex_count() > n.max(1) => grid_samples(polygon, n.max(1)),
-        SampleSet::Vertices | SampleSet::AtMost(_) => mesh.sample_positions
+        // As many cells as vertices on a small polygon: the same rays as
+        // shooting from its vertices, and cells give the near field (a
+        // table leg shooting at the floor it stands on).
+        SampleSet::AtMost(n) => grid_samples(polygon, n.min(pm.vertex_count()).max(1)),
+        SampleSet::Vertices => mesh.sample_positions
             [pm.vertices.start as usize..pm.vertices.end as usize]
             .iter()
             .zip(mesh.polygon_vertex_weights(pm))

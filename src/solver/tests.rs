@@ -828,6 +828,59 @@ fn close_receivers_match_lambert_without_spikes() {
     assert!(worst < 0.005, "worst relative error {worst}");
 }
 
+/// A small shooter standing on the receiver (a table leg's face on the
+/// floor): a 0.2 × 0.2 square with 36 element vertices, upright on a unit
+/// floor. Each floor vertex in front of it gets, after one step,
+/// `rho · F(vertex → leg)`; against Lambert's exact value at the vertex's
+/// evaluation point every vertex must be within 1 %, the ones touching the
+/// leg's foot included, and none may spike. Measured: worst 0.48 % (its
+/// vertices as samples, as `--shooter-samples all` shoots: worst 45 %).
+#[test]
+fn small_shooter_standing_on_the_receiver_matches_lambert() {
+    use super::formfactor::point_to_polygon;
+    let leg = [
+        [0.4, 0.5, 0.],
+        [0.6, 0.5, 0.],
+        [0.6, 0.5, 0.2],
+        [0.4, 0.5, 0.2],
+    ];
+    let s = scene(
+        vec![polygon(0, &leg), polygon(1, &BOTTOM)],
+        vec![grey("lamp", 1.0, 0.0), grey("floor", 0.0, 0.5)],
+    );
+    assert!(s.polygons[0].normal.y < 0.0, "the leg faces -y");
+    let solved = solve(
+        &s,
+        0.05,
+        crate::mesh::DEFAULT_INSET,
+        SolverOptions {
+            max_steps: Some(1),
+            ..Default::default()
+        },
+    );
+    assert!(solved.mesh.polygons[0].vertex_count() <= DEFAULT_SHOOTER_SAMPLES);
+    let floor = &solved.mesh.polygons[1];
+    let (mut worst, mut checked) = (0.0f64, 0);
+    for l in floor.vertices.clone() {
+        let x = solved.mesh.sample_positions[l as usize];
+        let f = solved.radiosity[l as usize].r / 0.5;
+        if x.y >= 0.5 {
+            // Behind the leg, which faces -y.
+            assert_eq!(f, 0.0, "at {x}");
+            continue;
+        }
+        let exact = point_to_polygon(x, glam::Vec3::Z, &s.polygons[0].vertices);
+        assert!(f <= 0.5 + 1e-6, "F = {f} at {x}: a spike");
+        if exact > 1e-3 {
+            worst = worst.max((f - exact).abs() / exact);
+            checked += 1;
+        }
+    }
+    eprintln!("{checked} floor vertices, worst relative error {worst}");
+    assert!(checked > 50);
+    assert!(worst < 0.01, "worst relative error {worst}");
+}
+
 /// Reciprocity: for two unequal polygons, `A_i F_ij = A_j F_ji` within 1 %.
 #[test]
 fn reciprocity_of_measured_form_factors() {
