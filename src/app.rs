@@ -345,15 +345,19 @@ pub struct RunStats {
     pub exposure: f32,
     /// True when the threshold was reached (false: step limit).
     pub converged: bool,
-    /// With `--adaptive`, one entry per solve, the coarsest first; the
-    /// counts above are the last solve's. Empty (and not written) without.
+    /// With `--adaptive`, one entry per pass, the coarsest first; then
+    /// `elements` and `vertices` above are the last mesh's and the steps,
+    /// rays and pairs totals over every pass. Empty (and not written)
+    /// without.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub adaptive: Vec<PassStats>,
     /// Seconds per phase.
     pub seconds: PhaseSeconds,
 }
 
-/// One solve of an adaptive run (see [`RunStats::adaptive`]).
+/// One pass of an adaptive run (see [`RunStats::adaptive`]): a solve on one
+/// mesh (continued from the last pass with per-vertex unshot, afresh with
+/// per-polygon unshot) and the refinement of its result.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PassStats {
     /// Mesh elements of this solve.
@@ -362,11 +366,12 @@ pub struct PassStats {
     pub vertices: usize,
     /// Shooting steps it took.
     pub steps: u64,
-    /// Shadow rays it cast.
+    /// Shadow rays it cast, the new vertices' gather included.
     pub rays: u64,
     /// Seconds it took, refinement of its result included.
     pub seconds: f64,
-    /// Of those, seconds spent refining the mesh after the solve.
+    /// Of those, seconds spent refining the mesh after the solve and
+    /// gathering the light at the new vertices.
     pub refine_seconds: f64,
     /// Elements its result marked for splitting (0 for the last solve).
     pub split: usize,
@@ -462,6 +467,15 @@ fn solve_mesh(
         fingerprint,
     });
     let steps_taken = solve_cancellable(&mut solver, config.progress, cancel, plan.as_ref())?;
+    solved_from(&solver, config, steps_taken)
+}
+
+/// The result of a finished solve (checked), detached from the solver.
+fn solved_from(
+    solver: &Progressive,
+    config: &RunConfig,
+    steps_taken: Vec<(StepReport, Duration)>,
+) -> Result<Solved, RunError> {
     solver
         .validate()
         .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?;
@@ -487,9 +501,15 @@ fn solve_mesh(
 }
 
 /// Solves, refines where the solution's luminance changes sharply, and
-/// solves again on the refined mesh, until nothing needs splitting or
-/// `options.levels` refinements are done. Each solve starts afresh: a
-/// converged solve on the final mesh, as if it had been built that way.
+/// goes on on the refined mesh, until nothing needs splitting or
+/// `options.levels` refinements are done.
+///
+/// With per-vertex unshot radiosity the solve continues on the refined
+/// mesh ([`Progressive::refined_state`]): the vertices both meshes share
+/// keep their values, the new ones gather the light every polygon has shot
+/// so far, and shooting goes on from there. With per-polygon unshot each
+/// refined mesh is solved afresh. The counts of the returned solve are
+/// totals over every pass.
 fn solve_adaptive(
     config: &RunConfig,
     prepared: &Prepared,
@@ -498,15 +518,35 @@ fn solve_adaptive(
 ) -> Result<(Mesh, Solved, Vec<PassStats>), RunError> {
     let mut refiner = Refiner::new(&prepared.mesh);
     let mut mesh = prepared.mesh.clone();
-    let mut passes = Vec::new();
+    let mut passes: Vec<PassStats> = Vec::new();
+    let mut start: Option<checkpoint::SolverState> = None;
+    let (mut steps_taken, mut pairs, mut receiver_pairs) = (Vec::new(), 0, (0, 0));
     loop {
         let t = Instant::now();
-        let solved = solve_mesh(config, prepared, &mesh, cancel)?;
+        let mut solver =
+            Progressive::new(&prepared.scene, &mesh, &prepared.visibility, config.solver);
+        match start.take() {
+            Some(state) => solver
+                .restore(state)
+                .map_err(|e| RunError::Render(RenderError::BadMesh(e)))?,
+            // A fresh solve numbers its steps from 1 again: the log and
+            // plot show only the last one.
+            None => steps_taken.clear(),
+        }
+        let (steps_at_start, rays_at_start) = (solver.steps(), solver.rays());
+        let offset = steps_taken
+            .last()
+            .map_or(Duration::ZERO, |s: &(StepReport, Duration)| s.1);
+        let taken = solve_cancellable(&mut solver, config.progress, cancel, None)?;
+        steps_taken.extend(taken.into_iter().map(|(r, d)| (r, d + offset)));
+        pairs += solver.pairs();
+        receiver_pairs.0 += solver.receiver_pairs().0;
+        receiver_pairs.1 += solver.receiver_pairs().1;
         let mut pass = PassStats {
             elements: mesh.elements.len(),
             vertices: mesh.vertex_count(),
-            steps: solved.steps,
-            rays: solved.rays,
+            steps: solver.steps() - steps_at_start,
+            rays: solver.rays() - rays_at_start,
             seconds: 0.0,
             refine_seconds: 0.0,
             split: 0,
@@ -514,11 +554,20 @@ fn solve_adaptive(
         };
         let refining = Instant::now();
         let next = if refiner.passes() < options.levels {
-            let luminance: Vec<f64> = solved.radiosity.iter().map(|b| b.luminance()).collect();
+            let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
             refiner.refine(&prepared.scene, &luminance, options)
         } else {
             None
         };
+        if let Some((refined, _)) = &next {
+            // The gather for the new vertices is this pass's work too.
+            let previous = refiner.previous_index();
+            let unshot = refiner.carry(solver.unshot());
+            start = solver.refined_state(refined, &previous, unshot);
+            if let Some(state) = &start {
+                pass.rays += state.rays - solver.rays();
+            }
+        }
         pass.refine_seconds = refining.elapsed().as_secs_f64();
         pass.seconds = t.elapsed().as_secs_f64();
         if config.progress {
@@ -546,6 +595,12 @@ fn solve_adaptive(
             }
             None => {
                 passes.push(pass);
+                let mut solved = solved_from(&solver, config, std::mem::take(&mut steps_taken))?;
+                solved.steps = passes.iter().map(|p| p.steps).sum();
+                solved.rays = passes.iter().map(|p| p.rays).sum();
+                solved.pairs = pairs;
+                solved.receiver_pairs = receiver_pairs;
+                drop(solver);
                 return Ok((mesh, solved, passes));
             }
         }
@@ -1094,7 +1149,7 @@ impl RateEstimate {
 pub fn summary(stats: &RunStats) -> String {
     let steps = match (stats.adaptive.first(), stats.adaptive.len()) {
         (Some(first), solves) if solves > 1 => format!(
-            "{solves} solves refining {} to {} vertices, {} steps in the last",
+            "{solves} passes refining {} to {} vertices, {} steps in all",
             first.vertices, stats.vertices, stats.steps
         ),
         _ => format!("{} steps", stats.steps),

@@ -96,6 +96,38 @@ fn start_xvfb() -> Option<(Reaper, String)> {
     None
 }
 
+/// Starts the program on `cornell.sc` (a coarse mesh, a small window) in
+/// `dir` on `display` with `extra` arguments, and waits for its window.
+/// Returns the program (stdout piped) and the window's id.
+fn open_cornell(dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
+    let scene = common::scene("cornell.sc");
+    let mut args = vec![
+        scene.to_str().unwrap(),
+        "--lenmax",
+        "80",
+        "--size",
+        "160x120",
+    ];
+    args.extend_from_slice(extra);
+    let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(&args)
+        .current_dir(dir)
+        .env("DISPLAY", display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let program = Reaper(child);
+    let window = wait_for(Duration::from_secs(20), || {
+        xdotool(display, &["search", "--name", "^radiosity.*cornell"])
+            .and_then(|ids| ids.lines().next().map(str::to_string))
+    })
+    .expect("the window appears");
+    (program, window)
+}
+
 #[test]
 fn window_writes_a_picture_and_quits_on_keys() {
     if which("Xvfb").is_none() || which("xdotool").is_none() {
@@ -107,30 +139,7 @@ fn window_writes_a_picture_and_quits_on_keys() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let scene = common::scene("cornell.sc");
-    let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .args([
-            scene.to_str().unwrap(),
-            "--lenmax",
-            "80",
-            "--size",
-            "160x120",
-        ])
-        .current_dir(dir.path())
-        .env("DISPLAY", &display)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut program = Reaper(child);
-
-    let window = wait_for(Duration::from_secs(20), || {
-        xdotool(&display, &["search", "--name", "^radiosity.*cornell"])
-            .and_then(|ids| ids.lines().next().map(str::to_string))
-    })
-    .expect("the window appears");
+    let (mut program, window) = open_cornell(dir.path(), &display, &[]);
     // A few steps, read from the title.
     let title = wait_for(Duration::from_secs(30), || {
         let title = xdotool(&display, &["getwindowname", &window])?;
@@ -194,34 +203,9 @@ fn window_refines_adaptively_and_shows_the_refined_mesh() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let scene = common::scene("cornell.sc");
     let run = |adaptive: bool| {
-        let mut args = vec![
-            scene.to_str().unwrap().to_string(),
-            "--lenmax".into(),
-            "80".into(),
-            "--size".into(),
-            "160x120".into(),
-        ];
-        if adaptive {
-            args.push("--adaptive".into());
-        }
-        let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
-            .args(&args)
-            .current_dir(dir.path())
-            .env("DISPLAY", &display)
-            .env_remove("WAYLAND_DISPLAY")
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        let mut program = Reaper(child);
-        let window = wait_for(Duration::from_secs(20), || {
-            xdotool(&display, &["search", "--name", "^radiosity.*cornell"])
-                .and_then(|ids| ids.lines().next().map(str::to_string))
-        })
-        .expect("the window appears");
+        let extra: &[&str] = if adaptive { &["--adaptive"] } else { &[] };
+        let (mut program, window) = open_cornell(dir.path(), &display, extra);
         let title = wait_for(Duration::from_secs(60), || {
             let title = xdotool(&display, &["getwindowname", &window])?;
             title.contains("converged").then_some(title)

@@ -810,7 +810,9 @@ mod tests {
         testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
     }
 
-    fn all_shapes() -> Vec<Polygon> {
+    /// One polygon of every shape the mesher knows, in parallel planes
+    /// `z = 0, 1, 2, …` (also used by the refinement tests).
+    pub(super) fn all_shapes() -> Vec<Polygon> {
         vec![
             polygon(
                 &[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]],

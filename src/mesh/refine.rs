@@ -118,6 +118,12 @@ pub struct Refiner {
     /// Pool id of each vertex of the last mesh returned (or of the mesh
     /// the refiner was built from).
     mesh_to_pool: Vec<u32>,
+    /// Pool id of each vertex of the mesh before the last one returned.
+    previous_mesh_to_pool: Vec<u32>,
+    /// The two pool vertices each pool vertex was made between (its edge's
+    /// ends, or a quadrilateral's `0–2` diagonal for its centre), `None`
+    /// for the initial mesh's vertices.
+    parents: Vec<Option<[u32; 2]>>,
     passes: u32,
 }
 
@@ -153,6 +159,8 @@ impl Refiner {
             midpoints: HashMap::new(),
             polygons: mesh.polygons.clone(),
             mesh_to_pool: (0..mesh.vertex_count() as u32).collect(),
+            previous_mesh_to_pool: Vec::new(),
+            parents: vec![None; mesh.vertex_count()],
             passes: 0,
         }
     }
@@ -160,6 +168,49 @@ impl Refiner {
     /// Refinement passes that split something so far.
     pub fn passes(&self) -> u32 {
         self.passes
+    }
+
+    /// For each vertex of the last mesh returned, its index in the mesh
+    /// before it, or `None` for a vertex the last pass made. Empty before
+    /// the first pass.
+    pub fn previous_index(&self) -> Vec<Option<u32>> {
+        let mut index = vec![None; self.positions.len()];
+        for (k, &pool) in self.previous_mesh_to_pool.iter().enumerate() {
+            index[pool as usize] = Some(k as u32);
+        }
+        self.mesh_to_pool
+            .iter()
+            .map(|&pool| index[pool as usize])
+            .collect()
+    }
+
+    /// Carries a per-vertex field of the mesh before the last one returned
+    /// over to the last one: kept at the vertices both have, and at each
+    /// new vertex the mean of the two it was made between (the value the
+    /// coarser mesh's Gouraud interpolation had there, but where that mesh
+    /// drew the split element as a fan). `previous` holds one value per
+    /// vertex of the mesh before.
+    pub fn carry<T>(&self, previous: &[T]) -> Vec<T>
+    where
+        T: Copy + Default + std::ops::Add<Output = T> + std::ops::Mul<f64, Output = T>,
+    {
+        assert_eq!(previous.len(), self.previous_mesh_to_pool.len());
+        let mut pool = vec![T::default(); self.positions.len()];
+        let mut known = vec![false; self.positions.len()];
+        for (&p, &v) in self.previous_mesh_to_pool.iter().zip(previous) {
+            pool[p as usize] = v;
+            known[p as usize] = true;
+        }
+        // Parents are always made before their children.
+        for v in 0..pool.len() {
+            if let (false, Some([a, b])) = (known[v], self.parents[v]) {
+                pool[v] = (pool[a as usize] + pool[b as usize]) * 0.5;
+            }
+        }
+        self.mesh_to_pool
+            .iter()
+            .map(|&p| pool[p as usize])
+            .collect()
     }
 
     /// One pass: marks and splits the leaves over the threshold, closes the
@@ -279,14 +330,15 @@ impl Refiner {
             return m;
         }
         let p = (self.positions[a as usize] + self.positions[b as usize]) * 0.5;
-        let m = self.vertex(p, self.vertex_polygon[a as usize]);
+        let m = self.vertex(p, self.vertex_polygon[a as usize], [a, b]);
         self.midpoints.insert(key, m);
         m
     }
 
-    fn vertex(&mut self, p: Vec3, polygon: PolygonId) -> u32 {
+    fn vertex(&mut self, p: Vec3, polygon: PolygonId, parents: [u32; 2]) -> u32 {
         self.positions.push(p);
         self.vertex_polygon.push(polygon);
+        self.parents.push(Some(parents));
         (self.positions.len() - 1) as u32
     }
 
@@ -311,7 +363,9 @@ impl Refiner {
             let m23 = self.midpoint(c[2], c[3]);
             let m30 = self.midpoint(c[3], c[0]);
             let centre = c.iter().map(|&v| self.positions[v as usize]).sum::<Vec3>() * 0.25;
-            let o = self.vertex(centre, leaf.polygon);
+            // The centre lies on the 0–2 diagonal the quadrilateral is
+            // drawn with: its value there is the mean of those corners.
+            let o = self.vertex(centre, leaf.polygon, [c[0], c[2]]);
             vec![
                 child(&[c[0], m01, o, m30]),
                 child(&[m01, c[1], m12, o]),
@@ -400,7 +454,7 @@ impl Refiner {
             polygons: Vec::with_capacity(polygon_count),
         };
         let mut pool_to_mesh = vec![0u32; self.positions.len()];
-        self.mesh_to_pool.clear();
+        self.previous_mesh_to_pool = std::mem::take(&mut self.mesh_to_pool);
         let mut fans = 0;
         let mut ring = Vec::new();
         for (p, (polygon, initial)) in scene.polygons.iter().zip(&self.polygons).enumerate() {
@@ -527,29 +581,13 @@ mod tests {
     use crate::mesh::{build, MeshOptions};
     use crate::testutil;
 
-    /// A parallelogram, a bilinear quad, a triangle and a hexagon (a fan),
-    /// in four parallel planes.
+    /// A parallelogram, a bilinear quad, a triangle, a hexagon and a
+    /// pentagon (fans), in parallel planes `z = 0 … 4`.
     fn shapes() -> Scene {
-        let polygons = vec![
-            testutil::polygon(0, &[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]]),
-            testutil::polygon(
-                0,
-                &[[0., 0., 1.], [2., 0., 1.], [1.5, 1., 1.], [0.2, 1.3, 1.]],
-            ),
-            testutil::polygon(0, &[[0., 0., 2.], [1., 0., 2.], [0.3, 1.7, 2.]]),
-            testutil::polygon(
-                0,
-                &[
-                    [1., 0., 3.],
-                    [0.5, 0.87, 3.],
-                    [-0.5, 0.87, 3.],
-                    [-1., 0., 3.],
-                    [-0.5, -0.87, 3.],
-                    [0.5, -0.87, 3.],
-                ],
-            ),
-        ];
-        testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
+        testutil::scene(
+            crate::mesh::tests::all_shapes(),
+            vec![testutil::grey("m", 0.0, 0.5)],
+        )
     }
 
     fn options() -> MeshOptions {

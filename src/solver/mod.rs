@@ -457,20 +457,9 @@ impl<'a> Progressive<'a> {
 
     /// Area-weighted mean unshot radiosity of polygon `j`.
     fn polygon_unshot_mean(&self, j: usize) -> Rgb {
-        let pm = &self.mesh.polygons[j];
         match self.options.unshot {
             UnshotScheme::Polygon => self.unshot[j],
-            UnshotScheme::Vertex => {
-                let mut sum = Rgb::BLACK;
-                for l in pm.vertices.clone() {
-                    sum += self.unshot[l as usize] * self.vertex_area[l as usize];
-                }
-                if pm.area > 0.0 {
-                    sum / pm.area
-                } else {
-                    Rgb::BLACK
-                }
-            }
+            UnshotScheme::Vertex => self.polygon_mean(j, &self.unshot),
         }
     }
 
@@ -721,26 +710,144 @@ impl<'a> Progressive<'a> {
             UnshotScheme::Polygon => self.shot.resize(n, self.unshot[i]),
             UnshotScheme::Vertex => {
                 let mean = self.polygon_unshot_mean(i);
-                for source in &self.sample_sources[i] {
-                    let value = match *source {
-                        SampleSource::Vertex(l) => self.unshot[l as usize],
-                        SampleSource::Triangle(v, w) => {
-                            let mut sum = Rgb::BLACK;
-                            for (l, weight) in v.iter().zip(w) {
-                                sum += self.unshot[*l as usize] * f64::from(weight.max(0.0));
-                            }
-                            sum / f64::from(
-                                w.iter()
-                                    .map(|x| x.max(0.0))
-                                    .sum::<f32>()
-                                    .max(f32::MIN_POSITIVE),
-                            )
-                        }
-                        SampleSource::PolygonMean => mean,
-                    };
-                    self.shot.push(value);
-                }
+                let mut shot = std::mem::take(&mut self.shot);
+                self.read_at_samples(i, &self.unshot, mean, &mut shot);
+                self.shot = shot;
             }
+        }
+    }
+
+    /// Appends to `out` the per-vertex `field` read at each sample of
+    /// polygon `i` (per-vertex scheme: interpolated within the element
+    /// triangle holding the sample); `mean` for samples that stand for the
+    /// whole polygon.
+    fn read_at_samples(&self, i: usize, field: &[Rgb], mean: Rgb, out: &mut Vec<Rgb>) {
+        for source in &self.sample_sources[i] {
+            let value = match *source {
+                SampleSource::Vertex(l) => field[l as usize],
+                SampleSource::Triangle(v, w) => {
+                    let mut sum = Rgb::BLACK;
+                    for (l, weight) in v.iter().zip(w) {
+                        sum += field[*l as usize] * f64::from(weight.max(0.0));
+                    }
+                    sum / f64::from(
+                        w.iter()
+                            .map(|x| x.max(0.0))
+                            .sum::<f32>()
+                            .max(f32::MIN_POSITIVE),
+                    )
+                }
+                SampleSource::PolygonMean => mean,
+            };
+            out.push(value);
+        }
+    }
+
+    /// The state a solve on `refined`, a refinement of this solve's mesh,
+    /// starts from to continue this one rather than start afresh (per-vertex
+    /// scheme only; `None` for the per-polygon one):
+    ///
+    /// - a vertex both meshes have keeps its radiosity and unshot radiosity;
+    /// - a new vertex gathers, from every polygon, the light that polygon
+    ///   has shot so far (`b − Δb` read at its samples, as shooting reads
+    ///   `Δb`): `b = e + ρ Σ_i F(x → i)(b − Δb)_i`, with the same form
+    ///   factors and visibility as a step. Its unshot radiosity is
+    ///   `unshot[l]`, the coarse field carried over by the caller, so the
+    ///   polygon's unshot power is unchanged.
+    ///
+    /// `previous[l]` is vertex `l`'s index in this solve's mesh, or `None`
+    /// for a new vertex. The gather's rays are added to the ray count.
+    pub fn refined_state(
+        &self,
+        refined: &Mesh,
+        previous: &[Option<u32>],
+        unshot: Vec<Rgb>,
+    ) -> Option<checkpoint::SolverState> {
+        if self.options.unshot != UnshotScheme::Vertex
+            || previous.len() != refined.vertex_count()
+            || unshot.len() != refined.vertex_count()
+        {
+            return None;
+        }
+        let shot_field: Vec<Rgb> = self
+            .radiosity
+            .iter()
+            .zip(&self.unshot)
+            .map(|(b, u)| {
+                Rgb::new(
+                    (b.r - u.r).max(0.0),
+                    (b.g - u.g).max(0.0),
+                    (b.b - u.b).max(0.0),
+                )
+            })
+            .collect();
+        let shot: Vec<Vec<Rgb>> = (0..self.mesh.polygons.len())
+            .map(|i| {
+                let mut values = Vec::new();
+                let mean = self.polygon_mean(i, &shot_field);
+                self.read_at_samples(i, &shot_field, mean, &mut values);
+                values
+            })
+            .collect();
+        let visibility = self.visibility;
+        let near_field = self.options.near_field;
+        let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|l| {
+                let j = refined.vertex_polygon[l];
+                let b = match previous[l] {
+                    Some(old) => return (self.radiosity[old as usize], 0),
+                    None => self.emission[j.index()],
+                };
+                let rho = self.reflectance[j.index()];
+                if rho.is_black() {
+                    return (b, 0);
+                }
+                let x = refined.sample_positions[l];
+                let normal = refined.polygons[j.index()].normal;
+                let mut sum = Rgb::BLACK;
+                let mut rays = 0;
+                for (i, (samples, values)) in self.samples.iter().zip(&shot).enumerate() {
+                    if i == j.index() {
+                        continue;
+                    }
+                    let shooter = PolygonId(i as u32);
+                    let (f, asked) = weighted_point_to_samples(
+                        x,
+                        normal,
+                        self.mesh.polygons[i].normal,
+                        samples,
+                        |k| values[k],
+                        near_field,
+                        |_, s| visibility.occluded(s, x, (shooter, j)),
+                    );
+                    sum += f;
+                    rays += asked;
+                }
+                (b + rho * sum, rays)
+            })
+            .collect();
+        let rays = gathered.iter().map(|g| g.1).sum::<u64>();
+        Some(checkpoint::SolverState {
+            radiosity: gathered.into_iter().map(|g| g.0).collect(),
+            unshot,
+            steps: self.steps,
+            rays: self.rays + rays,
+        })
+    }
+
+    /// Area-weighted mean of a per-vertex field over polygon `j`.
+    fn polygon_mean(&self, j: usize, field: &[Rgb]) -> Rgb {
+        let pm = &self.mesh.polygons[j];
+        let mut sum = Rgb::BLACK;
+        for l in pm.vertices.clone() {
+            sum += field[l as usize] * self.vertex_area[l as usize];
+        }
+        if pm.area > 0.0 {
+            sum / pm.area
+        } else {
+            Rgb::BLACK
         }
     }
 

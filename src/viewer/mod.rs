@@ -204,12 +204,19 @@ fn solve_in_background(
     let levels = config.adaptive.map_or(0, |o| o.levels);
     // The refined mesh of the current pass (`None`: the prepared mesh).
     let mut refined: Option<Arc<Mesh>> = None;
+    // Where a refined pass continues the last one (per-vertex unshot).
+    let mut start = None;
     let mut solving = Duration::ZERO;
     let mut rays_before = 0;
     for pass in 1.. {
         let mesh = refined.as_deref().unwrap_or(&prepared.mesh);
         let mut solver =
             Progressive::new(&prepared.scene, mesh, &prepared.visibility, config.solver);
+        if let Some(state) = start.take() {
+            // Consistent by construction; were it refused, the pass would
+            // only lose its head start and solve afresh.
+            let _ = solver.restore(state);
+        }
         // The first pass is shown as it converges; a refined pass only once
         // it has converged, so the picture never falls back to darkness.
         let shown = pass == 1;
@@ -235,14 +242,24 @@ fn solve_in_background(
         let Some(stop) = stop else {
             return;
         };
-        rays_before += solver.rays();
         let next = match refiner.as_mut() {
             Some((r, options)) if stop == StopReason::Converged && r.passes() < options.levels => {
                 let luminance: Vec<f64> =
                     solver.radiosity().iter().map(|b| b.luminance()).collect();
-                r.refine(&prepared.scene, &luminance, options)
+                let next = r.refine(&prepared.scene, &luminance, options);
+                if let Some((mesh, _)) = &next {
+                    let unshot = r.carry(solver.unshot());
+                    start = solver.refined_state(mesh, &r.previous_index(), unshot);
+                }
+                next
             }
             _ => None,
+        };
+        // A continued solve counts its rays on from the last one's.
+        rays_before = if start.is_some() {
+            0
+        } else {
+            rays_before + solver.rays()
         };
         let Ok(mut p) = progress.lock() else {
             return;
