@@ -52,7 +52,7 @@ fn main() {
     let radiosity = &solution.solved.radiosity;
     let areas = mesh.vertex_areas();
     println!(
-        "# {path}: --unshot {scheme}, lenmax {}{}, {} vertices, {} steps (last solve), {:.2} s",
+        "# {path}: --unshot {scheme}, lenmax {}{}, {} vertices, {} steps, {:.2} s",
         prepared.lenmax,
         if config.adaptive.is_some() {
             ", --adaptive"

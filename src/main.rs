@@ -97,9 +97,10 @@ struct Args {
 
     /// Adaptive subdivision: once the solve converges, split the elements
     /// whose vertex luminances differ by more than --adaptive-threshold
-    /// (relative to the largest), keep the mesh crack-free, and solve again
-    /// on the refined mesh; repeat up to --adaptive-levels times. Sharpens
-    /// shadow boundaries where the regular mesh blurs them.
+    /// (relative to the largest), keep the mesh crack-free, and continue
+    /// the solve on the refined mesh (new vertices gather the light shot so
+    /// far); repeat up to --adaptive-levels times. Sharpens shadow
+    /// boundaries where the regular mesh blurs them.
     #[arg(long, conflicts_with_all = ["checkpoint", "resume"])]
     adaptive: bool,
 

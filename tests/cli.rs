@@ -401,8 +401,14 @@ fn adaptive_runs_refine_and_report_each_pass() {
     assert!(vertices.windows(2).all(|w| w[1] > w[0]), "{vertices:?}");
     assert!(passes[0]["split"].as_u64().unwrap() > 0);
     // Refined passes continue the converged solve: far fewer steps.
-    let steps: Vec<u64> = passes.iter().map(|p| p["steps"].as_u64().unwrap()).collect();
-    assert!(steps[1] * 4 < steps[0] && steps[2] * 4 < steps[0], "{steps:?}");
+    let steps: Vec<u64> = passes
+        .iter()
+        .map(|p| p["steps"].as_u64().unwrap())
+        .collect();
+    assert!(
+        steps[1] * 4 < steps[0] && steps[2] * 4 < steps[0],
+        "{steps:?}"
+    );
     assert_eq!(stats["steps"].as_u64(), Some(steps.iter().sum()));
     assert_eq!(passes[2]["split"].as_u64(), Some(0));
     // The totals describe the last, finest solve, and the export holds it.
