@@ -779,6 +779,51 @@ mod tests {
         }
     }
 
+    #[test]
+    fn adaptively_refined_mesh_has_no_cracks() {
+        // A square facing the camera, refined twice across a step, so split
+        // elements, fans around hanging vertices and unsplit elements meet:
+        // every pixel inside it is drawn exactly once.
+        use crate::mesh::refine::{RefineOptions, Refiner};
+        use crate::testutil;
+        let d = 3.0;
+        let corners = [[-1.5, -1.5, -d], [1.5, -1.5, -d], [1.5, 1.5, -d], [-1.5, 1.5, -d]];
+        let scene = testutil::scene(
+            vec![testutil::polygon(0, &corners)],
+            vec![testutil::grey("m", 0.0, 0.5)],
+        );
+        let options = crate::mesh::MeshOptions {
+            lenmax: 0.4,
+            inset: 0.0,
+        };
+        let mut mesh = crate::mesh::build(&scene, &options).unwrap();
+        let mut refiner = Refiner::new(&mesh);
+        let mut fans = 0;
+        while let Some((next, report)) = refiner.refine(
+            &scene,
+            &mesh
+                .positions
+                .iter()
+                .map(|p| if p.x + 0.3 * p.y < 0.21 { 0.1 } else { 1.0 })
+                .collect::<Vec<_>>(),
+            &RefineOptions::default(),
+        ) {
+            fans += report.fans;
+            mesh = next;
+        }
+        assert!(fans > 0);
+        let radiosity = vec![Rgb::splat(1.0); mesh.vertex_count()];
+        let counts = coverage_counts(&mesh, &radiosity);
+        assert!(counts.iter().all(|&n| n <= 1), "a pixel drawn twice");
+        // The square spans pixels 25..75 (one pixel is d/50 = 0.06 wide);
+        // one pixel in from its edges every pixel must be drawn.
+        for y in 26..74 {
+            for x in 26..74 {
+                assert_eq!(counts[y * 100 + x], 1, "crack at ({x}, {y})");
+            }
+        }
+    }
+
     /// How many triangles cover each pixel, drawing each triangle alone.
     fn coverage_counts(mesh: &Mesh, radiosity: &[Rgb]) -> Vec<u32> {
         let mut counts = vec![0u32; 100 * 100];
