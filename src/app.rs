@@ -517,6 +517,10 @@ fn solve_adaptive(
     cancel: &AtomicBool,
 ) -> Result<(Mesh, Solved, Vec<PassStats>), RunError> {
     let mut refiner = Refiner::new(&prepared.mesh);
+    let options = &RefineOptions {
+        max_elements: options.max_elements.min(config.max_elements),
+        ..*options
+    };
     let mut mesh = prepared.mesh.clone();
     let mut passes: Vec<PassStats> = Vec::new();
     let mut start: Option<checkpoint::SolverState> = None;
@@ -555,7 +559,15 @@ fn solve_adaptive(
         let refining = Instant::now();
         let next = if refiner.passes() < options.levels {
             let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
-            refiner.refine(&prepared.scene, &luminance, options)
+            let next = refiner.refine(&prepared.scene, &luminance, options);
+            if let Some(elements) = refiner.refused() {
+                eprintln!(
+                    "warning: refining no further: the next refinement would make about \
+                     {elements} elements, over --max-elements {}",
+                    options.max_elements
+                );
+            }
+            next
         } else {
             None
         };

@@ -340,6 +340,7 @@ fn config(args: &Args) -> Result<RunConfig, String> {
         adaptive: args.adaptive.then_some(RefineOptions {
             threshold: args.adaptive_threshold,
             levels: args.adaptive_levels,
+            max_elements: args.max_elements,
         }),
         mesh_lines: args.mesh_lines,
     })

@@ -445,3 +445,38 @@ fn adaptive_runs_refine_and_report_each_pass() {
     assert!(plain.get("adaptive").is_none());
     assert_eq!(plain["vertices"].as_u64(), Some(vertices[0]));
 }
+
+#[test]
+fn adaptive_refinement_respects_max_elements() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    // 60 gives 632 elements; a first refinement would go past 1,100.
+    let out = run_in(
+        dir.path(),
+        &[
+            scene.to_str().unwrap(),
+            "-o",
+            "out.png",
+            "--lenmax",
+            "60",
+            "--adaptive",
+            "--max-elements",
+            "1100",
+            "--stats",
+            "stats.json",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("refining no further")
+            && stderr(&out).contains("--max-elements 1100"),
+        "{}",
+        stderr(&out)
+    );
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
+            .unwrap();
+    assert!(stats["elements"].as_u64().unwrap() <= 1100);
+    assert_eq!(stats["adaptive"].as_array().unwrap().len(), 1);
+}

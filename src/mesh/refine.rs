@@ -57,6 +57,10 @@ pub struct RefineOptions {
     /// Split an initial element at most this many times (each halves the
     /// edge length); at least 1.
     pub levels: u32,
+    /// Refuse a pass whose mesh would have more elements than this (then
+    /// [`Refiner::refine`] changes nothing and [`Refiner::refused`] says
+    /// how many it would have had).
+    pub max_elements: u64,
 }
 
 impl Default for RefineOptions {
@@ -64,6 +68,7 @@ impl Default for RefineOptions {
         RefineOptions {
             threshold: DEFAULT_THRESHOLD,
             levels: DEFAULT_LEVELS,
+            max_elements: super::MAX_ELEMENTS,
         }
     }
 }
@@ -125,6 +130,9 @@ pub struct Refiner {
     /// for the initial mesh's vertices.
     parents: Vec<Option<[u32; 2]>>,
     passes: u32,
+    /// The element count of the last pass refused for
+    /// [`RefineOptions::max_elements`].
+    refused: Option<u64>,
 }
 
 fn edge_key(a: u32, b: u32) -> (u32, u32) {
@@ -162,7 +170,15 @@ impl Refiner {
             previous_mesh_to_pool: Vec::new(),
             parents: vec![None; mesh.vertex_count()],
             passes: 0,
+            refused: None,
         }
+    }
+
+    /// When the last [`Refiner::refine`] returned `None` because its mesh
+    /// would have exceeded [`RefineOptions::max_elements`]: about how many
+    /// elements it would have had.
+    pub fn refused(&self) -> Option<u64> {
+        self.refused
     }
 
     /// Refinement passes that split something so far.
@@ -253,7 +269,16 @@ impl Refiner {
                 hi > 0.0 && (hi - lo) / hi.max(floor) > options.threshold
             })
             .collect();
+        self.refused = None;
         if marked.is_empty() {
+            return None;
+        }
+        // Each split adds three leaves, and a fan up to three triangles
+        // more than its leaf: at most six more elements per split before
+        // the closure, which adds a few percent.
+        let elements = self.leaves.len() as u64 + 6 * marked.len() as u64;
+        if elements > options.max_elements {
+            self.refused = Some(elements);
             return None;
         }
         let mut report = RefineReport {
@@ -719,8 +744,8 @@ mod tests {
         let mut mesh = build(&scene, &options()).unwrap();
         let mut refiner = Refiner::new(&mesh);
         let options = RefineOptions {
-            threshold: 0.25,
             levels: 3,
+            ..RefineOptions::default()
         };
         let band = |m: &Mesh| -> Vec<f64> {
             m.positions

@@ -787,7 +787,12 @@ mod tests {
         use crate::mesh::refine::{RefineOptions, Refiner};
         use crate::testutil;
         let d = 3.0;
-        let corners = [[-1.5, -1.5, -d], [1.5, -1.5, -d], [1.5, 1.5, -d], [-1.5, 1.5, -d]];
+        let corners = [
+            [-1.5, -1.5, -d],
+            [1.5, -1.5, -d],
+            [1.5, 1.5, -d],
+            [-1.5, 1.5, -d],
+        ];
         let scene = testutil::scene(
             vec![testutil::polygon(0, &corners)],
             vec![testutil::grey("m", 0.0, 0.5)],

@@ -60,10 +60,7 @@ fn refined_across(s: &Scene, lenmax: f32, cut: f32) -> Mesh {
     )
     .unwrap();
     let mut refiner = Refiner::new(&m);
-    let options = RefineOptions {
-        threshold: 0.25,
-        levels: 2,
-    };
+    let options = RefineOptions::default();
     loop {
         let field: Vec<f64> = m
             .positions

@@ -24,7 +24,7 @@ pub mod controls;
 
 use crate::app::{Prepared, RunConfig};
 use crate::color::Rgb;
-use crate::mesh::refine::Refiner;
+use crate::mesh::refine::{RefineOptions, Refiner};
 use crate::mesh::Mesh;
 use crate::output;
 use crate::render::{self, Exposure, Rasterizer, View};
@@ -246,7 +246,18 @@ fn solve_in_background(
             Some((r, options)) if stop == StopReason::Converged && r.passes() < options.levels => {
                 let luminance: Vec<f64> =
                     solver.radiosity().iter().map(|b| b.luminance()).collect();
+                let options = &RefineOptions {
+                    max_elements: options.max_elements.min(config.max_elements),
+                    ..*options
+                };
                 let next = r.refine(&prepared.scene, &luminance, options);
+                if let Some(elements) = r.refused() {
+                    eprintln!(
+                        "warning: refining no further: the next refinement would make about \
+                     {elements} elements, over --max-elements {}",
+                        options.max_elements
+                    );
+                }
                 if let Some((mesh, _)) = &next {
                     let unshot = r.carry(solver.unshot());
                     start = solver.refined_state(mesh, &r.previous_index(), unshot);
