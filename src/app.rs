@@ -557,7 +557,10 @@ fn solve_adaptive(
             closure: 0,
         };
         let refining = Instant::now();
-        let next = if refiner.passes() < options.levels {
+        // Refine a converged solution only: one cut short by --max-steps
+        // would mark what is merely unfinished.
+        let converged = solver.stop_reason() == Some(StopReason::Converged);
+        let next = if converged && refiner.passes() < options.levels {
             let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
             let next = refiner.refine(&prepared.scene, &luminance, options);
             if let Some(elements) = refiner.refused() {
@@ -573,9 +576,7 @@ fn solve_adaptive(
         };
         if let Some((refined, _)) = &next {
             // The gather for the new vertices is this pass's work too.
-            let previous = refiner.previous_index();
-            let unshot = refiner.carry(solver.unshot());
-            start = solver.refined_state(refined, &previous, unshot);
+            start = solver.refined_state(refined, &refiner);
             if let Some(state) = &start {
                 pass.rays += state.rays - solver.rays();
             }

@@ -480,3 +480,40 @@ fn adaptive_refinement_respects_max_elements() {
     assert!(stats["elements"].as_u64().unwrap() <= 1100);
     assert_eq!(stats["adaptive"].as_array().unwrap().len(), 1);
 }
+
+#[test]
+fn adaptive_runs_with_every_scheme_and_form_factor() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    for (extra, passes) in [
+        (&["--unshot", "polygon"][..], 3),
+        (&["--form-factor", "center"], 3),
+        (&["--form-factor", "center", "--unshot", "polygon"], 3),
+        (&["--shooter-samples", "all"], 3),
+        // A solve cut short is not refined.
+        (&["--max-steps", "3"], 1),
+    ] {
+        let mut args = vec![
+            scene.to_str().unwrap(),
+            "-o",
+            "out.png",
+            "--lenmax",
+            "60",
+            "--adaptive",
+            "--stats",
+            "stats.json",
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        let out = run_in(dir.path(), &args);
+        assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
+                .unwrap();
+        assert_eq!(
+            stats["adaptive"].as_array().unwrap().len(),
+            passes,
+            "{extra:?}"
+        );
+    }
+}

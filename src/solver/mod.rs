@@ -23,6 +23,7 @@ pub mod checkpoint;
 pub mod formfactor;
 
 use crate::color::Rgb;
+use crate::mesh::refine::Refiner;
 use crate::mesh::Mesh;
 use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
@@ -751,22 +752,23 @@ impl<'a> Progressive<'a> {
     /// - a new vertex gathers, from every polygon, the light that polygon
     ///   has shot so far (`b − Δb` read at its samples, as shooting reads
     ///   `Δb`): `b = e + ρ Σ_i F(x → i)(b − Δb)_i`, with the same form
-    ///   factors and visibility as a step. Its unshot radiosity is
-    ///   `unshot[l]`, the coarse field carried over by the caller, so the
-    ///   polygon's unshot power is unchanged.
+    ///   factors and visibility as a step. Its unshot radiosity is the
+    ///   coarse field carried over ([`Refiner::carry`]), so the polygon's
+    ///   unshot power is unchanged.
     ///
-    /// `previous[l]` is vertex `l`'s index in this solve's mesh, or `None`
-    /// for a new vertex. The gather's rays are added to the ray count.
+    /// `refined` must be the mesh `refiner` returned last, refining this
+    /// solve's mesh. The gather's rays are added to the ray count.
     pub fn refined_state(
         &self,
         refined: &Mesh,
-        previous: &[Option<u32>],
-        unshot: Vec<Rgb>,
+        refiner: &Refiner,
     ) -> Option<checkpoint::SolverState> {
-        if self.options.unshot != UnshotScheme::Vertex
-            || previous.len() != refined.vertex_count()
-            || unshot.len() != refined.vertex_count()
-        {
+        if self.options.unshot != UnshotScheme::Vertex {
+            return None;
+        }
+        let previous = refiner.previous_index();
+        let unshot = refiner.carry(&self.unshot);
+        if previous.len() != refined.vertex_count() || unshot.len() != refined.vertex_count() {
             return None;
         }
         let shot_field: Vec<Rgb> = self

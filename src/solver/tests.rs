@@ -267,8 +267,7 @@ fn solve_continued(s: &Scene, lenmax: f32, cut: Option<f32>, options: SolverOpti
         };
         match next {
             Some((refined, _)) => {
-                let unshot = refiner.carry(solver.unshot());
-                start = solver.refined_state(&refined, &refiner.previous_index(), unshot);
+                start = solver.refined_state(&refined, &refiner);
                 assert!(start.is_some());
                 drop(solver);
                 mesh = refined;

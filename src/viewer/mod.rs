@@ -259,8 +259,7 @@ fn solve_in_background(
                     );
                 }
                 if let Some((mesh, _)) = &next {
-                    let unshot = r.carry(solver.unshot());
-                    start = solver.refined_state(mesh, &r.previous_index(), unshot);
+                    start = solver.refined_state(mesh, r);
                 }
                 next
             }
