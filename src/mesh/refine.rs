@@ -822,6 +822,54 @@ mod tests {
     }
 
     #[test]
+    fn random_fields_always_give_conforming_meshes() {
+        // Noise marks elements all over, in every pattern the closure has
+        // to handle; every pass on every shape must stay conforming and
+        // tile its polygon, carry a field exactly at old vertices, and
+        // number each vertex once.
+        let scene = shapes();
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let refine = RefineOptions {
+            levels: 3,
+            ..RefineOptions::default()
+        };
+        // A coarse start keeps three levels of noise small enough for the
+        // quadratic conformity check.
+        let coarse = MeshOptions {
+            lenmax: 0.7,
+            inset: 0.05,
+        };
+        for _ in 0..6 {
+            let mut mesh = build(&scene, &coarse).unwrap();
+            let mut refiner = Refiner::new(&mesh);
+            let sparse = rand() * 0.3;
+            loop {
+                let values: Vec<f64> = (0..mesh.vertex_count())
+                    .map(|_| if rand() < sparse { 0.1 } else { 1.0 })
+                    .collect();
+                let Some((next, _)) = refiner.refine(&scene, &values, &refine) else {
+                    break;
+                };
+                assert_conforming(&scene, &next);
+                let carried = refiner.carry(&values);
+                for (l, previous) in refiner.previous_index().iter().enumerate() {
+                    match previous {
+                        Some(k) => assert_eq!(carried[l], values[*k as usize]),
+                        None => assert!((0.1..=1.0).contains(&carried[l])),
+                    }
+                }
+                mesh = next;
+            }
+        }
+    }
+
+    #[test]
     fn dark_noise_is_not_refined() {
         // Values differing by 100 % but all under the dark floor of a
         // bright scene: nothing to see, nothing to split.
