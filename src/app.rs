@@ -563,12 +563,8 @@ fn solve_adaptive(
         let next = if converged && refiner.passes() < options.levels {
             let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
             let next = refiner.refine(&prepared.scene, &luminance, options);
-            if let Some(elements) = refiner.refused() {
-                eprintln!(
-                    "warning: refining no further: the next refinement would make about \
-                     {elements} elements, over --max-elements {}",
-                    options.max_elements
-                );
+            if let Some(refused) = refiner.refused() {
+                eprintln!("warning: {refused}");
             }
             next
         } else {

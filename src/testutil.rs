@@ -4,6 +4,30 @@ use crate::color::Rgb;
 use crate::scene::{Camera, CameraSource, Material, MaterialId, Polygon, Scene, Shape, SourcePos};
 use glam::{DVec3, Vec3};
 
+/// Marsaglia's xorshift64: a tiny deterministic pseudo-random stream, so
+/// that randomized tests draw the same cases on every run.
+pub struct Xorshift(pub u64);
+
+impl Xorshift {
+    /// The next 64 random bits (the seed must not be 0).
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    /// Uniform in `[0, 1)` with 53 random bits.
+    pub fn unit_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in `[0, 1)` with 24 random bits (exact in `f32`).
+    pub fn unit_f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
 /// A polygon with its Newell normal and area; the shape is inferred.
 pub fn polygon(material: u32, vertices: &[[f32; 3]]) -> Polygon {
     let v: Vec<Vec3> = vertices.iter().map(|a| Vec3::from_array(*a)).collect();

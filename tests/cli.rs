@@ -44,9 +44,7 @@ fn render_scene(name: &str, lenmax: &str) {
         lit > (img.width() * img.height()) as usize / 4,
         "{name}: only {lit} lit pixels"
     );
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
-            .unwrap();
+    let stats: serde_json::Value = read_json(dir.path(), "stats.json");
     assert!(stats["steps"].as_u64().unwrap() > 0);
     assert!(stats["rays"].as_u64().unwrap() > 0);
     assert!(stats["vertices"].as_u64().unwrap() > stats["polygons"].as_u64().unwrap());
@@ -389,9 +387,7 @@ fn adaptive_runs_refine_and_report_each_pass() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("adaptive pass 3"), "{}", stderr(&out));
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
-            .unwrap();
+    let stats: serde_json::Value = read_json(dir.path(), "stats.json");
     let passes = stats["adaptive"].as_array().unwrap();
     assert_eq!(passes.len(), 3, "{passes:?}");
     let vertices: Vec<u64> = passes
@@ -439,9 +435,7 @@ fn adaptive_runs_refine_and_report_each_pass() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let plain: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("plain.json")).unwrap())
-            .unwrap();
+    let plain: serde_json::Value = read_json(dir.path(), "plain.json");
     assert!(plain.get("adaptive").is_none());
     assert_eq!(plain["vertices"].as_u64(), Some(vertices[0]));
 }
@@ -474,9 +468,7 @@ fn adaptive_refinement_respects_max_elements() {
         "{}",
         stderr(&out)
     );
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
-            .unwrap();
+    let stats: serde_json::Value = read_json(dir.path(), "stats.json");
     assert!(stats["elements"].as_u64().unwrap() <= 1100);
     assert_eq!(stats["adaptive"].as_array().unwrap().len(), 1);
 }
@@ -507,9 +499,7 @@ fn adaptive_runs_with_every_scheme_and_form_factor() {
         args.extend_from_slice(extra);
         let out = run_in(dir.path(), &args);
         assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
-        let stats: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
-                .unwrap();
+        let stats: serde_json::Value = read_json(dir.path(), "stats.json");
         assert_eq!(
             stats["adaptive"].as_array().unwrap().len(),
             passes,

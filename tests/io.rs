@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{listing, run_in, scene, stderr, write};
+use common::{listing, read_json, run_in, scene, stderr, write};
 use radiosity::color::Rgb;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::output::convergence::{LOG_HEADER, PLOT_SIZE};
@@ -609,9 +609,7 @@ fn obj_scene_runs_with_camera_export_log_and_plot() {
             "steps.csv"
         ]
     );
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stats.json")).unwrap())
-            .unwrap();
+    let stats: serde_json::Value = read_json(dir.path(), "stats.json");
     let steps = stats["steps"].as_u64().unwrap();
     assert_eq!(steps, 12);
     let picture = image::open(dir.path().join("cornell.png")).unwrap();

@@ -124,9 +124,7 @@ fn interrupted_and_resumed_solve_gives_the_same_bits() {
     // Interrupt at a step that differs from run to run: after the first
     // checkpoint exists, wait a random fraction of the reference solve.
     let solve_ms = {
-        let stats: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.path().join("full.json")).unwrap())
-                .unwrap();
+        let stats: serde_json::Value = read_json(dir.path(), "full.json");
         (stats["seconds"]["solve"].as_f64().unwrap() * 1000.0) as u64
     };
     let nanos = std::time::SystemTime::now()
@@ -183,9 +181,7 @@ fn interrupted_and_resumed_solve_gives_the_same_bits() {
         a == b,
         "the resumed picture differs from the uninterrupted one"
     );
-    let json = |name: &str| -> serde_json::Value {
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join(name)).unwrap()).unwrap()
-    };
+    let json = |name: &str| -> serde_json::Value { read_json(dir.path(), name) };
     let (f, r) = (json("full.json"), json("resumed.json"));
     for key in ["steps", "rays", "unshot_fraction", "vertices"] {
         assert_eq!(f[key], r[key], "{key}");
@@ -256,8 +252,7 @@ fn too_many_elements_are_refused_with_a_lenmax_that_fits() {
         ],
     );
     assert!(ok.status.success(), "{}", stderr(&ok));
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    let stats: serde_json::Value = read_json(dir.path(), "s.json");
     assert!(stats["elements"].as_u64().unwrap() <= 2000);
     let smaller = format!("{}", l * 0.98);
     let refused = run_in(

@@ -96,6 +96,20 @@ fn start_xvfb() -> Option<(Reaper, String)> {
     None
 }
 
+/// An X server for a test, or `None` (having said loudly why the test is
+/// skipped) when Xvfb or xdotool is missing or no server starts.
+fn x_server() -> Option<(Reaper, String)> {
+    if which("Xvfb").is_none() || which("xdotool").is_none() {
+        skip("Xvfb or xdotool is not installed");
+        return None;
+    }
+    let server = start_xvfb();
+    if server.is_none() {
+        skip("no X server could be started");
+    }
+    server
+}
+
 /// Starts the program on `cornell.sc` (a coarse mesh, a small window) in
 /// `dir` on `display` with `extra` arguments, and waits for its window.
 /// Returns the program (stdout piped) and the window's id.
@@ -130,12 +144,7 @@ fn open_cornell(dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
 
 #[test]
 fn window_writes_a_picture_and_quits_on_keys() {
-    if which("Xvfb").is_none() || which("xdotool").is_none() {
-        skip("Xvfb or xdotool is not installed");
-        return;
-    }
-    let Some((_xvfb, display)) = start_xvfb() else {
-        skip("no X server could be started");
+    let Some((_xvfb, display)) = x_server() else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
@@ -194,12 +203,7 @@ fn window_writes_a_picture_and_quits_on_keys() {
 
 #[test]
 fn window_refines_adaptively_and_shows_the_refined_mesh() {
-    if which("Xvfb").is_none() || which("xdotool").is_none() {
-        skip("Xvfb or xdotool is not installed");
-        return;
-    }
-    let Some((_xvfb, display)) = start_xvfb() else {
-        skip("no X server could be started");
+    let Some((_xvfb, display)) = x_server() else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();

@@ -86,6 +86,20 @@ pub struct RefineReport {
     pub fans: usize,
 }
 
+/// A refinement pass refused because its mesh would be too large; its
+/// `Display` is a one-line warning for the user.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "refining no further: the next refinement would make about {elements} elements, \
+     over --max-elements {max}"
+)]
+pub struct Refused {
+    /// Elements the refused mesh could have had (an upper bound).
+    pub elements: u64,
+    /// The limit it would have passed.
+    pub max: u64,
+}
+
 /// One leaf element: 3 or 4 corners in pool vertex ids, counter-clockwise.
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
@@ -130,9 +144,8 @@ pub struct Refiner {
     /// for the initial mesh's vertices.
     parents: Vec<Option<[u32; 2]>>,
     passes: u32,
-    /// The element count of the last pass refused for
-    /// [`RefineOptions::max_elements`].
-    refused: Option<u64>,
+    /// The last pass, if it was refused for [`RefineOptions::max_elements`].
+    refused: Option<Refused>,
 }
 
 fn edge_key(a: u32, b: u32) -> (u32, u32) {
@@ -175,9 +188,8 @@ impl Refiner {
     }
 
     /// When the last [`Refiner::refine`] returned `None` because its mesh
-    /// would have exceeded [`RefineOptions::max_elements`]: about how many
-    /// elements it would have had.
-    pub fn refused(&self) -> Option<u64> {
+    /// would have exceeded [`RefineOptions::max_elements`]: why.
+    pub fn refused(&self) -> Option<Refused> {
         self.refused
     }
 
@@ -278,7 +290,10 @@ impl Refiner {
         // the closure, which adds a few percent.
         let elements = self.leaves.len() as u64 + 6 * marked.len() as u64;
         if elements > options.max_elements {
-            self.refused = Some(elements);
+            self.refused = Some(Refused {
+                elements,
+                max: options.max_elements,
+            });
             return None;
         }
         let mut report = RefineReport {
@@ -828,13 +843,8 @@ mod tests {
         // tile its polygon, carry a field exactly at old vertices, and
         // number each vertex once.
         let scene = shapes();
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rand = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut stream = testutil::Xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut rand = move || stream.unit_f64();
         let refine = RefineOptions {
             levels: 3,
             ..RefineOptions::default()

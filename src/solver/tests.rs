@@ -913,13 +913,8 @@ fn point_to_square_matches_lambert_at_random_points() {
     use super::formfactor::{point_to_polygon, point_to_samples};
     let (square, samples) = unit_square_samples();
     let corners: Vec<glam::Vec3> = square.vertices.clone();
-    let mut seed = 0xfeed_5eed_1234_5678u64;
-    let mut rand = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f32 / (1u64 << 53) as f32
-    };
+    let mut stream = crate::testutil::Xorshift(0xfeed_5eed_1234_5678);
+    let mut rand = move || stream.unit_f64() as f32;
     let mut errors = Vec::new();
     while errors.len() < 2000 {
         let x = glam::Vec3::new(

@@ -251,12 +251,8 @@ fn solve_in_background(
                     ..*options
                 };
                 let next = r.refine(&prepared.scene, &luminance, options);
-                if let Some(elements) = r.refused() {
-                    eprintln!(
-                        "warning: refining no further: the next refinement would make about \
-                     {elements} elements, over --max-elements {}",
-                        options.max_elements
-                    );
+                if let Some(refused) = r.refused() {
+                    eprintln!("warning: {refused}");
                 }
                 if let Some((mesh, _)) = &next {
                     start = solver.refined_state(mesh, r);

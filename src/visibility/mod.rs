@@ -454,13 +454,8 @@ mod tests {
     /// of scattered squares and many pseudo-random segments.
     #[test]
     fn bvh_agrees_with_brute_force() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut stream = crate::testutil::Xorshift(0x2545_f491_4f6c_dd1d);
+        let mut rand = move || stream.unit_f32();
         let polygons: Vec<Polygon> = (0..60)
             .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
             .collect();
@@ -486,13 +481,8 @@ mod tests {
     /// as testing every polygon.
     #[test]
     fn shaft_candidates_agree_with_brute_force() {
-        let mut seed = 0x1234_5678_9abc_def1u64;
-        let mut rand = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut stream = crate::testutil::Xorshift(0x1234_5678_9abc_def1);
+        let mut rand = move || stream.unit_f32();
         let polygons: Vec<Polygon> = (0..80)
             .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
             .collect();

@@ -165,13 +165,9 @@ impl Shaft {
 mod tests {
     use super::*;
 
-    fn rand_stream(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        }
+    fn rand_stream(seed: u64) -> impl FnMut() -> f64 {
+        let mut stream = crate::testutil::Xorshift(seed);
+        move || stream.unit_f64()
     }
 
     fn random_box(r: &mut impl FnMut() -> f64) -> (DVec3, DVec3) {

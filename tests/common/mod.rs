@@ -61,3 +61,9 @@ pub fn listing(dir: &Path) -> Vec<String> {
     names.sort();
     names
 }
+
+/// The JSON file `name` in `dir` (a `--stats` file), parsed.
+pub fn read_json(dir: &Path, name: &str) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join(name)).expect("the JSON file exists");
+    serde_json::from_str(&text).expect("the file is JSON")
+}
