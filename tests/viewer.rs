@@ -24,12 +24,23 @@ fn skip(why: &str) {
     eprintln!("\n**************** SKIPPED: window end-to-end test: {why} ****************\n");
 }
 
-/// Kills a child process when dropped, so a failed assertion never leaves
-/// an X server or a window behind.
+/// Stops a child process when dropped, so a failed assertion never leaves
+/// an X server or a window behind: SIGTERM first, so that an X server
+/// removes its socket and lock file, then SIGKILL if it lingers.
 struct Reaper(Child);
 
 impl Drop for Reaper {
     fn drop(&mut self) {
+        let terminated = Command::new("kill")
+            .arg(self.0.id().to_string())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        if terminated
+            && wait_for(Duration::from_secs(2), || self.0.try_wait().ok().flatten()).is_some()
+        {
+            return;
+        }
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
@@ -58,42 +69,40 @@ fn xdotool(display: &str, args: &[&str]) -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
 }
 
-/// Starts Xvfb on a free display number; `None` if none starts.
+/// Starts Xvfb on a display number it picks itself (`-displayfd`: it
+/// skips the numbers in use and clears stale lock files); `None` if it
+/// does not start within 10 s.
 fn start_xvfb() -> Option<(Reaper, String)> {
-    for n in 90..110 {
-        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        {
-            continue;
-        }
-        let display = format!(":{n}");
-        let child = Command::new("Xvfb")
-            .args([
-                display.as_str(),
-                "-screen",
-                "0",
-                "800x600x24",
-                "-nolisten",
-                "tcp",
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .ok()?;
-        let mut xvfb = Reaper(child);
-        let up = wait_for(Duration::from_secs(10), || {
-            if let Ok(Some(_)) = xvfb.0.try_wait() {
-                return Some(false);
-            }
-            Path::new(&format!("/tmp/.X11-unix/X{n}"))
-                .exists()
-                .then_some(true)
-        });
-        if up == Some(true) {
-            return Some((xvfb, display));
-        }
-    }
-    None
+    use std::io::BufRead;
+    let mut child = Command::new("Xvfb")
+        .args([
+            "-displayfd",
+            "1",
+            "-screen",
+            "0",
+            "800x600x24",
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .ok()?;
+    let stdout = child.stdout.take()?;
+    let xvfb = Reaper(child);
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = std::io::BufReader::new(stdout).read_line(&mut line);
+        let _ = send.send(line);
+    });
+    let number: u32 = receive
+        .recv_timeout(Duration::from_secs(10))
+        .ok()?
+        .trim()
+        .parse()
+        .ok()?;
+    Some((xvfb, format!(":{number}")))
 }
 
 /// An X server for a test, or `None` (having said loudly why the test is
