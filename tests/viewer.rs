@@ -69,44 +69,52 @@ fn xdotool(display: &str, args: &[&str]) -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
 }
 
-/// Starts Xvfb on a display number it picks itself (`-displayfd`: it
-/// skips the numbers in use and clears stale lock files); `None` if it
-/// does not start within 10 s.
+/// Starts Xvfb on a free display number from 90 on; `None` if none
+/// starts. A number whose lock file exists is in use; a socket without a
+/// lock file is what a killed server left behind, and is removed.
 fn start_xvfb() -> Option<(Reaper, String)> {
-    use std::io::BufRead;
-    let mut child = Command::new("Xvfb")
-        .args([
-            "-displayfd",
-            "1",
-            "-screen",
-            "0",
-            "800x600x24",
-            "-nolisten",
-            "tcp",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .ok()?;
-    let stdout = child.stdout.take()?;
-    let xvfb = Reaper(child);
-    let (send, receive) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        let mut line = String::new();
-        let _ = std::io::BufReader::new(stdout).read_line(&mut line);
-        let _ = send.send(line);
-    });
-    let number: u32 = receive
-        .recv_timeout(Duration::from_secs(10))
-        .ok()?
-        .trim()
-        .parse()
-        .ok()?;
-    Some((xvfb, format!(":{number}")))
+    for n in 90..130 {
+        if Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+            continue;
+        }
+        let socket = format!("/tmp/.X11-unix/X{n}");
+        let _ = std::fs::remove_file(&socket);
+        let display = format!(":{n}");
+        let child = Command::new("Xvfb")
+            .args([
+                display.as_str(),
+                "-screen",
+                "0",
+                "800x600x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .ok()?;
+        let mut xvfb = Reaper(child);
+        let up = wait_for(Duration::from_secs(10), || {
+            if let Ok(Some(_)) = xvfb.0.try_wait() {
+                return Some(false);
+            }
+            Path::new(&socket).exists().then_some(true)
+        });
+        if up == Some(true) {
+            return Some((xvfb, display));
+        }
+    }
+    None
 }
+
+/// Held by each window test for its whole run.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// An X server for a test, or `None` (having said loudly why the test is
 /// skipped) when Xvfb or xdotool is missing or no server starts.
+///
+/// The window tests run one at a time (they hold [`ONE_AT_A_TIME`]): two
+/// servers starting at once would race for the same display number.
 fn x_server() -> Option<(Reaper, String)> {
     if which("Xvfb").is_none() || which("xdotool").is_none() {
         skip("Xvfb or xdotool is not installed");
@@ -139,20 +147,30 @@ fn open_cornell(dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
         .env_remove("WAYLAND_DISPLAY")
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let program = Reaper(child);
+    let mut program = Reaper(child);
     let window = wait_for(Duration::from_secs(20), || {
         xdotool(display, &["search", "--name", "^radiosity.*cornell"])
             .and_then(|ids| ids.lines().next().map(str::to_string))
-    })
-    .expect("the window appears");
+    });
+    let Some(window) = window else {
+        let _ = program.0.kill();
+        let mut said = String::new();
+        if let Some(mut err) = program.0.stderr.take() {
+            use std::io::Read;
+            let _ = err.read_to_string(&mut said);
+        }
+        panic!("no window appeared on {display}; the program said: {said}");
+    };
     (program, window)
 }
 
 #[test]
 fn window_writes_a_picture_and_quits_on_keys() {
+    // A failed test poisons the lock; the next one may still run.
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let Some((_xvfb, display)) = x_server() else {
         return;
     };
@@ -212,6 +230,8 @@ fn window_writes_a_picture_and_quits_on_keys() {
 
 #[test]
 fn window_refines_adaptively_and_shows_the_refined_mesh() {
+    // A failed test poisons the lock; the next one may still run.
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let Some((_xvfb, display)) = x_server() else {
         return;
     };
