@@ -63,7 +63,7 @@ struct Target {
     /// Generates a random input from the grammar.
     generate: fn(&mut Rng) -> Vec<u8>,
     /// Tokens worth inserting.
-    dictionary: &'static [&'static str],
+    dictionary: Vec<&'static str>,
 }
 
 fn targets() -> Vec<Target> {
@@ -73,7 +73,12 @@ fn targets() -> Vec<Target> {
         load: |b| scene::parse_bytes(b, FILE).map_err(|e| e.diagnostics),
         seeds: sc_seeds,
         generate: generate_sc,
-        dictionary: SC_DICTIONARY,
+        // The parser's keywords, then malformed and extreme fragments.
+        dictionary: scene::KEYWORDS
+            .iter()
+            .chain(SC_FRAGMENTS)
+            .copied()
+            .collect(),
     }]
 }
 
@@ -178,25 +183,7 @@ const INTERESTING_NUMBERS: &[&str] = &[
     "99999999999999999999999999999999999999999",
 ];
 
-const SC_DICTIONARY: &[&str] = &[
-    "camera",
-    "material",
-    "polygon",
-    "box",
-    "transform",
-    "end",
-    "eye",
-    "lookat",
-    "up",
-    "fov",
-    "size",
-    "color",
-    "k_diffrefl",
-    "k_emission",
-    "vertex",
-    "translate",
-    "rotate",
-    "scale",
+const SC_FRAGMENTS: &[&str] = &[
     "scale 0.000001",
     "scale 1e300",
     "scale 1 0.000001 1",
@@ -640,7 +627,7 @@ fn fuzz(target: &Target, cases: u64, seed: u64) -> Summary {
         };
         let other = rng.pick(&seeds).clone();
         for _ in 0..mutations {
-            mutate(&mut rng, &mut input, &other, target.dictionary);
+            mutate(&mut rng, &mut input, &other, &target.dictionary);
         }
         dog.begin(&input);
         let t = Instant::now();

@@ -19,7 +19,7 @@ pub use polygon::{
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
 pub use sc::{
-    load_camera, parse_bytes, parse_camera_str, parse_str, MAX_DIAGNOSTICS, MAX_EMISSION,
+    load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_DIAGNOSTICS, MAX_EMISSION,
     UP_PARALLEL_TOLERANCE,
 };
 

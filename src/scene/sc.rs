@@ -40,7 +40,7 @@ pub const UP_PARALLEL_TOLERANCE: f64 = 1e-4;
 pub const MAX_EMISSION: f64 = 1e20;
 
 /// Every keyword of the format. None of them may be used as a name.
-const KEYWORDS: &[&str] = &[
+pub const KEYWORDS: &[&str] = &[
     "camera",
     "material",
     "polygon",
