@@ -22,7 +22,7 @@
 //! continues to the same bits an uninterrupted one gives.
 
 use crate::color::Rgb;
-use crate::mesh::refine::{RefineOptions, Refiner};
+use crate::mesh::refine::{RefineOptions, RefineReport, Refiner};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions, MeshSize};
 use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, MeshFormat, OutputError, PictureFormat};
@@ -557,25 +557,13 @@ fn solve_adaptive(
             closure: 0,
         };
         let refining = Instant::now();
-        // Refine a converged solution only: one cut short by --max-steps
-        // would mark what is merely unfinished.
-        let converged = solver.stop_reason() == Some(StopReason::Converged);
-        let next = if converged && refiner.passes() < options.levels {
-            let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
-            let next = refiner.refine(&prepared.scene, &luminance, options);
-            if let Some(refused) = refiner.refused() {
-                eprintln!("warning: {refused}");
-            }
-            next
-        } else {
-            None
-        };
-        if let Some((refined, _)) = &next {
+        let next = refine_solved(&solver, &mut refiner, &prepared.scene, options);
+        if let Some(Refinement {
+            start: Some(state), ..
+        }) = &next
+        {
             // The gather for the new vertices is this pass's work too.
-            start = solver.refined_state(refined, &refiner);
-            if let Some(state) = &start {
-                pass.rays += state.rays - solver.rays();
-            }
+            pass.rays += state.rays - solver.rays();
         }
         pass.refine_seconds = refining.elapsed().as_secs_f64();
         pass.seconds = t.elapsed().as_secs_f64();
@@ -587,7 +575,7 @@ fn solve_adaptive(
                 pass.steps,
                 pass.seconds,
                 match &next {
-                    Some((_, r)) => format!(
+                    Some(Refinement { report: r, .. }) => format!(
                         "; splitting {} elements (+{} to stay conforming)",
                         r.marked, r.closure
                     ),
@@ -596,11 +584,12 @@ fn solve_adaptive(
             );
         }
         match next {
-            Some((refined, report)) => {
-                pass.split = report.marked;
-                pass.closure = report.closure;
+            Some(refinement) => {
+                pass.split = refinement.report.marked;
+                pass.closure = refinement.report.closure;
                 passes.push(pass);
-                mesh = refined;
+                start = refinement.start;
+                mesh = refinement.mesh;
             }
             None => {
                 passes.push(pass);
@@ -614,6 +603,47 @@ fn solve_adaptive(
             }
         }
     }
+}
+
+/// The next mesh of an adaptive run, and where its solve starts.
+pub struct Refinement {
+    /// The refined mesh.
+    pub mesh: Mesh,
+    /// What the refinement split.
+    pub report: RefineReport,
+    /// The state that continues the solve on [`Refinement::mesh`]
+    /// ([`Progressive::refined_state`]); `None` to solve it afresh
+    /// (per-polygon unshot).
+    pub start: Option<checkpoint::SolverState>,
+}
+
+/// After a solve on `refiner`'s last mesh: the next refinement, or `None`
+/// when there is none to make. A solve cut short (by a step limit) is not
+/// refined, since it would mark what is merely unfinished; nor one after
+/// `options.levels` passes, nor one whose refinement would pass
+/// `options.max_elements` (said on stderr as a warning).
+pub fn refine_solved(
+    solver: &Progressive,
+    refiner: &mut Refiner,
+    scene: &Scene,
+    options: &RefineOptions,
+) -> Option<Refinement> {
+    if solver.stop_reason() != Some(StopReason::Converged) || refiner.passes() >= options.levels {
+        return None;
+    }
+    let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
+    let Some((mesh, report)) = refiner.refine(scene, &luminance, options) else {
+        if let Some(refused) = refiner.refused() {
+            eprintln!("warning: {refused}");
+        }
+        return None;
+    };
+    let start = solver.refined_state(&mesh, refiner);
+    Some(Refinement {
+        mesh,
+        report,
+        start,
+    })
 }
 
 /// A scene loaded, meshed and put in a BVH: what both the batch run and

@@ -22,7 +22,7 @@
 
 pub mod controls;
 
-use crate::app::{Prepared, RunConfig};
+use crate::app::{self, Prepared, RunConfig};
 use crate::color::Rgb;
 use crate::mesh::refine::{RefineOptions, Refiner};
 use crate::mesh::Mesh;
@@ -200,7 +200,13 @@ fn solve_in_background(
     control: &Control,
     ambient: bool,
 ) {
-    let mut refiner = config.adaptive.map(|o| (Refiner::new(&prepared.mesh), o));
+    let mut refiner = config.adaptive.map(|o| {
+        let options = RefineOptions {
+            max_elements: o.max_elements.min(config.max_elements),
+            ..o
+        };
+        (Refiner::new(&prepared.mesh), options)
+    });
     let levels = config.adaptive.map_or(0, |o| o.levels);
     // The refined mesh of the current pass (`None`: the prepared mesh).
     let mut refined: Option<Arc<Mesh>> = None;
@@ -243,26 +249,11 @@ fn solve_in_background(
             return;
         };
         let next = match refiner.as_mut() {
-            Some((r, options)) if stop == StopReason::Converged && r.passes() < options.levels => {
-                let luminance: Vec<f64> =
-                    solver.radiosity().iter().map(|b| b.luminance()).collect();
-                let options = &RefineOptions {
-                    max_elements: options.max_elements.min(config.max_elements),
-                    ..*options
-                };
-                let next = r.refine(&prepared.scene, &luminance, options);
-                if let Some(refused) = r.refused() {
-                    eprintln!("warning: {refused}");
-                }
-                if let Some((mesh, _)) = &next {
-                    start = solver.refined_state(mesh, r);
-                }
-                next
-            }
-            _ => None,
+            Some((r, options)) => app::refine_solved(&solver, r, &prepared.scene, options),
+            None => None,
         };
         // A continued solve counts its rays on from the last one's.
-        rays_before = if start.is_some() {
+        rays_before = if next.as_ref().is_some_and(|n| n.start.is_some()) {
             0
         } else {
             rays_before + solver.rays()
@@ -275,10 +266,11 @@ fn solve_in_background(
             p.mesh = refined.clone();
         }
         match next {
-            Some((mesh, _)) => {
+            Some(refinement) => {
                 drop(p);
                 drop(solver);
-                refined = Some(Arc::new(mesh));
+                start = refinement.start;
+                refined = Some(Arc::new(refinement.mesh));
             }
             None => {
                 p.stopped = Some(stop);
