@@ -662,19 +662,15 @@ impl<'a> Progressive<'a> {
                 let d = self.delta[l as usize];
                 self.radiosity[l as usize] += d;
                 match self.options.unshot {
-                    UnshotScheme::Polygon if pm.levels == 0 => gathered += d,
+                    // Weighted as the polygon's mean is ([`Mesh::
+                    // polygon_vertex_weights`]): 1/n on a regular mesh, as
+                    // the original algorithm, area shares on a refined one.
                     UnshotScheme::Polygon => gathered += d * self.mean_weight[l as usize],
                     UnshotScheme::Vertex => self.unshot[l as usize] += d,
                 }
             }
             if self.options.unshot == UnshotScheme::Polygon {
-                // A regular mesh divides by n exactly as the original
-                // algorithm; a refined one weights by area.
-                self.unshot[j] += if pm.levels == 0 {
-                    gathered / pm.vertex_count() as f64
-                } else {
-                    gathered
-                };
+                self.unshot[j] += gathered;
             }
         }
         self.pairs += pairs;
