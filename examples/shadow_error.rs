@@ -15,7 +15,9 @@
 //! 20 % of the local maximum within two pixels), both relative to the
 //! reference's mean luminance there.
 
-use radiosity::app::{self, Prepared, RunConfig, SceneSource};
+use radiosity::config::{RunConfig, SceneSource};
+use radiosity::prepare::{self, Prepared};
+use radiosity::session::Session;
 use radiosity::mesh::refine::RefineOptions;
 use radiosity::render::Frame;
 use std::path::PathBuf;
@@ -43,7 +45,7 @@ fn main() {
         c.camera = Some(camera.clone());
         c
     };
-    let default_lenmax = match app::prepare(&base) {
+    let default_lenmax = match prepare::prepare(&base) {
         Ok(p) => p.lenmax,
         Err(e) => {
             eprintln!("{e}");
@@ -73,15 +75,22 @@ fn main() {
         let mut config = base.clone();
         config.lenmax = Some(lenmax);
         config.adaptive = refine;
-        let prepared: Prepared = app::prepare(&config).expect("the scene prepared once already");
+        let prepared: Prepared = prepare::prepare(&config).expect("the scene prepared once already");
         let view = prepared.view(&config).expect("the camera file's camera");
         let t = Instant::now();
-        let solution =
-            app::solve(&config, &prepared, &AtomicBool::new(false)).expect("an uncancelled solve");
+        let mut session = Session::new(
+            &prepared.scene,
+            &prepared.mesh,
+            &prepared.visibility,
+            config.session_options(false),
+        );
+        session
+            .run_to_end(&AtomicBool::new(false))
+            .expect("an uncancelled solve");
         let seconds = t.elapsed().as_secs_f64();
-        let frame = app::render(&solution.mesh, &solution.solved.radiosity, &view)
+        let frame = radiosity::render::render(session.mesh(), session.radiosity(), &view)
             .expect("the solution renders");
-        let vertices = solution.mesh.vertex_count();
+        let vertices = session.mesh().vertex_count();
         match &reference {
             None => {
                 let band = shadow_band(&frame);

@@ -10,7 +10,9 @@
 //! `lenmax` in scene units (optional; `-` or absent for the program's
 //! default), and `adaptive` to solve with the default adaptive subdivision.
 
-use radiosity::app::{self, RunConfig, SceneSource};
+use radiosity::config::{RunConfig, SceneSource};
+use radiosity::prepare;
+use radiosity::session::Session;
 use radiosity::color::Rgb;
 use radiosity::mesh::refine::RefineOptions;
 use radiosity::solver::UnshotScheme;
@@ -33,7 +35,7 @@ fn main() {
     if args.get(4).is_some_and(|a| a == "adaptive") {
         config.adaptive = Some(RefineOptions::default());
     }
-    let prepared = match app::prepare(&config) {
+    let prepared = match prepare::prepare(&config) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("{e}");
@@ -41,15 +43,18 @@ fn main() {
         }
     };
     let start = std::time::Instant::now();
-    let solution = match app::solve(&config, &prepared, &AtomicBool::new(false)) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(1);
-        }
-    };
-    let mesh = &solution.mesh;
-    let radiosity = &solution.solved.radiosity;
+    let mut session = Session::new(
+        &prepared.scene,
+        &prepared.mesh,
+        &prepared.visibility,
+        config.session_options(false),
+    );
+    if let Err(e) = session.run_to_end(&AtomicBool::new(false)) {
+        eprintln!("{e}");
+        std::process::exit(1);
+    }
+    let mesh = session.mesh();
+    let radiosity = session.radiosity();
     let areas = mesh.vertex_areas();
     println!(
         "# {path}: --unshot {scheme}, lenmax {}{}, {} vertices, {} steps, {:.2} s",
@@ -60,7 +65,7 @@ fn main() {
             ""
         },
         mesh.vertex_count(),
-        solution.solved.steps,
+        session.totals().steps,
         start.elapsed().as_secs_f64()
     );
     println!("polygon,line,area,r,g,b");

@@ -1,12 +1,15 @@
 //! A progressive-refinement radiosity renderer with ray-traced form factors.
 #![warn(missing_docs)]
 
-pub mod app;
+pub mod batch;
 pub mod color;
+pub mod config;
 pub mod mesh;
 pub mod output;
+pub mod prepare;
 pub mod render;
 pub mod scene;
+pub mod session;
 pub mod solver;
 pub mod viewer;
 pub mod visibility;

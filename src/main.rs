@@ -4,7 +4,8 @@
 //! 130 interrupted (Ctrl-C).
 
 use clap::Parser;
-use radiosity::app::{self, RunConfig, SceneSource};
+use radiosity::batch::{self, RunError, RunStats};
+use radiosity::config::{self, RunConfig, SceneSource};
 use radiosity::mesh::refine::{self, RefineOptions};
 use radiosity::mesh::DEFAULT_INSET;
 use radiosity::render::Exposure;
@@ -178,7 +179,7 @@ struct Args {
     /// Refuse meshes with more elements than this, before building them;
     /// the message says which --lenmax fits. The default allows meshes of
     /// up to about 3.7 GB (estimated; 2.7 GB measured).
-    #[arg(long, value_name = "N", default_value_t = app::DEFAULT_MAX_ELEMENTS)]
+    #[arg(long, value_name = "N", default_value_t = config::DEFAULT_MAX_ELEMENTS)]
     max_elements: u64,
 
     /// Save the solver state to this file every --checkpoint-every seconds,
@@ -188,7 +189,7 @@ struct Args {
     checkpoint: Option<PathBuf>,
 
     /// Seconds between checkpoints.
-    #[arg(long, value_name = "SECS", default_value_t = app::DEFAULT_CHECKPOINT_EVERY.as_secs_f64())]
+    #[arg(long, value_name = "SECS", default_value_t = config::DEFAULT_CHECKPOINT_EVERY.as_secs_f64())]
     checkpoint_every: f64,
 
     /// Continue the solve saved in this checkpoint (same scene and mesh and
@@ -371,7 +372,7 @@ fn main() -> ExitCode {
         || config.resume.is_some();
     let result = if batch {
         catch_ctrl_c();
-        app::run_cancellable(&config, &INTERRUPTED).map(Some)
+        batch::run(&config, &INTERRUPTED).map(Some)
     } else {
         run_window_or_fallback(&config, args.quiet)
     };
@@ -379,16 +380,13 @@ fn main() -> ExitCode {
         Ok(None) => ExitCode::SUCCESS,
         Ok(Some(stats)) => {
             if !args.quiet {
-                eprintln!("{}", app::summary(&stats));
+                eprintln!("{}", batch::summary(&stats));
             }
             ExitCode::SUCCESS
         }
         Err(e) => {
             // Load errors already read `FILE:LINE:COL: error: ...`.
-            if matches!(
-                e,
-                app::RunError::Load(_) | app::RunError::Interrupted { .. }
-            ) {
+            if e.is_self_describing() {
                 eprintln!("{e}");
             } else {
                 eprintln!("error: {e}");
@@ -403,31 +401,31 @@ fn main() -> ExitCode {
 fn run_window_or_fallback(
     config: &RunConfig,
     quiet: bool,
-) -> Result<Option<app::RunStats>, app::RunError> {
+) -> Result<Option<RunStats>, RunError> {
     let fallback = |why: &str| {
         if !quiet {
             eprintln!(
                 "{why}: writing {} in the current directory instead",
-                app::output_path(config).display()
+                config.output_path().display()
             );
         }
     };
     if let Err(why) = viewer::display_available() {
-        app::check_outputs(config)?;
+        batch::check_outputs(config)?;
         fallback(&why);
         catch_ctrl_c();
-        return app::run_cancellable(config, &INTERRUPTED).map(Some);
+        return batch::run(config, &INTERRUPTED).map(Some);
     }
-    let prepared = app::prepare(config)?;
+    let prepared = radiosity::prepare::prepare(config)?;
     match viewer::run(&prepared, config) {
         Ok(()) => Ok(None),
         Err(viewer::ViewerError::CannotOpen(why)) => {
             fallback(&why);
             catch_ctrl_c();
-            app::run_prepared_cancellable(config, &prepared, &INTERRUPTED).map(Some)
+            batch::run_prepared(config, &prepared, &INTERRUPTED).map(Some)
         }
-        Err(viewer::ViewerError::View(e)) => Err(app::RunError::View(e)),
-        Err(viewer::ViewerError::Render(e)) => Err(app::RunError::Render(e)),
+        Err(viewer::ViewerError::View(e)) => Err(RunError::View(e)),
+        Err(viewer::ViewerError::Render(e)) => Err(RunError::Render(e)),
     }
 }
 

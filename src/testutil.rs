@@ -128,3 +128,33 @@ fn closed_box_faces_inward() {
         assert_eq!(w.shape, Shape::Parallelogram);
     }
 }
+
+/// A closed 2-unit box with one glowing wall (emission 10, reflectance
+/// 0.3) and the others of reflectance 0.7 and 0.4: every polygon reflects,
+/// so its energy balance is a closed form.
+pub fn glowing_box() -> Scene {
+    scene(
+        closed_box(2.0, [1, 2, 1, 0, 1, 2]),
+        vec![
+            grey("lamp", 10.0, 0.3),
+            grey("a", 0.0, 0.7),
+            grey("b", 0.0, 0.4),
+        ],
+    )
+}
+
+/// [`glowing_box`] with a square floating low over its floor, facing up:
+/// it casts a sharp shadow that adaptive subdivision refines.
+pub fn shadowed_box() -> Scene {
+    let mut polygons = closed_box(2.0, [1, 2, 1, 0, 1, 2]);
+    polygons.push(polygon(
+        1,
+        &[
+            [0.6, 0.3, 0.6],
+            [0.6, 0.3, 1.4],
+            [1.4, 0.3, 1.4],
+            [1.4, 0.3, 0.6],
+        ],
+    ));
+    scene(polygons, glowing_box().materials)
+}

@@ -1,7 +1,7 @@
 //! Numerical safety: degenerate and extreme geometry the loader accepts
 //! gives finite, non-negative radiosities and pictures.
 
-use radiosity::app::render;
+use radiosity::render::render;
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::render::View;
 use radiosity::scene::{parse_str, Scene};

@@ -32,7 +32,10 @@ use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 use std::ops::Range;
 
+mod handle;
 pub mod refine;
+
+pub use handle::MeshRef;
 
 /// Default inset of boundary vertices, as a fraction of the polygon's
 /// shortest element edge (see the module docs). Five percent moves the
@@ -206,20 +209,29 @@ pub enum MeshError {
     /// The inset is outside `[0, 0.5)`.
     #[error("inset must be at least 0 and below 0.5 (a fraction of an element edge), got {0}")]
     BadInset(f32),
-    /// The mesh would be too large to hold.
+    /// The mesh would have more elements than allowed: what it would
+    /// take, and the smallest lenmax that fits.
     #[error(
-        "lenmax {lenmax} would make {elements} elements (at most {max} are allowed); \
-         try lenmax {suggested:.4} or larger"
+        "lenmax {lenmax} would make {} elements and {} vertices, about {} of memory; \
+         --max-elements allows {max}: {}",
+        size.elements,
+        size.vertices,
+        fmt_bytes(memory_estimate(*size)),
+        match suggested {
+            Some(l) => format!("use --lenmax {l} or larger (or raise --max-elements)"),
+            None => "the scene has more polygons than that even unsubdivided".to_string(),
+        }
     )]
     TooManyElements {
-        /// The requested lenmax.
+        /// The lenmax asked for, in scene units.
         lenmax: f32,
-        /// The estimated element count.
-        elements: u64,
-        /// The limit.
+        /// The mesh it would make.
+        size: MeshSize,
+        /// The element limit.
         max: u64,
-        /// A lenmax that would fit.
-        suggested: f32,
+        /// The smallest lenmax (to three significant digits) that fits,
+        /// if any does ([`lenmax_to_fit`]).
+        suggested: Option<f32>,
     },
 }
 
@@ -247,6 +259,107 @@ pub fn estimate(scene: &Scene, options: &MeshOptions) -> Result<MeshSize, MeshEr
         size.vertices = size.vertices.saturating_add(plan.vertex_count());
     }
     Ok(size)
+}
+
+/// Refuses, before anything is allocated, a mesh with more than
+/// `max_elements` elements (at most [`MAX_ADDRESSABLE_ELEMENTS`]), saying
+/// how much memory it would take and which lenmax would fit.
+pub fn check_size(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+) -> Result<MeshSize, MeshError> {
+    let max = max_elements.min(MAX_ADDRESSABLE_ELEMENTS);
+    let size = estimate(scene, options)?;
+    if size.elements <= max {
+        Ok(size)
+    } else {
+        Err(too_many_elements(scene, options, max))
+    }
+}
+
+/// The error for a mesh over `max_elements`, with its size and the
+/// lenmax that fits.
+fn too_many_elements(scene: &Scene, options: &MeshOptions, max_elements: u64) -> MeshError {
+    let size = estimate(scene, options).unwrap_or(MeshSize {
+        elements: u64::MAX,
+        vertices: u64::MAX,
+    });
+    MeshError::TooManyElements {
+        lenmax: options.lenmax,
+        size,
+        max: max_elements,
+        suggested: lenmax_to_fit(scene, options, max_elements),
+    }
+}
+
+/// The smallest lenmax, rounded up to three significant digits, whose mesh
+/// has at most `max_elements` elements; `None` when even one element per
+/// polygon is too many.
+pub fn lenmax_to_fit(scene: &Scene, options: &MeshOptions, max_elements: u64) -> Option<f32> {
+    let fits = |lenmax: f32| {
+        let o = MeshOptions { lenmax, ..*options };
+        estimate(scene, &o).is_ok_and(|s| s.elements <= max_elements)
+    };
+    // Longer than every polygon: one element per triangle or quad, a fan
+    // per larger polygon.
+    let mut hi = (scene.extent() * 2.0)
+        .max(options.lenmax)
+        .max(f32::MIN_POSITIVE);
+    if !fits(hi) {
+        return None;
+    }
+    let mut lo = options.lenmax;
+    // Bisection in log scale; the count only falls as lenmax grows.
+    for _ in 0..60 {
+        let mid = (lo * hi).sqrt();
+        if !(mid > lo && mid < hi) {
+            break;
+        }
+        if fits(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    // Round up to three significant digits for the message, keeping a
+    // value that still fits.
+    let digits = 10f64.powf((hi as f64).log10().floor() - 2.0);
+    let rounded = ((hi as f64 / digits).ceil() * digits) as f32;
+    Some(if fits(rounded) { rounded } else { hi })
+}
+
+/// Bytes held per mesh vertex during a whole run, for
+/// [`memory_estimate`]: positions and sample points (24, up to twice that
+/// while the arrays grow), the owning polygon (4), the solver's radiosity
+/// and step scratch (48), the rasterizer's projected vertex (about 32) and
+/// a checkpoint's copy (24). Measured peak memory stays below this estimate:
+/// 639 MB for 4.7 million vertices and elements, estimated 863 MB (see
+/// `docs/reliability.md`).
+pub const BYTES_PER_VERTEX: u64 = 160;
+
+/// Bytes held per mesh element during a run: its corners and owning
+/// polygon.
+pub const BYTES_PER_ELEMENT: u64 = 24;
+
+/// Estimated peak memory of a run with a mesh of this size, in bytes:
+/// [`BYTES_PER_VERTEX`] per vertex and [`BYTES_PER_ELEMENT`] per element.
+pub fn memory_estimate(size: MeshSize) -> u64 {
+    size.vertices
+        .saturating_mul(BYTES_PER_VERTEX)
+        .saturating_add(size.elements.saturating_mul(BYTES_PER_ELEMENT))
+}
+
+/// `bytes` as `1.5 GB`, `320 MB`, `12 kB`.
+fn fmt_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else if b >= 1e6 {
+        format!("{:.0} MB", b / 1e6)
+    } else {
+        format!("{:.0} kB", (b / 1e3).ceil())
+    }
 }
 
 /// Builds the element mesh of every polygon of `scene`, refusing more than
@@ -285,14 +398,7 @@ pub fn build_with_limit(
         .iter()
         .fold(0u64, |sum, p| sum.saturating_add(p.element_count()));
     if elements > max_elements {
-        // Element count scales with 1/lenmax², so this factor brings it under.
-        let factor = (elements as f64 / max_elements as f64).sqrt() as f32 * 1.05;
-        return Err(MeshError::TooManyElements {
-            lenmax: options.lenmax,
-            elements,
-            max: max_elements,
-            suggested: options.lenmax * factor,
-        });
+        return Err(too_many_elements(scene, options, max_elements));
     }
 
     let mut mesh = Mesh {
@@ -1048,7 +1154,10 @@ mod tests {
             Err(MeshError::BadInset(_))
         ));
         match build(&s, &opts(1e-5, 0.0)) {
-            Err(MeshError::TooManyElements { suggested, .. }) => {
+            Err(MeshError::TooManyElements {
+                suggested: Some(suggested),
+                ..
+            }) => {
                 let m = build(&s, &opts(suggested, 0.0)).unwrap();
                 assert!(m.elements.len() as u64 <= MAX_ELEMENTS);
             }

@@ -23,7 +23,6 @@
 //! system font is needed.
 
 use super::{write_rgb8, OutputError, PictureFormat};
-use crate::solver::StepReport;
 use image::RgbImage;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
@@ -41,11 +40,19 @@ pub const LOG_HEADER: &str = "step,shooter,shooter_line,shot_power,unshot_fracti
 const FONT: &str = "sans-serif";
 static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/NotoMono-Regular.ttf");
 
-/// One shooting step as logged.
+/// One shooting step as logged (see the module docs for each column).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepRecord {
-    /// What the solver reported.
-    pub report: StepReport,
+    /// Which step this was, from 1.
+    pub step: u64,
+    /// The polygon that shot: its index in the scene, from 0.
+    pub shooter: u32,
+    /// The power it shot, radiosity × area (scene units).
+    pub shot_power: f64,
+    /// Unshot power left after the step ÷ emitted power.
+    pub unshot_fraction: f64,
+    /// Shadow rays cast in the step.
+    pub rays: u64,
     /// The line of the scene file where the shooter is written.
     pub shooter_line: u32,
     /// Seconds from the start of the solve to the end of this step.
@@ -56,11 +63,10 @@ pub struct StepRecord {
 pub fn write_log(w: &mut dyn Write, steps: &[StepRecord]) -> io::Result<()> {
     writeln!(w, "{LOG_HEADER}")?;
     for s in steps {
-        let r = &s.report;
         writeln!(
             w,
             "{},{},{},{},{},{},{}",
-            r.step, r.shooter.0, s.shooter_line, r.shot_power, r.unshot_fraction, r.rays, s.seconds
+            s.step, s.shooter, s.shooter_line, s.shot_power, s.unshot_fraction, s.rays, s.seconds
         )?;
     }
     Ok(())
@@ -102,7 +108,7 @@ pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImag
             .chain(
                 steps
                     .iter()
-                    .map(|s| (s.report.step as f64, s.report.unshot_fraction)),
+                    .map(|s| (s.step as f64, s.unshot_fraction)),
             )
             .filter(|&(_, y)| y > 0.0 && y.is_finite())
             .collect();
@@ -177,22 +183,15 @@ pub fn write_plot_file(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::PolygonId;
-    use crate::solver::StepReport;
 
     fn steps(n: u64) -> Vec<StepRecord> {
         (1..=n)
             .map(|i| StepRecord {
-                report: StepReport {
-                    step: i,
-                    shooter: PolygonId(i as u32 % 3),
-                    shot_power: 1.0 / i as f64,
-                    unshot_fraction: 0.5f64.powi(i as i32),
-                    rays: 100 * i,
-                    pairs: 120 * i,
-                    receivers: 4,
-                    clear_receivers: 1,
-                },
+                step: i,
+                shooter: i as u32 % 3,
+                shot_power: 1.0 / i as f64,
+                unshot_fraction: 0.5f64.powi(i as i32),
+                rays: 100 * i,
                 shooter_line: 7,
                 seconds: 0.1 * i as f64,
             })
@@ -219,7 +218,7 @@ mod tests {
         assert_eq!(lines[0], LOG_HEADER);
         assert_eq!(lines[2], "2,2,7,0.5,0.25,200,0.2");
         let third: Vec<f64> = lines[3].split(',').map(|x| x.parse().unwrap()).collect();
-        assert_eq!(third[4], s[2].report.unshot_fraction);
+        assert_eq!(third[4], s[2].unshot_fraction);
         assert_eq!(third[6], s[2].seconds);
     }
 

@@ -25,3 +25,15 @@ pub use camera::{View, ViewError};
 pub use overlay::{draw_mesh_edges, MESH_COLOR};
 pub use raster::{Frame, Rasterizer, RenderError};
 pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};
+
+/// Renders one frame of a solution (`radiosity` per vertex of `mesh`) with
+/// a rasterizer of its own: for a single picture; a window or an animation
+/// keeps one [`Rasterizer`] and reuses its buffers.
+pub fn render(
+    mesh: &crate::mesh::Mesh,
+    radiosity: &[crate::color::Rgb],
+    view: &View,
+) -> Result<Frame, RenderError> {
+    let mut rasterizer = Rasterizer::new();
+    Ok(rasterizer.render(mesh, radiosity, view)?.clone())
+}

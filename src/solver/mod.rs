@@ -24,7 +24,7 @@ pub mod formfactor;
 
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshRef};
 use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
 use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
@@ -167,7 +167,7 @@ pub enum StopReason {
 /// unshot value is finite and non-negative; one radiosity per mesh vertex
 /// and one unshot value per polygon.
 pub struct Progressive<'a> {
-    mesh: &'a Mesh,
+    mesh: MeshRef<'a>,
     visibility: &'a Visibility,
     options: SolverOptions,
     /// Per polygon: front emission `e`.
@@ -283,10 +283,12 @@ impl<'a> Progressive<'a> {
     /// `scene`.
     pub fn new(
         scene: &Scene,
-        mesh: &'a Mesh,
+        mesh: impl Into<MeshRef<'a>>,
         visibility: &'a Visibility,
         options: SolverOptions,
     ) -> Self {
+        let mesh_ref = mesh.into();
+        let mesh: &Mesh = &mesh_ref;
         let set = match (options.form_factor, options.shooter_samples) {
             (FormFactorMethod::Center, _) => SampleSet::Centre,
             (FormFactorMethod::Wallace, ShooterSamples::All) => SampleSet::Vertices,
@@ -347,7 +349,7 @@ impl<'a> Progressive<'a> {
             }
         }
         let mut solver = Progressive {
-            mesh,
+            mesh: mesh_ref.clone(),
             visibility,
             options,
             emission,
@@ -400,6 +402,16 @@ impl<'a> Progressive<'a> {
     /// The options it runs with.
     pub fn options(&self) -> &SolverOptions {
         &self.options
+    }
+
+    /// The mesh it solves on.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// The mesh it solves on, as a handle that can outlive this solver.
+    pub fn mesh_ref(&self) -> MeshRef<'a> {
+        self.mesh.clone()
     }
 
     /// The ambient term of Cohen, Chen, Wallace and Greenberg (1988): the
@@ -548,7 +560,8 @@ impl<'a> Progressive<'a> {
         self.fill_shot(i);
         self.mark_receivers(i);
 
-        let mesh = self.mesh;
+        let mesh_ref = self.mesh.clone();
+        let mesh: &Mesh = &mesh_ref;
         let visibility = self.visibility;
         let culling = self.options.shaft_culling;
         let receives = &self.receives;
@@ -854,7 +867,8 @@ impl<'a> Progressive<'a> {
     /// and some sample of `i` in front of their own plane. The others get
     /// nothing and need no per-vertex work.
     fn mark_receivers(&mut self, i: usize) {
-        let mesh = self.mesh;
+        let mesh_ref = self.mesh.clone();
+        let mesh: &Mesh = &mesh_ref;
         let shooter = &mesh.polygons[i];
         let origin = self.samples[i]
             .first()

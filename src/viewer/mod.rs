@@ -7,7 +7,7 @@
 //! with the same [`Rasterizer`] and tone mapping the batch command uses, so
 //! what `w` writes is exactly what is on screen. The window never waits
 //! for a step: a long step only delays the next new picture, and quitting
-//! cancels it ([`Progressive::step_cancellable`]).
+//! cancels it ([`Progressive::step_cancellable`](crate::solver::Progressive::step_cancellable)).
 //!
 //! With adaptive subdivision the worker refines the mesh once a solve
 //! converges and solves again on the refined mesh; meanwhile the window
@@ -22,13 +22,14 @@
 
 pub mod controls;
 
-use crate::app::{self, Prepared, RunConfig};
 use crate::color::Rgb;
-use crate::mesh::refine::{RefineOptions, Refiner};
-use crate::mesh::Mesh;
+use crate::config::RunConfig;
+use crate::mesh::MeshRef;
 use crate::output;
+use crate::prepare::Prepared;
 use crate::render::{self, Exposure, Rasterizer, View};
-use crate::solver::{Progressive, StopReason};
+use crate::session::{Event, Session};
+use crate::solver::StopReason;
 use controls::CameraControl;
 use image::RgbImage;
 use minifb::{InputCallback, Key, MouseButton, MouseMode, Window, WindowOptions};
@@ -97,24 +98,13 @@ pub fn display_available() -> Result<(), String> {
     }
 }
 
-/// The radiosity the window shows: with the ambient term while the solve
-/// is unconverged (it fades as the solve converges), or the solution alone.
-fn shown_radiosity(solver: &Progressive, ambient: bool) -> Vec<Rgb> {
-    let mut shown = Vec::new();
-    if ambient {
-        solver.radiosity_with_ambient(&mut shown);
-    } else {
-        shown.extend_from_slice(solver.radiosity());
-    }
-    shown
-}
-
 /// What the solver thread publishes after each step.
 #[derive(Clone, Debug, Default)]
-struct Progress {
-    /// The mesh [`Progress::radiosity`] belongs to: `None` for the
-    /// prepared mesh, else the latest adaptive refinement.
-    mesh: Option<Arc<Mesh>>,
+struct Progress<'p> {
+    /// The mesh [`Progress::radiosity`] belongs to: the prepared mesh or
+    /// its latest adaptive refinement; `None` before the first
+    /// publication.
+    mesh: Option<MeshRef<'p>>,
     radiosity: Vec<Rgb>,
     step: u64,
     unshot_fraction: f64,
@@ -158,7 +148,6 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     let presses = Arc::new(Mutex::new(Vec::new()));
     window.set_input_callback(Box::new(KeyPresses(Arc::clone(&presses))));
 
-    let ambient = config.ambient.unwrap_or(true);
     let progress = Mutex::new(Progress::default());
     let control = Control {
         quit: AtomicBool::new(false),
@@ -166,7 +155,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     };
 
     std::thread::scope(|scope| {
-        scope.spawn(|| solve_in_background(prepared, config, &progress, &control, ambient));
+        scope.spawn(|| solve_in_background(prepared, config, &progress, &control));
         let mut ui = Ui {
             prepared,
             window: &mut window,
@@ -191,147 +180,86 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     })
 }
 
-/// The solver thread: solves (and, with adaptive subdivision, refines and
-/// solves again) until done or told to quit, publishing after each step.
-fn solve_in_background(
-    prepared: &Prepared,
+/// The solver thread: runs the solve session (which, with adaptive
+/// subdivision, refines and goes on) until it finishes or the window
+/// quits, publishing after each step. The first pass is shown as it
+/// converges; a refined pass only once it has converged, so the picture
+/// never falls back to darkness.
+fn solve_in_background<'p>(
+    prepared: &'p Prepared,
     config: &RunConfig,
-    progress: &Mutex<Progress>,
+    progress: &Mutex<Progress<'p>>,
     control: &Control,
-    ambient: bool,
 ) {
-    let mut refiner = config.adaptive.map(|o| {
-        let options = RefineOptions {
-            max_elements: o.max_elements.min(config.max_elements),
-            ..o
-        };
-        (Refiner::new(&prepared.mesh), options)
-    });
-    let levels = config.adaptive.map_or(0, |o| o.levels);
-    // The refined mesh of the current pass (`None`: the prepared mesh).
-    let mut refined: Option<Arc<Mesh>> = None;
-    // Where a refined pass continues the last one (per-vertex unshot).
-    let mut start = None;
+    let mut session = Session::new(
+        &prepared.scene,
+        &prepared.mesh,
+        &prepared.visibility,
+        config.session_options(true),
+    );
+    let levels = session.max_refinements();
+    if let Ok(mut p) = progress.lock() {
+        session.shown(&mut p.radiosity);
+        p.mesh = Some(session.mesh_ref());
+        p.unshot_fraction = session.unshot_fraction();
+        p.pass = (1, levels);
+        p.version += 1;
+    }
     let mut solving = Duration::ZERO;
-    let mut rays_before = 0;
-    for pass in 1.. {
-        let mesh = refined.as_deref().unwrap_or(&prepared.mesh);
-        let mut solver =
-            Progressive::new(&prepared.scene, mesh, &prepared.visibility, config.solver);
-        if let Some(state) = start.take() {
-            // Consistent by construction; were it refused, the pass would
-            // only lose its head start and solve afresh.
-            let _ = solver.restore(state);
-        }
-        // The first pass is shown as it converges; a refined pass only once
-        // it has converged, so the picture never falls back to darkness.
-        let shown = pass == 1;
-        if let Ok(mut p) = progress.lock() {
-            if shown {
-                p.radiosity = shown_radiosity(&solver, ambient);
-                p.mesh = refined.clone();
-            }
-            p.unshot_fraction = solver.unshot_fraction();
-            p.stopped = None;
-            p.pass = (pass, levels);
-            p.version += 1;
-        }
-        let stop = solve_pass(
-            &mut solver,
-            progress,
-            control,
-            ambient,
-            shown,
-            &mut solving,
-            rays_before,
-        );
-        let Some(stop) = stop else {
-            return;
-        };
-        let next = match refiner.as_mut() {
-            Some((r, options)) => app::refine_solved(&solver, r, &prepared.scene, options),
-            None => None,
-        };
-        // A continued solve counts its rays on from the last one's.
-        rays_before = if next.as_ref().is_some_and(|n| n.start.is_some()) {
-            0
-        } else {
-            rays_before + solver.rays()
-        };
-        let Ok(mut p) = progress.lock() else {
-            return;
-        };
-        if !shown {
-            p.radiosity = shown_radiosity(&solver, ambient);
-            p.mesh = refined.clone();
-        }
-        match next {
-            Some(refinement) => {
-                drop(p);
-                drop(solver);
-                start = refinement.start;
-                refined = Some(Arc::new(refinement.mesh));
-            }
-            None => {
-                p.stopped = Some(stop);
-                p.version += 1;
-                break;
-            }
-        }
-    }
-    while !control.quit.load(Ordering::Relaxed) {
-        std::thread::sleep(FRAME_INTERVAL);
-    }
-}
-
-/// Steps one solve until it stops (returning why) or the window quits
-/// (returning `None`). Publishes the step count and unshot fraction after
-/// each step, and the radiosity too when `shown`.
-fn solve_pass(
-    solver: &mut Progressive,
-    progress: &Mutex<Progress>,
-    control: &Control,
-    ambient: bool,
-    shown: bool,
-    solving: &mut Duration,
-    rays_before: u64,
-) -> Option<StopReason> {
+    let mut stopped = None;
     loop {
         if control.quit.load(Ordering::Relaxed) {
-            return None;
-        }
-        if let Some(stop) = solver.stop_reason() {
-            return Some(stop);
+            return;
         }
         if control.paused.load(Ordering::Relaxed) {
             std::thread::sleep(FRAME_INTERVAL);
             continue;
         }
         let t = Instant::now();
-        let report = solver.step_cancellable(&control.quit);
-        *solving += t.elapsed();
+        let event = session.advance(&control.quit);
+        solving += t.elapsed();
         let Ok(mut p) = progress.lock() else {
-            return None;
+            return;
         };
-        let Some(report) = report else {
-            if control.quit.load(Ordering::Relaxed) {
-                return None;
+        match event {
+            Ok(Event::Step(report)) => {
+                if session.pass() == 1 {
+                    session.shown(&mut p.radiosity);
+                }
+                p.step = report.step;
+                p.unshot_fraction = report.unshot_fraction;
+                p.rays = session.totals().rays;
+                p.solving = solving.as_secs_f64();
             }
-            // Nothing left to shoot.
-            return Some(StopReason::Converged);
-        };
-        if shown {
-            if ambient {
-                solver.radiosity_with_ambient(&mut p.radiosity);
-            } else {
-                p.radiosity.clone_from_slice(solver.radiosity());
+            Ok(Event::Stopped(reason)) => {
+                stopped = Some(reason);
+                session.shown(&mut p.radiosity);
+                p.mesh = Some(session.mesh_ref());
+            }
+            Ok(Event::Refined(_)) => {
+                p.unshot_fraction = session.unshot_fraction();
+                p.pass = (session.pass(), levels);
+            }
+            Ok(Event::Refused(refused)) => eprintln!("warning: {refused}"),
+            Ok(Event::Finished) => {
+                p.stopped = stopped;
+                p.version += 1;
+                break;
+            }
+            Ok(Event::Cancelled) => return,
+            Err(e) => {
+                // A refined pass could not take over the last one's state
+                // (a bug): keep showing the last solution.
+                eprintln!("error: {e}");
+                p.stopped = stopped;
+                p.version += 1;
+                break;
             }
         }
-        p.step = report.step;
-        p.unshot_fraction = report.unshot_fraction;
-        p.rays = rays_before + solver.rays();
-        p.solving = solving.as_secs_f64();
         p.version += 1;
+    }
+    while !control.quit.load(Ordering::Relaxed) {
+        std::thread::sleep(FRAME_INTERVAL);
     }
 }
 
@@ -348,8 +276,9 @@ struct Ui<'a> {
     picture: RgbImage,
     buffer: Vec<u32>,
     radiosity: Vec<Rgb>,
-    /// The mesh [`Ui::radiosity`] belongs to (`None`: the prepared one).
-    mesh: Option<Arc<Mesh>>,
+    /// The mesh [`Ui::radiosity`] belongs to (`None`: nothing published
+    /// yet).
+    mesh: Option<MeshRef<'a>>,
     last_mouse: Option<(f32, f32)>,
     written: u32,
     presses: Arc<Mutex<Vec<Key>>>,
@@ -375,8 +304,8 @@ impl InputCallback for KeyPresses {
     }
 }
 
-impl Ui<'_> {
-    fn run(&mut self, progress: &Mutex<Progress>, control: &Control) -> Result<(), ViewerError> {
+impl<'a> Ui<'a> {
+    fn run(&mut self, progress: &Mutex<Progress<'a>>, control: &Control) -> Result<(), ViewerError> {
         let mut shown_version = u64::MAX;
         let mut last_draw = Instant::now() - REDRAW_INTERVAL;
         let mut dirty = true;
@@ -463,7 +392,7 @@ impl Ui<'_> {
     fn draw(&mut self) -> Result<(), ViewerError> {
         let view = View::new(self.camera.camera())?;
         let mesh = self.mesh.as_deref().unwrap_or(&self.prepared.mesh);
-        if self.radiosity.len() != mesh.vertex_count() {
+        if self.mesh.is_none() || self.radiosity.len() != mesh.vertex_count() {
             // Before the solver thread's first publication: nothing yet.
             self.buffer.fill(0);
             return Ok(());

@@ -1,0 +1,77 @@
+//! Checkpoint files: the batch run saves the solver's state (encoded by
+//! [`crate::solver::checkpoint`]) atomically, and a resumed run reads it
+//! back, refusing a file that is damaged or was saved for another solve.
+
+use crate::output::{self, OutputError};
+use crate::solver::checkpoint::{self, SolverState};
+use crate::solver::Progressive;
+use std::path::{Path, PathBuf};
+
+/// Why a checkpoint could not be read or used. Every message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    /// The file could not be read.
+    #[error("cannot read checkpoint {}: {error}", path.display())]
+    Read {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What the operating system said.
+        error: std::io::Error,
+    },
+    /// The file is not a checkpoint of a supported version, or is damaged.
+    #[error("{} is not a usable checkpoint: {reason}", path.display())]
+    Invalid {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The checkpoint was written for another scene, mesh or solver options.
+    #[error(
+        "checkpoint {} was saved for a different scene, mesh or form-factor options \
+         (give the same scene, --lenmax, --inset, --form-factor, --shooter-samples and \
+         --no-near-field as the run that saved it)",
+        path.display()
+    )]
+    Mismatch {
+        /// The checkpoint file.
+        path: PathBuf,
+    },
+    /// The state does not fit the solver (a bug if the fingerprint matched).
+    #[error("checkpoint {} does not fit this solve: {reason}", path.display())]
+    Restore {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What the solver refused.
+        reason: String,
+    },
+    /// Writing the checkpoint failed.
+    #[error("{0}")]
+    Write(#[from] OutputError),
+}
+
+/// Saves `solver`'s state to `path` atomically (temporary file + rename):
+/// the file is always either the previous checkpoint or the new one.
+pub fn save(path: &Path, fingerprint: u64, solver: &Progressive) -> Result<(), CheckpointError> {
+    let bytes = checkpoint::encode(fingerprint, solver);
+    Ok(output::write_atomically(path, |w| w.write_all(&bytes))?)
+}
+
+/// Reads the checkpoint at `path` and checks it was saved for a solve with
+/// `fingerprint`.
+pub fn load(path: &Path, fingerprint: u64) -> Result<SolverState, CheckpointError> {
+    let bytes = std::fs::read(path).map_err(|error| CheckpointError::Read {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let (found, state) = checkpoint::decode(&bytes).map_err(|reason| CheckpointError::Invalid {
+        path: path.to_path_buf(),
+        reason: reason.to_string(),
+    })?;
+    if found != fingerprint {
+        return Err(CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(state)
+}

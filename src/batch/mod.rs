@@ -1,0 +1,456 @@
+//! The batch driver: prepare → solve → render → write, with progress on
+//! the terminal and timings for `--stats`; optionally the solved mesh
+//! (`--export`), the per-step log (`--log`) and the convergence plot
+//! (`--plot`).
+//!
+//! The command line turns its arguments into a [`RunConfig`] and calls
+//! [`run`] with its Ctrl-C flag; nothing here reads `argv` or installs
+//! signal handlers. The solve itself is a [`Session`] loop, the same one
+//! the window's worker thread runs.
+//!
+//! **Limits.** Before meshing, [`prepare`](crate::prepare::prepare)
+//! computes the exact element and vertex counts and an estimate of the
+//! memory they need, and refuses a mesh over [`RunConfig::max_elements`]
+//! with the `lenmax` that would fit ([`crate::mesh::check_size`]).
+//!
+//! **Interruption and checkpoints.** A run checks its cancel flag during
+//! every shooting step, before rendering and before each write; once it is
+//! set, nothing more is written except the checkpoint (when asked for),
+//! and the run ends with [`RunError::Interrupted`]. With a checkpoint path
+//! the solver state is saved every [`RunConfig::checkpoint_every`], on
+//! interruption and at the end ([`checkpoint`]); a resumed run continues
+//! to the same bits an uninterrupted one gives.
+
+pub mod checkpoint;
+pub mod outputs;
+pub mod progress;
+
+pub use checkpoint::CheckpointError;
+pub use outputs::check_outputs;
+
+use crate::config::RunConfig;
+use crate::mesh::MeshRef;
+use crate::output::convergence::{self, StepRecord};
+use crate::output::{self, OutputError};
+use crate::prepare::{self, PhaseSeconds, PrepareError, Prepared};
+use crate::render::{self, Exposure, Rasterizer, RenderError, ViewError};
+use crate::session::{Event, PassStats, Session};
+use crate::solver::checkpoint::fingerprint;
+use crate::session::SolverError;
+use progress::Progress;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scene could not be loaded or meshed as asked.
+    #[error("{0}")]
+    Prepare(#[from] PrepareError),
+    /// The checkpoint to resume from is unusable, or saving one failed.
+    #[error("{0}")]
+    Checkpoint(#[from] CheckpointError),
+    /// Ctrl-C (or the caller's flag) stopped the run; no picture or stats
+    /// were written.
+    #[error(
+        "interrupted after {steps} steps; nothing was written{}",
+        match checkpoint {
+            Some(p) => format!(
+                " but the checkpoint {}: resume with --resume {}",
+                p.display(),
+                p.display()
+            ),
+            None => String::new(),
+        }
+    )]
+    Interrupted {
+        /// Shooting steps completed.
+        steps: u64,
+        /// The checkpoint saved on the way out, if one was asked for.
+        checkpoint: Option<PathBuf>,
+    },
+    /// The camera or picture size is unusable.
+    #[error("{0}")]
+    View(#[from] ViewError),
+    /// Options that cannot be combined.
+    #[error("{0}")]
+    Options(String),
+    /// An output path is unusable before anything was computed.
+    #[error("{0}")]
+    BadOutput(OutputError),
+    /// The solver's state broke an invariant (a bug if it happens).
+    #[error("{0}")]
+    Solver(#[from] SolverError),
+    /// Rendering failed (a bug if it happens).
+    #[error("{0}")]
+    Render(#[from] RenderError),
+    /// Writing a result failed.
+    #[error("{0}")]
+    Write(OutputError),
+}
+
+impl RunError {
+    /// True when the user's input or options are at fault (exit code 2),
+    /// false for failures of the machine (exit code 1).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(
+            self,
+            RunError::Render(_)
+                | RunError::Solver(_)
+                | RunError::Write(_)
+                | RunError::Interrupted { .. }
+                | RunError::Checkpoint(CheckpointError::Write(_))
+        )
+    }
+
+    /// The process exit code for this error: 130 interrupted, 2 bad input
+    /// or usage, 1 a failure of the machine.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            RunError::Interrupted { .. } => 130,
+            e if e.is_bad_input() => 2,
+            _ => 1,
+        }
+    }
+
+    /// True when the message already carries its own position and kind
+    /// (`FILE:LINE:COL: error: ...`, or the interruption notice), so it is
+    /// printed without an `error: ` prefix.
+    pub fn is_self_describing(&self) -> bool {
+        matches!(
+            self,
+            RunError::Prepare(PrepareError::Load(_)) | RunError::Interrupted { .. }
+        )
+    }
+}
+
+/// What a run did, as written by `--stats`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunStats {
+    /// The scene as named by the user.
+    pub scene: String,
+    /// The picture written.
+    pub output: String,
+    /// Every file written besides the picture (stats, export, log, plot,
+    /// checkpoint), in that order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub also_written: Vec<String>,
+    /// Scene polygons.
+    pub polygons: usize,
+    /// Mesh elements.
+    pub elements: usize,
+    /// Mesh element vertices.
+    pub vertices: usize,
+    /// The lenmax used, in scene units.
+    pub lenmax: f32,
+    /// Shooting steps taken.
+    pub steps: u64,
+    /// Shadow rays cast.
+    pub rays: u64,
+    /// Sample–vertex pairs whose visibility mattered; `pairs - rays` rays
+    /// were saved by shaft culling.
+    pub pairs: u64,
+    /// Fraction of shooter–receiver polygon pairs whose shaft was clear,
+    /// so that no ray at all was cast between them.
+    pub clear_shaft_fraction: f64,
+    /// Unshot power left as a fraction of the emitted power.
+    pub unshot_fraction: f64,
+    /// The exposure the 8-bit picture and the exported display colours
+    /// used (dimensionless): the given one, or the automatic one.
+    pub exposure: f32,
+    /// True when the threshold was reached (false: step limit).
+    pub converged: bool,
+    /// With `--adaptive`, one entry per pass, the coarsest first; then
+    /// `elements` and `vertices` above are the last mesh's and the steps,
+    /// rays and pairs totals over every pass. Empty (and not written)
+    /// without.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub adaptive: Vec<PassStats>,
+    /// Seconds per phase.
+    pub seconds: PhaseSeconds,
+}
+
+/// Runs the whole batch pipeline once and writes the picture and the other
+/// results asked for. Stops promptly once `cancel` is set (by a Ctrl-C
+/// handler, say) with [`RunError::Interrupted`], writing nothing but the
+/// checkpoint.
+pub fn run(config: &RunConfig, cancel: &AtomicBool) -> Result<RunStats, RunError> {
+    check_outputs(config)?;
+    let prepared = prepare::prepare(config)?;
+    run_prepared(config, &prepared, cancel)
+}
+
+/// The solved state a batch run draws and writes.
+struct Solved<'p> {
+    mesh: MeshRef<'p>,
+    radiosity: Vec<crate::color::Rgb>,
+    shown: Vec<crate::color::Rgb>,
+    records: Vec<StepRecord>,
+}
+
+/// [`run`] from a prepared scene: solve, render, write.
+pub fn run_prepared(
+    config: &RunConfig,
+    prepared: &Prepared,
+    cancel: &AtomicBool,
+) -> Result<RunStats, RunError> {
+    check_outputs(config)?;
+    if config.adaptive.is_some() && (config.checkpoint.is_some() || config.resume.is_some()) {
+        return Err(RunError::Options(
+            "--adaptive cannot be combined with --checkpoint or --resume: \
+             a checkpoint holds one mesh, and refinement changes it"
+                .into(),
+        ));
+    }
+    let output = config.output_path();
+    let mut seconds = prepared.seconds;
+    let view = prepared.view(config)?;
+
+    let t = Instant::now();
+    // A file shows the solution; the ambient term only when asked for.
+    let mut session = Session::new(
+        &prepared.scene,
+        &prepared.mesh,
+        &prepared.visibility,
+        config.session_options(false),
+    );
+    let solved = solve(config, prepared, &mut session, cancel)?;
+    seconds.solve = t.elapsed().as_secs_f64();
+    let mesh: &crate::mesh::Mesh = &solved.mesh;
+    let totals = session.totals();
+
+    let interrupted = || RunError::Interrupted {
+        steps: totals.steps,
+        checkpoint: config.checkpoint.clone(),
+    };
+    if cancel.load(Ordering::SeqCst) {
+        return Err(interrupted());
+    }
+    let t = Instant::now();
+    let mut rasterizer = Rasterizer::new();
+    let frame = rasterizer.render(mesh, &solved.shown, &view)?;
+    seconds.render = t.elapsed().as_secs_f64();
+
+    if cancel.load(Ordering::SeqCst) {
+        return Err(interrupted());
+    }
+    let t = Instant::now();
+    // Resolved once, so the picture and the exported colours agree.
+    let exposure = config.exposure.resolve(frame);
+    if config.mesh_lines {
+        let mut picture = render::to_srgb8(frame, exposure);
+        render::draw_mesh_edges(
+            &mut picture,
+            mesh,
+            &view,
+            rasterizer.inv_depth(),
+            render::MESH_COLOR,
+        );
+        output::write_rgb8(&output, &picture).map_err(RunError::Write)?;
+    } else {
+        output::write_picture(&output, frame, Exposure::Fixed(exposure))
+            .map_err(RunError::Write)?;
+    }
+    if let Some(path) = &config.export {
+        output::write_mesh(path, mesh, &solved.radiosity, exposure).map_err(RunError::Write)?;
+    }
+    if let Some(path) = &config.log {
+        convergence::write_log_file(path, &solved.records).map_err(RunError::Write)?;
+    }
+    if let Some(path) = &config.plot {
+        convergence::write_plot_file(
+            path,
+            &solved.records,
+            config.solver.threshold,
+            &config.scene.display_name(),
+        )
+        .map_err(RunError::Write)?;
+    }
+    let mut stats = RunStats {
+        scene: config.scene.display_name(),
+        output: output.display().to_string(),
+        also_written: config
+            .extra_outputs()
+            .map(|p| p.display().to_string())
+            .collect(),
+        polygons: prepared.scene.polygons.len(),
+        elements: mesh.elements.len(),
+        vertices: mesh.vertex_count(),
+        lenmax: prepared.lenmax,
+        steps: totals.steps,
+        rays: totals.rays,
+        pairs: totals.pairs,
+        clear_shaft_fraction: if totals.receiver_pairs > 0 {
+            totals.clear_receiver_pairs as f64 / totals.receiver_pairs as f64
+        } else {
+            0.0
+        },
+        unshot_fraction: session.unshot_fraction(),
+        exposure,
+        converged: session.converged(),
+        adaptive: if config.adaptive.is_some() {
+            session.passes().to_vec()
+        } else {
+            Vec::new()
+        },
+        seconds,
+    };
+    stats.seconds.write = t.elapsed().as_secs_f64();
+    if let Some(path) = &config.stats {
+        // The picture is complete and stays; the stats are skipped if the
+        // interrupt came while it was written.
+        if cancel.load(Ordering::SeqCst) {
+            return Err(interrupted());
+        }
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| {
+            RunError::Write(OutputError::Io {
+                path: path.clone(),
+                error: std::io::Error::other(e),
+            })
+        })?;
+        output::write_atomically(path, |w| writeln!(w, "{json}")).map_err(RunError::Write)?;
+    }
+    Ok(stats)
+}
+
+/// Runs `session` to its end: resumes from the checkpoint asked for,
+/// draws the progress bar, saves checkpoints, keeps the step log and says
+/// what each adaptive pass did. An interruption saves the checkpoint (of
+/// the state after the last complete step) and returns
+/// [`RunError::Interrupted`].
+fn solve<'p>(
+    config: &RunConfig,
+    prepared: &'p Prepared,
+    session: &mut Session<'p>,
+    cancel: &AtomicBool,
+) -> Result<Solved<'p>, RunError> {
+    let fingerprint = fingerprint(&prepared.scene, session.mesh(), &config.solver);
+    if let Some(path) = &config.resume {
+        let state = checkpoint::load(path, fingerprint)?;
+        session
+            .restore(state)
+            .map_err(|reason| CheckpointError::Restore {
+                path: path.clone(),
+                reason: reason.to_string(),
+            })?;
+    }
+    let save = |session: &Session| -> Result<(), RunError> {
+        if let Some(path) = &config.checkpoint {
+            checkpoint::save(path, fingerprint, session.solver())?;
+        }
+        Ok(())
+    };
+    let mut progress = Progress::new(config.progress, config.solver.threshold);
+    let mut last_save = Instant::now();
+    let start = Instant::now();
+    let mut records = Vec::new();
+    loop {
+        if cancel.load(Ordering::SeqCst) {
+            progress.clear();
+            save(session)?;
+            return Err(RunError::Interrupted {
+                steps: session.totals().steps,
+                checkpoint: config.checkpoint.clone(),
+            });
+        }
+        match session.advance(cancel)? {
+            Event::Step(report) => {
+                if config.checkpoint.is_some() && last_save.elapsed() >= config.checkpoint_every {
+                    save(session)?;
+                    last_save = Instant::now();
+                }
+                records.push(StepRecord {
+                    step: report.step,
+                    shooter: report.shooter.0,
+                    shooter_line: prepared.scene.polygons[report.shooter.index()].origin.line,
+                    shot_power: report.shot_power,
+                    unshot_fraction: report.unshot_fraction,
+                    rays: report.rays,
+                    seconds: start.elapsed().as_secs_f64(),
+                });
+                progress.step(&report, session.solver().rays());
+            }
+            Event::Stopped(_) | Event::Cancelled => {}
+            Event::Refined(report) => {
+                progress.restart_rate();
+                if config.progress {
+                    progress.clear();
+                    say_pass(session, Some(&report));
+                }
+                // A fresh solve numbers its steps from 1 again: the log
+                // and plot show only the last one.
+                if session.solver().steps() == 0 {
+                    records.clear();
+                }
+            }
+            Event::Refused(refused) => {
+                progress.clear();
+                eprintln!("warning: {refused}");
+            }
+            Event::Finished => break,
+        }
+    }
+    progress.clear();
+    if config.progress && config.adaptive.is_some() {
+        say_pass(session, None);
+    }
+    save(session)?;
+    session.validate()?;
+    let mut shown = Vec::new();
+    session.shown(&mut shown);
+    Ok(Solved {
+        mesh: session.mesh_ref(),
+        radiosity: session.radiosity().to_vec(),
+        shown,
+        records,
+    })
+}
+
+/// Says on stderr what the last finished pass of an adaptive run did, and
+/// what its refinement split (`None`: it was the last).
+fn say_pass(session: &Session, refined: Option<&crate::mesh::refine::RefineReport>) {
+    let passes = session.passes();
+    let Some(pass) = passes.last() else {
+        return;
+    };
+    eprintln!(
+        "adaptive pass {}: {} elements, {} steps, {:.2} s{}",
+        passes.len(),
+        pass.elements,
+        pass.steps,
+        pass.seconds,
+        match refined {
+            Some(r) => format!(
+                "; splitting {} elements (+{} to stay conforming)",
+                r.marked, r.closure
+            ),
+            None => "; final".to_string(),
+        }
+    );
+}
+
+/// A one-line summary of a finished run, naming every file written.
+pub fn summary(stats: &RunStats) -> String {
+    let steps = match (stats.adaptive.first(), stats.adaptive.len()) {
+        (Some(first), solves) if solves > 1 => format!(
+            "{solves} passes refining {} to {} vertices, {} steps in all",
+            first.vertices, stats.vertices, stats.steps
+        ),
+        _ => format!("{} steps", stats.steps),
+    };
+    let mut written = stats.output.clone();
+    for also in &stats.also_written {
+        written.push_str(", ");
+        written.push_str(also);
+    }
+    format!(
+        "{}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {written}",
+        stats.scene,
+        stats.seconds.solve,
+        stats.rays as f64 / 1e6,
+        stats.unshot_fraction * 100.0,
+        if stats.converged { "" } else { " (step limit)" },
+    )
+}

@@ -1,0 +1,180 @@
+//! The one configuration value the library sees: what to solve, how, and
+//! what to write. The command line ([`crate::cli`]) builds it from the
+//! arguments; tests and examples build it with [`RunConfig::new`] and
+//! field updates. Values here are already validated.
+
+use crate::mesh::{self, refine::RefineOptions};
+use crate::render::Exposure;
+use crate::session::SessionOptions;
+use crate::solver::SolverOptions;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Default for [`RunConfig::max_elements`]: [`mesh::MAX_ELEMENTS`], 20
+/// million elements. A mesh that large needs about 3.7 GB by
+/// [`mesh::memory_estimate`]; the bundled scenes at their default `lenmax` have
+/// about 15,000.
+pub const DEFAULT_MAX_ELEMENTS: u64 = mesh::MAX_ELEMENTS;
+
+/// Default for [`RunConfig::checkpoint_every`]: one minute, so at most a
+/// minute of work is lost, and writing even a 20-million-vertex state
+/// (about 500 MB) takes a small fraction of the time.
+pub const DEFAULT_CHECKPOINT_EVERY: Duration = Duration::from_secs(60);
+
+/// The bundled default scene, compiled into the binary so it works from
+/// any directory.
+pub const BUNDLED_SCENE: &str = include_str!("../scenes/rtable.sc");
+/// The name the bundled scene goes by in messages and default file names.
+pub const BUNDLED_SCENE_NAME: &str = "scenes/rtable.sc";
+
+/// Where the scene comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SceneSource {
+    /// The bundled `rtable.sc`.
+    Bundled,
+    /// A scene file: `.obj` (Wavefront OBJ with MTL materials) or `.sc`.
+    File(PathBuf),
+}
+
+impl SceneSource {
+    /// The scene's name for messages: the path as given.
+    pub fn display_name(&self) -> String {
+        match self {
+            SceneSource::Bundled => BUNDLED_SCENE_NAME.to_string(),
+            SceneSource::File(p) => p.display().to_string(),
+        }
+    }
+
+    /// The file stem, for default output names (`rtable` for the bundled).
+    pub fn stem(&self) -> String {
+        let path = match self {
+            SceneSource::Bundled => Path::new(BUNDLED_SCENE_NAME),
+            SceneSource::File(p) => p.as_path(),
+        };
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".to_string())
+    }
+}
+
+/// Everything one batch run needs, validated by the front end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunConfig {
+    /// The scene to solve.
+    pub scene: SceneSource,
+    /// The picture to write; `None` writes `<scene-stem>.png` in the
+    /// current directory.
+    pub output: Option<PathBuf>,
+    /// Longest element edge in scene units; `None` for the default
+    /// ([`MeshOptions::for_scene`]).
+    pub lenmax: Option<f32>,
+    /// Boundary inset as a fraction of an element edge.
+    pub inset: f32,
+    /// Solver settings.
+    pub solver: SolverOptions,
+    /// Picture size override in pixels (width, height).
+    pub size: Option<(u32, u32)>,
+    /// Exposure for 8-bit pictures.
+    pub exposure: Exposure,
+    /// Where to write the statistics JSON, if anywhere.
+    pub stats: Option<PathBuf>,
+    /// A `.sc` file whose `camera` block replaces the scene's camera.
+    pub camera: Option<PathBuf>,
+    /// Where to write the solved mesh (`.glb` or `.ply`), if anywhere.
+    pub export: Option<PathBuf>,
+    /// Where to write the per-step CSV log, if anywhere.
+    pub log: Option<PathBuf>,
+    /// Where to write the convergence plot (`.png`), if anywhere.
+    pub plot: Option<PathBuf>,
+    /// Show a progress bar (only drawn when stderr is a terminal).
+    pub progress: bool,
+    /// Refuse meshes with more elements than this (see
+    /// [`DEFAULT_MAX_ELEMENTS`]); at most [`mesh::MAX_ADDRESSABLE_ELEMENTS`].
+    pub max_elements: u64,
+    /// Where to save the solver state during the solve, if anywhere.
+    pub checkpoint: Option<PathBuf>,
+    /// How often to save the checkpoint (wall clock).
+    pub checkpoint_every: Duration,
+    /// A checkpoint to continue from instead of starting the solve afresh.
+    pub resume: Option<PathBuf>,
+    /// Add the ambient term ([`crate::solver::Progressive::ambient`]) to the radiosity
+    /// shown: `None` for the default, on in the window and off for files.
+    pub ambient: Option<bool>,
+    /// Refine the mesh where the solution changes sharply and solve again
+    /// ([`mesh::refine`]), or `None` to solve on the regular mesh only.
+    pub adaptive: Option<RefineOptions>,
+    /// Draw the element mesh over the picture (8-bit pictures only).
+    pub mesh_lines: bool,
+}
+
+impl RunConfig {
+    /// The configuration with every option at its default, for `scene`.
+    pub fn new(scene: SceneSource) -> RunConfig {
+        RunConfig {
+            scene,
+            output: None,
+            lenmax: None,
+            inset: mesh::DEFAULT_INSET,
+            solver: SolverOptions::default(),
+            size: None,
+            exposure: Exposure::Auto,
+            stats: None,
+            progress: false,
+            camera: None,
+            export: None,
+            log: None,
+            plot: None,
+            max_elements: DEFAULT_MAX_ELEMENTS,
+            checkpoint: None,
+            checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
+            resume: None,
+            ambient: None,
+            adaptive: None,
+            mesh_lines: false,
+        }
+    }
+}
+
+impl RunConfig {
+    /// True when the run asks for results only a batch run writes (the
+    /// mesh export, the log, the plot or mesh lines on the picture), so no
+    /// window should open.
+    pub fn wants_batch_outputs(&self) -> bool {
+        self.export.is_some() || self.log.is_some() || self.plot.is_some() || self.mesh_lines
+    }
+
+    /// Every file the batch run writes besides the picture.
+    pub fn extra_outputs(&self) -> impl Iterator<Item = &PathBuf> {
+        [
+            &self.stats,
+            &self.export,
+            &self.log,
+            &self.plot,
+            &self.checkpoint,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+impl RunConfig {
+    /// The picture path a batch run writes: `-o`, or `<scene-stem>.png`
+    /// in the current directory.
+    pub fn output_path(&self) -> PathBuf {
+        self.output
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{}.png", self.scene.stem())))
+    }
+
+    /// The solve session's options; `ambient_default` is whether the
+    /// ambient term is shown when the user did not say (on in the window,
+    /// off for files).
+    pub fn session_options(&self, ambient_default: bool) -> SessionOptions {
+        SessionOptions {
+            solver: self.solver,
+            refine: self.adaptive,
+            max_elements: self.max_elements,
+            ambient: self.ambient.unwrap_or(ambient_default),
+        }
+    }
+}

@@ -1,0 +1,115 @@
+//! Preparing a scene for solving: load it (with a camera override), check
+//! the mesh size against the element limit before allocating anything,
+//! mesh it and build the visibility BVH. What the batch run, the window
+//! and the examples all start from.
+
+use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
+use crate::mesh::{self, Mesh, MeshError, MeshOptions};
+use crate::render::{View, ViewError};
+use crate::scene::{self, LoadError, Scene};
+use crate::visibility::Visibility;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// Why a scene could not be prepared.
+#[derive(Debug, thiserror::Error)]
+pub enum PrepareError {
+    /// The scene file (or the camera file) is bad or unreadable; the
+    /// message reads `FILE:LINE:COL: error: ...`.
+    #[error("{0}")]
+    Load(#[from] LoadError),
+    /// The mesh options do not suit the scene, or the mesh would be too
+    /// large.
+    #[error("{0}")]
+    Mesh(#[from] MeshError),
+}
+
+/// Seconds spent in each phase of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PhaseSeconds {
+    /// Reading and validating the scene.
+    pub load: f64,
+    /// Building the element mesh.
+    pub mesh: f64,
+    /// Building the visibility BVH.
+    pub bvh: f64,
+    /// Shooting.
+    pub solve: f64,
+    /// Rasterising the picture.
+    pub render: f64,
+    /// Encoding and writing files.
+    pub write: f64,
+}
+
+/// A scene loaded, meshed and put in a BVH: what both the batch run and
+/// the window start from.
+pub struct Prepared {
+    /// The scene.
+    pub scene: Scene,
+    /// Its element mesh.
+    pub mesh: Mesh,
+    /// Its visibility structure.
+    pub visibility: Visibility,
+    /// The lenmax the mesh was built with, in scene units.
+    pub lenmax: f32,
+    /// Seconds spent so far (load, mesh, bvh).
+    pub seconds: PhaseSeconds,
+}
+
+impl Prepared {
+    /// The view of the scene's camera, with the configured size override.
+    pub fn view(&self, config: &RunConfig) -> Result<View, ViewError> {
+        match config.size {
+            Some((w, h)) => View::with_size(&self.scene.camera, w, h),
+            None => View::new(&self.scene.camera),
+        }
+    }
+}
+
+/// Loads, validates, meshes and builds the BVH; refuses a mesh over
+/// [`RunConfig::max_elements`] before building it, with the lenmax that
+/// would fit.
+pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
+    let mut seconds = PhaseSeconds::default();
+    let t = Instant::now();
+    let scene = load_scene(&config.scene, config.camera.as_deref())?;
+    seconds.load = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let mut mesh_options = MeshOptions::for_scene(&scene);
+    mesh_options.inset = config.inset;
+    if let Some(lenmax) = config.lenmax {
+        mesh_options.lenmax = lenmax;
+    }
+    mesh::check_size(&scene, &mesh_options, config.max_elements)?;
+    let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
+    seconds.mesh = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let visibility = Visibility::new(&scene);
+    seconds.bvh = t.elapsed().as_secs_f64();
+    Ok(Prepared {
+        scene,
+        mesh,
+        visibility,
+        lenmax: mesh_options.lenmax,
+        seconds,
+    })
+}
+
+/// Loads the scene from its source, with the camera of the `.sc` file
+/// `camera` when given (see [`scene::load_with_camera`]).
+pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    match source {
+        SceneSource::Bundled => {
+            let mut scene = scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?;
+            if let Some(camera) = camera {
+                scene.camera = scene::load_camera(camera)?;
+                scene.camera_source = scene::CameraSource::File;
+            }
+            Ok(scene)
+        }
+        SceneSource::File(path) => scene::load_with_camera(path, camera),
+    }
+}

@@ -1,0 +1,236 @@
+//! The session against closed forms and against the solver run bare.
+
+use super::*;
+use crate::mesh::{self, refine::RefineOptions, MeshOptions};
+use crate::testutil::{glowing_box, shadowed_box};
+
+fn run_to_end(session: &mut Session) -> Vec<Event> {
+    let cancel = AtomicBool::new(false);
+    let mut events = Vec::new();
+    loop {
+        let event = session.advance(&cancel).unwrap();
+        events.push(event);
+        if event == Event::Finished {
+            return events;
+        }
+        assert!(events.len() < 100_000, "the session never finished");
+    }
+}
+
+fn build(s: &Scene, lenmax: f32) -> Mesh {
+    mesh::build(
+        s,
+        &MeshOptions {
+            lenmax,
+            inset: mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap()
+}
+
+fn options(refine: Option<RefineOptions>) -> SessionOptions {
+    SessionOptions {
+        solver: SolverOptions {
+            threshold: 1e-4,
+            ..Default::default()
+        },
+        refine,
+        max_elements: mesh::MAX_ELEMENTS,
+        ambient: false,
+    }
+}
+
+/// Without refinement a session is the bare solver loop: the same steps
+/// and the same radiosity bits, then `Stopped` and `Finished`.
+#[test]
+fn a_session_is_the_bare_solver_loop() {
+    let s = glowing_box();
+    let m = build(&s, 0.25);
+    let vis = Visibility::new(&s);
+    let o = options(None);
+    let mut bare = Progressive::new(&s, &m, &vis, o.solver);
+    let mut bare_steps = 0;
+    while !bare.is_done() && bare.step().is_some() {
+        bare_steps += 1;
+    }
+    let mut session = Session::new(&s, &m, &vis, o);
+    let events = run_to_end(&mut session);
+    let steps = events
+        .iter()
+        .filter(|e| matches!(e, Event::Step(_)))
+        .count();
+    assert_eq!(steps, bare_steps);
+    assert_eq!(
+        &events[steps..],
+        &[Event::Stopped(StopReason::Converged), Event::Finished]
+    );
+    let same = session
+        .radiosity()
+        .iter()
+        .zip(bare.radiosity())
+        .all(|(a, b)| a.r.to_bits() == b.r.to_bits() && a.b.to_bits() == b.b.to_bits());
+    assert!(same);
+    assert!(session.converged() && session.is_finished());
+    assert_eq!(session.totals().steps, bare.steps());
+    assert_eq!(session.totals().rays, bare.rays());
+    assert_eq!(session.passes().len(), 1);
+    // Finished stays finished.
+    assert_eq!(session.advance(&AtomicBool::new(false)), Ok(Event::Finished));
+}
+
+/// The uniform enclosure (every wall emitting `e`, reflecting `rho`) has
+/// `B = e / (1 − rho)` everywhere; a session with refinement on reaches it
+/// and refines nothing, since the solution has no edge.
+#[test]
+fn uniform_enclosure_through_a_session() {
+    use crate::testutil::{closed_box, grey, scene};
+    let (e, rho) = (1.0, 0.6);
+    let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]);
+    let m = build(&s, 0.1);
+    let vis = Visibility::new(&s);
+    let mut session = Session::new(&s, &m, &vis, options(Some(RefineOptions::default())));
+    let events = run_to_end(&mut session);
+    assert!(!events.iter().any(|e| matches!(e, Event::Refined(_))));
+    let exact = e / (1.0 - rho);
+    let worst = session
+        .radiosity()
+        .iter()
+        .map(|b| (b.r - exact).abs() / exact)
+        .fold(0.0, f64::max);
+    assert!(worst < 0.01, "worst vertex error {worst}");
+}
+
+/// With refinement the session refines the shadow's edge up to the
+/// allowed levels, each pass on a finer mesh, and its totals are the sums
+/// over its passes. Energy still balances in the closed box: what the
+/// walls absorbed plus what is unshot is what the lamp emitted.
+#[test]
+fn adaptive_passes_refine_and_add_up() {
+    let s = shadowed_box();
+    let m = build(&s, 0.2);
+    let vis = Visibility::new(&s);
+    let refine = RefineOptions::default();
+    let mut session = Session::new(&s, &m, &vis, options(Some(refine)));
+    let events = run_to_end(&mut session);
+    let refinements = events
+        .iter()
+        .filter(|e| matches!(e, Event::Refined(_)))
+        .count();
+    assert_eq!(refinements as u32, refine.levels);
+    let passes = session.passes();
+    assert_eq!(passes.len(), refinements + 1);
+    assert!(passes.windows(2).all(|w| w[1].vertices > w[0].vertices));
+    assert!(passes[..refinements].iter().all(|p| p.split > 0));
+    let totals = session.totals();
+    assert_eq!(totals.steps, passes.iter().map(|p| p.steps).sum::<u64>());
+    assert_eq!(totals.rays, passes.iter().map(|p| p.rays).sum::<u64>());
+    // Continued passes keep counting from the last: the solver's own
+    // count is the total.
+    assert_eq!(totals.steps, session.solver().steps());
+    assert_eq!(session.mesh().vertex_count(), passes[refinements].vertices);
+    assert!(session.converged());
+    // Energy: absorbed + unshot = emitted, over the refined mesh.
+    let mesh = session.mesh();
+    let areas = mesh.vertex_areas();
+    let mut absorbed = 0.0;
+    for (l, b) in session.radiosity().iter().enumerate() {
+        let j = mesh.vertex_polygon[l].index();
+        let material = &s.materials[s.polygons[j].material.index()];
+        let rho = material.reflectance().r;
+        absorbed += areas[l] * (1.0 - rho) / rho * (b.r - material.emission().r);
+    }
+    let emitted = session.solver().initial_unshot_power();
+    let unshot = session.solver().unshot_power();
+    let error = (absorbed + unshot - emitted).abs() / emitted;
+    assert!(error < 0.01, "energy error {error}");
+}
+
+/// The run's element limit clamps the refiner's: a refinement that would
+/// pass it is refused, said once, and the session finishes on the mesh
+/// it has.
+#[test]
+fn a_refinement_over_the_element_limit_is_refused() {
+    let s = shadowed_box();
+    let m = build(&s, 0.2);
+    let vis = Visibility::new(&s);
+    let mut o = options(Some(RefineOptions::default()));
+    o.max_elements = m.elements.len() as u64 + 1;
+    let mut session = Session::new(&s, &m, &vis, o);
+    let events = run_to_end(&mut session);
+    let tail = &events[events.len() - 3..];
+    assert_eq!(tail[0], Event::Stopped(StopReason::Converged));
+    assert!(
+        matches!(tail[1], Event::Refused(r) if r.max == o.max_elements),
+        "{tail:?}"
+    );
+    assert_eq!(tail[2], Event::Finished);
+    assert_eq!(session.mesh().elements.len(), m.elements.len());
+    assert_eq!(session.passes().len(), 1);
+}
+
+/// A pass stopped by the step limit is not refined: it would mark what is
+/// merely unfinished.
+#[test]
+fn a_step_limited_pass_is_not_refined() {
+    let s = shadowed_box();
+    let m = build(&s, 0.2);
+    let vis = Visibility::new(&s);
+    let mut o = options(Some(RefineOptions::default()));
+    o.solver.max_steps = Some(3);
+    let mut session = Session::new(&s, &m, &vis, o);
+    let events = run_to_end(&mut session);
+    assert_eq!(events.len(), 5, "{events:?}");
+    assert_eq!(events[3], Event::Stopped(StopReason::MaxSteps));
+    assert!(!session.converged());
+}
+
+/// A cancelled step leaves the session as it was, and the next call
+/// takes the step after all.
+#[test]
+fn a_cancelled_advance_changes_nothing() {
+    let s = glowing_box();
+    let m = build(&s, 0.25);
+    let vis = Visibility::new(&s);
+    let mut session = Session::new(&s, &m, &vis, options(None));
+    let before: Vec<Rgb> = session.radiosity().to_vec();
+    assert_eq!(
+        session.advance(&AtomicBool::new(true)),
+        Ok(Event::Cancelled)
+    );
+    assert_eq!(session.radiosity(), &before[..]);
+    assert_eq!(session.totals().steps, 0);
+    assert!(matches!(
+        session.advance(&AtomicBool::new(false)),
+        Ok(Event::Step(_))
+    ));
+}
+
+/// What is shown: the solution itself, or with the ambient term on top
+/// (never below it, and above it while light is unshot).
+#[test]
+fn shown_radiosity_with_and_without_the_ambient_term() {
+    let s = glowing_box();
+    let m = build(&s, 0.25);
+    let vis = Visibility::new(&s);
+    let mut plain = Session::new(&s, &m, &vis, options(None));
+    let mut ambient = Session::new(
+        &s,
+        &m,
+        &vis,
+        SessionOptions {
+            ambient: true,
+            ..options(None)
+        },
+    );
+    let cancel = AtomicBool::new(false);
+    for _ in 0..3 {
+        plain.advance(&cancel).unwrap();
+        ambient.advance(&cancel).unwrap();
+    }
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    plain.shown(&mut a);
+    ambient.shown(&mut b);
+    assert_eq!(a, plain.radiosity());
+    assert!(a.iter().zip(&b).all(|(x, y)| y.r >= x.r));
+    assert!(a.iter().zip(&b).any(|(x, y)| y.r > x.r));
+}
