@@ -16,10 +16,10 @@
 //! reference's mean luminance there.
 
 use radiosity::config::{RunConfig, SceneSource};
-use radiosity::prepare::{self, Prepared};
-use radiosity::session::Session;
 use radiosity::mesh::refine::RefineOptions;
+use radiosity::prepare::{self, Prepared};
 use radiosity::render::Frame;
+use radiosity::session::Session;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -75,7 +75,8 @@ fn main() {
         let mut config = base.clone();
         config.lenmax = Some(lenmax);
         config.adaptive = refine;
-        let prepared: Prepared = prepare::prepare(&config).expect("the scene prepared once already");
+        let prepared: Prepared =
+            prepare::prepare(&config).expect("the scene prepared once already");
         let view = prepared.view(&config).expect("the camera file's camera");
         let t = Instant::now();
         let mut session = Session::new(

@@ -10,11 +10,11 @@
 //! `lenmax` in scene units (optional; `-` or absent for the program's
 //! default), and `adaptive` to solve with the default adaptive subdivision.
 
+use radiosity::color::Rgb;
 use radiosity::config::{RunConfig, SceneSource};
+use radiosity::mesh::refine::RefineOptions;
 use radiosity::prepare;
 use radiosity::session::Session;
-use radiosity::color::Rgb;
-use radiosity::mesh::refine::RefineOptions;
 use radiosity::solver::UnshotScheme;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;

@@ -398,10 +398,7 @@ fn main() -> ExitCode {
 
 /// Without -o: the window when a display is available, else (saying why)
 /// the batch run writing `<scene>.png`. `Ok(None)` when the window ran.
-fn run_window_or_fallback(
-    config: &RunConfig,
-    quiet: bool,
-) -> Result<Option<RunStats>, RunError> {
+fn run_window_or_fallback(config: &RunConfig, quiet: bool) -> Result<Option<RunStats>, RunError> {
     let fallback = |why: &str| {
         if !quiet {
             eprintln!(

@@ -190,7 +190,10 @@ impl<'p> Session<'p> {
     /// Continues from a saved state of a solve of the same scene, mesh and
     /// solver options (a checkpoint), before the first step. Its steps and
     /// rays count as this session's.
-    pub fn restore(&mut self, state: crate::solver::checkpoint::SolverState) -> Result<(), SolverError> {
+    pub fn restore(
+        &mut self,
+        state: crate::solver::checkpoint::SolverState,
+    ) -> Result<(), SolverError> {
         self.solver.restore(state).map_err(SolverError)
     }
 

@@ -1,8 +1,8 @@
 //! Numerical safety: degenerate and extreme geometry the loader accepts
 //! gives finite, non-negative radiosities and pictures.
 
-use radiosity::render::render;
 use radiosity::mesh::{self, MeshOptions};
+use radiosity::render::render;
 use radiosity::render::View;
 use radiosity::scene::{parse_str, Scene};
 use radiosity::solver::{Progressive, SolverOptions};

@@ -97,4 +97,3 @@ fn same_file(a: &Path, b: &Path) -> bool {
         _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
     }
 }
-

@@ -55,11 +55,10 @@ impl Progress {
         let fraction = report.unshot_fraction.max(f64::MIN_POSITIVE);
         let done_log = (1.0 / fraction).ln().max(0.0);
         self.rate.push(elapsed, done_log);
-        let eta = self
-            .rate
-            .per_second()
-            .filter(|r| *r > 0.0)
-            .map(|r| Duration::from_secs_f64(((self.total_log - done_log) / r).clamp(0.0, 1e7)));
+        let eta =
+            self.rate.per_second().filter(|r| *r > 0.0).map(|r| {
+                Duration::from_secs_f64(((self.total_log - done_log) / r).clamp(0.0, 1e7))
+            });
         let rays_per_s = rays as f64 / elapsed.as_secs_f64().max(1e-9);
         self.bar
             .set_position(((done_log / self.total_log).clamp(0.0, 1.0) * TICKS as f64) as u64);
@@ -122,7 +121,11 @@ mod tests {
         assert_eq!(rate.per_second(), None);
         for k in 0..40u64 {
             // Slow at first, then one unit of log progress per second.
-            let p = if k < 20 { k as f64 * 0.1 } else { 2.0 + (k - 20) as f64 };
+            let p = if k < 20 {
+                k as f64 * 0.1
+            } else {
+                2.0 + (k - 20) as f64
+            };
             rate.push(Duration::from_secs(k), p);
         }
         let r = rate.per_second().unwrap();

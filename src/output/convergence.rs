@@ -105,11 +105,7 @@ pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImag
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let points: Vec<(f64, f64)> = std::iter::once((0.0, 1.0))
-            .chain(
-                steps
-                    .iter()
-                    .map(|s| (s.step as f64, s.unshot_fraction)),
-            )
+            .chain(steps.iter().map(|s| (s.step as f64, s.unshot_fraction)))
             .filter(|&(_, y)| y > 0.0 && y.is_finite())
             .collect();
         let last_step = points.last().map_or(1.0, |p| p.0).max(1.0);

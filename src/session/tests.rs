@@ -75,7 +75,10 @@ fn a_session_is_the_bare_solver_loop() {
     assert_eq!(session.totals().rays, bare.rays());
     assert_eq!(session.passes().len(), 1);
     // Finished stays finished.
-    assert_eq!(session.advance(&AtomicBool::new(false)), Ok(Event::Finished));
+    assert_eq!(
+        session.advance(&AtomicBool::new(false)),
+        Ok(Event::Finished)
+    );
 }
 
 /// The uniform enclosure (every wall emitting `e`, reflecting `rho`) has
@@ -102,8 +105,7 @@ fn uniform_enclosure_through_a_session() {
 
 /// With refinement the session refines the shadow's edge up to the
 /// allowed levels, each pass on a finer mesh, and its totals are the sums
-/// over its passes. Energy still balances in the closed box: what the
-/// walls absorbed plus what is unshot is what the lamp emitted.
+/// over its passes; the continued solution is that of its final mesh.
 #[test]
 fn adaptive_passes_refine_and_add_up() {
     let s = shadowed_box();
@@ -129,20 +131,28 @@ fn adaptive_passes_refine_and_add_up() {
     assert_eq!(totals.steps, session.solver().steps());
     assert_eq!(session.mesh().vertex_count(), passes[refinements].vertices);
     assert!(session.converged());
-    // Energy: absorbed + unshot = emitted, over the refined mesh.
+    // The continued solve is the solve of its final mesh: a fresh solve
+    // of that mesh agrees within 0.5 % of the mean on every polygon.
     let mesh = session.mesh();
+    let mut fresh = Progressive::new(&s, mesh, &vis, options(None).solver);
+    while !fresh.is_done() && fresh.step().is_some() {}
     let areas = mesh.vertex_areas();
-    let mut absorbed = 0.0;
-    for (l, b) in session.radiosity().iter().enumerate() {
-        let j = mesh.vertex_polygon[l].index();
-        let material = &s.materials[s.polygons[j].material.index()];
-        let rho = material.reflectance().r;
-        absorbed += areas[l] * (1.0 - rho) / rho * (b.r - material.emission().r);
+    let mean = |radiosity: &[Rgb], j: usize| {
+        let pm = &mesh.polygons[j];
+        pm.vertices
+            .clone()
+            .map(|l| radiosity[l as usize].r * areas[l as usize])
+            .sum::<f64>()
+            / pm.area
+    };
+    let scene_mean = (0..mesh.polygons.len())
+        .map(|j| mean(fresh.radiosity(), j) * mesh.polygons[j].area)
+        .sum::<f64>()
+        / mesh.polygons.iter().map(|pm| pm.area).sum::<f64>();
+    for j in 0..mesh.polygons.len() {
+        let error = (mean(session.radiosity(), j) - mean(fresh.radiosity(), j)).abs() / scene_mean;
+        assert!(error < 0.005, "polygon {j}: {error}");
     }
-    let emitted = session.solver().initial_unshot_power();
-    let unshot = session.solver().unshot_power();
-    let error = (absorbed + unshot - emitted).abs() / emitted;
-    assert!(error < 0.01, "energy error {error}");
 }
 
 /// The run's element limit clamps the refiner's: a refinement that would

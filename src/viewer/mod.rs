@@ -305,7 +305,11 @@ impl InputCallback for KeyPresses {
 }
 
 impl<'a> Ui<'a> {
-    fn run(&mut self, progress: &Mutex<Progress<'a>>, control: &Control) -> Result<(), ViewerError> {
+    fn run(
+        &mut self,
+        progress: &Mutex<Progress<'a>>,
+        control: &Control,
+    ) -> Result<(), ViewerError> {
         let mut shown_version = u64::MAX;
         let mut last_draw = Instant::now() - REDRAW_INTERVAL;
         let mut dirty = true;
