@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 pub mod app;
+pub mod camera;
 pub mod color;
 pub mod mesh;
 pub mod output;

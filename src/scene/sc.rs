@@ -14,11 +14,14 @@
 
 use super::error::fmt_num;
 use super::{
-    Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError,
-    Scene, SourcePos, DEFAULT_FOV_DEG, DEFAULT_SIZE, MAX_COORDINATE,
+    CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
+    SourcePos, MAX_COORDINATE,
+};
+use crate::camera::{
+    picture_size_ok, Camera, CameraError, DEFAULT_FOV_DEG, DEFAULT_SIZE, MAX_PICTURE_PIXELS,
+    MAX_PICTURE_SIDE,
 };
 use crate::color::Rgb;
-use crate::render::camera::{picture_size_ok, MAX_PICTURE_PIXELS, MAX_PICTURE_SIDE};
 use glam::{DAffine3, DMat3, DVec3, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
@@ -26,12 +29,6 @@ use std::path::Path;
 /// The parser stops after this many diagnostics: past that point a file is
 /// usually not a scene at all and more messages help nobody.
 pub const MAX_DIAGNOSTICS: usize = 100;
-
-/// `up` counts as parallel to the view direction when the sine of the angle
-/// between them is below this. Small enough to accept any up a person would
-/// write, large enough that `normalize(forward x up)` is still accurate in
-/// `f32`.
-pub const UP_PARALLEL_TOLERANCE: f64 = 1e-4;
 
 /// Largest emitted radiosity per channel (`k_emission` × `color`), in the
 /// scene's radiosity units. Far above any physical scene, low enough that
@@ -848,34 +845,6 @@ impl<'a> Parser<'a> {
             return;
         };
         let (up, up_pos) = up.unwrap_or((DVec3::Y, open.pos));
-        let forward = lookat.as_vec3().as_dvec3() - eye.as_vec3().as_dvec3();
-        if forward == DVec3::ZERO {
-            self.error(
-                lookat_pos,
-                "`lookat` equals `eye`; the camera has no view direction",
-            );
-            return;
-        }
-        if up == DVec3::ZERO {
-            self.error(up_pos, "`up` is zero; it must give a direction");
-            return;
-        }
-        let sine = forward
-            .normalize_or_zero()
-            .cross(up.normalize_or_zero())
-            .length();
-        if sine < UP_PARALLEL_TOLERANCE {
-            self.error(
-                up_pos,
-                format!(
-                    "`up` ({} {} {}) is parallel to the view direction; the picture's up would be undefined",
-                    fmt_num(up.x),
-                    fmt_num(up.y),
-                    fmt_num(up.z)
-                ),
-            );
-            return;
-        }
         let (width, height) = size.unwrap_or(DEFAULT_SIZE);
         let camera = Camera {
             eye: eye.as_vec3(),
@@ -885,11 +854,31 @@ impl<'a> Parser<'a> {
             width,
             height,
         };
-        // What the renderer will do with it: the checks above catch every
-        // case known, this catches what they miss (rounding to f32) with
-        // a position rather than a failure after solving.
-        if let Err(e) = crate::render::View::new(&camera) {
-            self.error(open.pos, format!("unusable camera: {e}"));
+        // The one validation every camera goes through; its errors are
+        // placed at the field at fault. The fields were checked one by one
+        // already, so only their combination can fail here, but a case
+        // nobody foresaw still gets the block's position rather than a
+        // failure after solving.
+        if let Err(e) = camera.check() {
+            match e {
+                CameraError::NoViewDirection => self.error(
+                    lookat_pos,
+                    "`lookat` equals `eye`; the camera has no view direction",
+                ),
+                CameraError::UpZero => {
+                    self.error(up_pos, "`up` is zero; it must give a direction")
+                }
+                CameraError::UpParallel => self.error(
+                    up_pos,
+                    format!(
+                        "`up` ({} {} {}) is parallel to the view direction; the picture's up would be undefined",
+                        fmt_num(up.x),
+                        fmt_num(up.y),
+                        fmt_num(up.z)
+                    ),
+                ),
+                e => self.error(open.pos, format!("unusable camera: {e}")),
+            }
             return;
         }
         if !second {
