@@ -1008,17 +1008,11 @@ pub fn load_scene_with_camera(
     source: &SceneSource,
     camera: Option<&Path>,
 ) -> Result<Scene, LoadError> {
-    match source {
-        SceneSource::Bundled => {
-            let mut scene = scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?;
-            if let Some(camera) = camera {
-                scene.camera = scene::load_camera(camera)?;
-                scene.camera_source = scene::CameraSource::File;
-            }
-            Ok(scene)
-        }
-        SceneSource::File(path) => scene::load_with_camera(path, camera),
-    }
+    let scene = match source {
+        SceneSource::Bundled => scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?,
+        SceneSource::File(path) => scene::load(path)?,
+    };
+    scene.with_camera_from(camera)
 }
 
 /// Renders one frame of a solution.

@@ -154,6 +154,21 @@ impl Scene {
         let (lo, hi) = self.bounds();
         (hi - lo).length()
     }
+
+    /// The scene with its camera taken from the `camera` block of the `.sc`
+    /// file at `camera` (see [`load_camera`]) when given, and then marked
+    /// [`CameraSource::File`]; unchanged when `None`.
+    ///
+    /// This is the one way a camera override (`--camera`) is applied,
+    /// whatever format the scene came from. The scene is loaded first, so
+    /// when both files are wrong the scene's mistakes are the ones reported.
+    pub fn with_camera_from(mut self, camera: Option<&Path>) -> Result<Scene, LoadError> {
+        if let Some(path) = camera {
+            self.camera = load_camera(path)?;
+            self.camera_source = CameraSource::File;
+        }
+        Ok(self)
+    }
 }
 
 /// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, in
@@ -170,23 +185,19 @@ pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
 /// when the extension is `.obj` in any case, else `.sc`. Errors carry the
 /// file name, line and column.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    load_with_camera(path, None)
-}
-
-/// [`load`], with the camera taken from the `camera` block of the `.sc`
-/// file `camera` when given (see [`load_camera`]) instead of the scene's
-/// own or the auto-framed one.
-pub fn load_with_camera(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
     let is_obj = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
-        return obj::load_obj(path, camera);
+        obj::load_obj(path, None)
+    } else {
+        sc::load_file(path)
     }
-    let mut scene = sc::load_file(path)?;
-    if let Some(camera) = camera {
-        scene.camera = sc::load_camera(camera)?;
-        scene.camera_source = CameraSource::File;
-    }
-    Ok(scene)
+}
+
+/// [`load`], then [`Scene::with_camera_from`]: the camera of the `.sc`
+/// file `camera` when given, instead of the scene's own or the
+/// auto-framed one.
+pub fn load_with_camera(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    load(path)?.with_camera_from(camera)
 }

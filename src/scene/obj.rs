@@ -35,8 +35,8 @@
 //! file order). MTL files are read here (they are a handful of lines) so
 //! that each `Kd` and `Ke` has its position for messages.
 //!
-//! The camera comes from a sidecar `.sc` file (see
-//! [`super::sc::load_camera`]) or is [`Camera::frame`]d around the model.
+//! The camera is [`Camera::frame`]d around the model, or comes from a
+//! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
 use super::error::fmt_num;
 use super::sc::MAX_DIAGNOSTICS;
@@ -68,14 +68,13 @@ pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
 
 /// Reads the OBJ file at `path`, its material libraries, and the camera:
-/// from the `.sc` file `camera` when given (its `camera` block), else
-/// framed around the model ([`Camera::frame`]).
+/// framed around the model ([`Camera::frame`]), or from the `.sc` file
+/// `camera` when given (see [`Scene::with_camera_from`]).
 ///
 /// Errors name the file (the OBJ, an MTL, or the camera file), the line
 /// and the column, and every problem found is reported (up to
 /// [`MAX_DIAGNOSTICS`]).
 pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
-    let camera = camera.map(super::sc::load_camera).transpose()?;
     let file = path.display().to_string();
     let bytes = std::fs::read(path)
         .map_err(|e| Diagnostic::new(&file, FILE_START, format!("cannot read file: {e}")))?;
@@ -91,7 +90,7 @@ pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> 
             Err(e) => Err(format!("cannot read material library {display}: {e}")),
         }
     };
-    parse_obj(&text, &file, &read_mtl, camera)
+    parse_obj(&text, &file, &read_mtl)?.with_camera_from(camera)
 }
 
 /// Turns a `mtllib` name into the library's name for messages and its
@@ -100,12 +99,11 @@ pub(crate) type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> +
 
 /// Parses OBJ text named `file`. `read_mtl` turns a `mtllib` name into
 /// the library's name for messages and its text, or says why it cannot.
-/// `camera` replaces the auto-framed camera.
+/// The camera frames the model.
 pub(crate) fn parse_obj(
     text: &str,
     file: &str,
     read_mtl: &ReadMtl<'_>,
-    camera: Option<Camera>,
 ) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let scan = scan_obj(text, file);
@@ -294,18 +292,12 @@ pub(crate) fn parse_obj(
     if !diags.is_empty() {
         return Err(LoadError::from_diagnostics(diags));
     }
-    let (camera, camera_source) = match camera {
-        Some(c) => (c, CameraSource::File),
-        None => {
-            let (lo, hi) = super::polygon_bounds(&polygons);
-            (Camera::frame(lo, hi), CameraSource::AutoFramed)
-        }
-    };
+    let (lo, hi) = super::polygon_bounds(&polygons);
     Ok(Scene {
         polygons,
         materials,
-        camera,
-        camera_source,
+        camera: Camera::frame(lo, hi),
+        camera_source: CameraSource::AutoFramed,
     })
 }
 
@@ -885,7 +877,7 @@ Kd 0.25
             "lib.mtl" => Ok(("lib.mtl".to_string(), mtl.to_string())),
             other => Err(format!("cannot read material library {other}: not found")),
         };
-        parse_obj(obj, "m.obj", &read, None)
+        parse_obj(obj, "m.obj", &read)
     }
 
     fn messages(e: &LoadError) -> Vec<String> {
