@@ -12,15 +12,13 @@ pub mod obj;
 mod polygon;
 mod sc;
 
-pub use error::{Diagnostic, LoadError};
+pub use error::{Diagnostic, LoadError, MAX_DIAGNOSTICS};
 pub use obj::load_obj;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
-pub use sc::{
-    load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_DIAGNOSTICS, MAX_EMISSION,
-};
+pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.

@@ -38,8 +38,9 @@
 //! The camera is [`Camera::frame`]d around the model, or comes from a
 //! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
-use super::error::fmt_num;
-use super::sc::MAX_DIAGNOSTICS;
+use super::error::{
+    cannot_read, negative_channel, reflectance_too_high, FILE_START, MAX_DIAGNOSTICS,
+};
 use super::{
     Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError,
     Scene, SourcePos,
@@ -64,9 +65,6 @@ pub const DEFAULT_REFLECTANCE: f64 = 0.8;
 /// straight, not as an ear: it would make a sliver of no area.
 pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 
-/// Where the start of a file is, for problems of the file as a whole.
-const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
-
 /// Reads the OBJ file at `path`, its material libraries, and the camera:
 /// framed around the model ([`Camera::frame`]), or from the `.sc` file
 /// `camera` when given (see [`Scene::with_camera_from`]).
@@ -76,8 +74,7 @@ const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
 /// [`MAX_DIAGNOSTICS`]).
 pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path)
-        .map_err(|e| Diagnostic::new(&file, FILE_START, format!("cannot read file: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
     // Lossy: a stray Latin-1 byte in a comment must not refuse the model;
     // names are decoded the same way in the OBJ and in its MTL files.
     let text = String::from_utf8_lossy(&bytes);
@@ -778,17 +775,10 @@ fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
                     Ok(rgb) if keyword == "Ke" => m.ke = rgb,
                     Ok(rgb) => {
                         if rgb.max_channel() >= 1.0 {
-                            let (channel, value) = ["red", "green", "blue"]
-                                .into_iter()
-                                .zip(rgb.to_array())
-                                .fold(("red", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
                             lib.diags.push(Diagnostic::new(
                                 file,
                                 at(col),
-                                format!(
-                                    "reflectance `Kd` is {} in the {channel} channel; every channel must be below 1",
-                                    fmt_num(value)
-                                ),
+                                reflectance_too_high("`Kd`", rgb),
                             ));
                         }
                         m.kd = rgb;
@@ -837,10 +827,7 @@ fn color(w: &[(&str, u32)]) -> Result<Rgb, (u32, String)> {
             Err(_) => return Err((c, format!("invalid number `{word}`"))),
         };
         if x < 0.0 {
-            return Err((
-                c,
-                format!("`{keyword}` channel {word} is negative; channels must be >= 0"),
-            ));
+            return Err((c, negative_channel(keyword, word)));
         }
         *slot = x;
     }
