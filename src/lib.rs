@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 pub mod batch;
+pub mod camera;
 pub mod color;
 pub mod config;
 pub mod mesh;

@@ -99,17 +99,11 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
 }
 
 /// Loads the scene from its source, with the camera of the `.sc` file
-/// `camera` when given (see [`scene::load_with_camera`]).
+/// `camera` when given (see [`Scene::with_camera_from`]).
 pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, LoadError> {
-    match source {
-        SceneSource::Bundled => {
-            let mut scene = scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?;
-            if let Some(camera) = camera {
-                scene.camera = scene::load_camera(camera)?;
-                scene.camera_source = scene::CameraSource::File;
-            }
-            Ok(scene)
-        }
-        SceneSource::File(path) => scene::load_with_camera(path, camera),
-    }
+    let scene = match source {
+        SceneSource::Bundled => scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?,
+        SceneSource::File(path) => scene::load(path)?,
+    };
+    scene.with_camera_from(camera)
 }

@@ -16,14 +16,9 @@
 //! Pixels are square: the vertical field of view is the camera's and the
 //! horizontal one follows from the aspect ratio `width / height`.
 
-use crate::scene::Camera;
+use crate::camera::{Camera, CameraError, CheckedCamera};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use thiserror::Error;
-
-/// Below this sine of the angle between the up vector and the viewing
-/// direction, up is taken to be parallel to the view and no picture
-/// orientation can be derived from it.
-pub const MIN_UP_SINE: f32 = 1e-6;
 
 /// The default near-plane distance as a fraction of the distance from the
 /// eye to the look-at point.
@@ -35,49 +30,28 @@ pub const MIN_UP_SINE: f32 = 1e-6;
 /// that know the scene's extent can choose their own with [`View::with_near`].
 pub const DEFAULT_NEAR_FRACTION: f32 = 1e-3;
 
-/// The largest picture side the renderer accepts, in pixels.
-///
-/// It bounds the fixed-point screen coordinates of the rasterizer so that its
-/// exact integer edge tests cannot overflow.
-pub const MAX_PICTURE_SIDE: u32 = 1 << 16;
-
-/// The most pixels a picture may have: 2^26 = 67,108,864 (8192 × 8192).
-///
-/// Rendering and writing a picture hold about 45 bytes per pixel at once
-/// (the linear frame, coverage, the z-buffer, luminances for the automatic
-/// exposure, the encoded copy), so this bounds a picture's memory near
-/// 3 GB; a larger request is almost always a typo.
-pub const MAX_PICTURE_PIXELS: u64 = 1 << 26;
-
-/// Whether a picture of `width × height` pixels is within
-/// [`MAX_PICTURE_SIDE`] and [`MAX_PICTURE_PIXELS`] (and not empty).
-pub fn picture_size_ok(width: u32, height: u32) -> bool {
-    (1..=MAX_PICTURE_SIDE).contains(&width)
-        && (1..=MAX_PICTURE_SIDE).contains(&height)
-        && width as u64 * height as u64 <= MAX_PICTURE_PIXELS
-}
-
-/// Why a [`Camera`] does not make a usable [`View`].
+/// Why a [`Camera`] does not make a usable [`View`]: the camera's own
+/// problems ([`CameraError`], with the same messages except that a zero up
+/// and a parallel one are one case here) and the view's near plane.
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum ViewError {
     /// A camera vector or the field of view is NaN or infinite.
-    #[error("the camera has a non-finite eye, look-at point, up vector or field of view")]
+    #[error("{}", CameraError::NotFinite)]
     NotFinite,
     /// The eye and the look-at point coincide, so there is no viewing direction.
-    #[error("the camera's eye and look-at point coincide")]
+    #[error("{}", CameraError::NoViewDirection)]
     NoViewDirection,
     /// Up is zero or parallel to the viewing direction.
     #[error("the camera's up vector is zero or parallel to the viewing direction")]
     UpParallel,
     /// The vertical field of view is not in `(0, pi)` radians.
-    #[error("the vertical field of view {0} rad is not strictly between 0 and pi")]
+    #[error("{}", CameraError::FovOutOfRange(*.0))]
     FovOutOfRange(f32),
-    /// A picture side is zero or larger than [`MAX_PICTURE_SIDE`], or the
-    /// picture has more than [`MAX_PICTURE_PIXELS`] pixels.
-    #[error(
-        "picture size {width}x{height} is too large or empty: each side must be between 1 and \
-         {MAX_PICTURE_SIDE} pixels and the picture at most {MAX_PICTURE_PIXELS} pixels (8192x8192)"
-    )]
+    /// A picture side is zero or larger than
+    /// [`MAX_PICTURE_SIDE`](crate::camera::MAX_PICTURE_SIDE), or the picture
+    /// has more than [`MAX_PICTURE_PIXELS`](crate::camera::MAX_PICTURE_PIXELS)
+    /// pixels.
+    #[error("{}", CameraError::BadSize { width: *.width, height: *.height })]
     BadSize {
         /// Requested width in pixels.
         width: u32,
@@ -89,14 +63,26 @@ pub enum ViewError {
     BadNear(f32),
 }
 
-/// A validated pinhole view made from a [`Camera`]: an orthonormal camera
-/// frame, a perspective projection and a picture size.
+impl From<CameraError> for ViewError {
+    fn from(e: CameraError) -> Self {
+        match e {
+            CameraError::NotFinite => ViewError::NotFinite,
+            CameraError::NoViewDirection => ViewError::NoViewDirection,
+            CameraError::UpZero | CameraError::UpParallel => ViewError::UpParallel,
+            CameraError::FovOutOfRange(fov) => ViewError::FovOutOfRange(fov),
+            CameraError::BadSize { width, height } => ViewError::BadSize { width, height },
+        }
+    }
+}
+
+/// A validated pinhole view made from a [`CheckedCamera`]: its orthonormal
+/// camera frame, a perspective projection and a picture size.
 ///
 /// Invariants: `right`, `up` and `forward` are unit length and mutually
 /// orthogonal with `right = forward × up` (a right-handed world looks
 /// right-handed in the picture: world-right is picture-right); `0 < fov_y <
-/// pi`; `1 <= width, height <= MAX_PICTURE_SIDE` and
-/// `width × height <= MAX_PICTURE_PIXELS`; `near` finite and `> 0`.
+/// pi`; the picture size within [`crate::camera::picture_size_ok`]; `near`
+/// finite and `> 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
     eye: Vec3,
@@ -118,45 +104,32 @@ impl View {
 
     /// The view of a camera rendered at another picture size (for example a
     /// resized window). The vertical field of view is kept; the horizontal one
-    /// follows the new aspect ratio.
+    /// follows the new aspect ratio. The camera is checked with that size
+    /// ([`Camera::check`]); its own size does not matter.
     pub fn with_size(camera: &Camera, width: u32, height: u32) -> Result<View, ViewError> {
-        let finite = camera.eye.is_finite()
-            && camera.lookat.is_finite()
-            && camera.up.is_finite()
-            && camera.fov_y.is_finite();
-        if !finite {
-            return Err(ViewError::NotFinite);
-        }
-        let forward = (camera.lookat - camera.eye)
-            .try_normalize()
-            .ok_or(ViewError::NoViewDirection)?;
-        let up_dir = camera.up.try_normalize().ok_or(ViewError::UpParallel)?;
-        // Gram–Schmidt through the cross product: the given up only has to
-        // say which way is up, it need not be orthogonal to the view.
-        let side = forward.cross(up_dir);
-        if side.length() < MIN_UP_SINE {
-            return Err(ViewError::UpParallel);
-        }
-        let right = side.normalize();
-        let up = right.cross(forward);
-        if !(camera.fov_y > 0.0 && camera.fov_y < std::f32::consts::PI) {
-            return Err(ViewError::FovOutOfRange(camera.fov_y));
-        }
-        if !picture_size_ok(width, height) {
-            return Err(ViewError::BadSize { width, height });
-        }
-        let distance = (camera.lookat - camera.eye).length();
-        View {
-            eye: camera.eye,
-            right,
-            up,
-            forward,
-            fov_y: camera.fov_y,
+        let sized = Camera {
             width,
             height,
+            ..*camera
+        };
+        View::from_checked(&sized.check()?)
+    }
+
+    /// The view of a checked camera, at its picture size, with the near
+    /// plane at [`DEFAULT_NEAR_FRACTION`] of the eye–look-at distance.
+    pub fn from_checked(camera: &CheckedCamera) -> Result<View, ViewError> {
+        let c = camera.camera();
+        View {
+            eye: c.eye,
+            right: camera.right(),
+            up: camera.up(),
+            forward: camera.forward(),
+            fov_y: c.fov_y,
+            width: c.width,
+            height: c.height,
             near: 1.0,
         }
-        .with_near(distance * DEFAULT_NEAR_FRACTION)
+        .with_near(camera.distance() * DEFAULT_NEAR_FRACTION)
     }
 
     /// The same view with the near plane at `near` scene units in front of
@@ -254,6 +227,7 @@ impl View {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::camera::MAX_PICTURE_SIDE;
 
     /// Pixel-space tolerance of the projection tests, in pixels.
     const PIXEL_TOLERANCE: f32 = 1e-3;

@@ -3,9 +3,10 @@
 //!
 //! The pipeline of a picture is
 //!
-//! 1. [`View::new`] turns the scene's [`Camera`](crate::scene::Camera) into
-//!    an orthonormal camera frame and a perspective projection (row 0 at the
-//!    top, world-right is picture-right);
+//! 1. [`View::new`] checks the scene's [`Camera`](crate::camera::Camera)
+//!    ([`Camera::check`](crate::camera::Camera::check)) and turns its
+//!    orthonormal frame into a perspective projection (row 0 at the top,
+//!    world-right is picture-right);
 //! 2. [`Rasterizer::render`] draws the element mesh with the per-vertex
 //!    radiosity, Gouraud-shaded and z-buffered, into a linear [`Frame`]
 //!    (front faces lit, back faces black, background black);

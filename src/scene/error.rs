@@ -10,9 +10,48 @@
 //!
 //! A failed load is a [`LoadError`] holding one or more diagnostics in file
 //! order, so a user can fix several mistakes per run.
+//!
+//! What the `.sc` and `.obj` loaders share lives here too, so that the two
+//! formats word the same problem the same way: the cap on diagnostics, the
+//! position of whole-file problems, and the messages for unreadable files,
+//! negative colour channels and reflectance at or above one.
 
 use super::SourcePos;
+use crate::color::Rgb;
 use std::fmt;
+
+/// A loader stops after this many diagnostics: past that point a file is
+/// usually not a scene at all and more messages help nobody.
+pub const MAX_DIAGNOSTICS: usize = 100;
+
+/// Where the start of a file is, for problems of the file as a whole (it
+/// cannot be read, it is empty, it lacks a required block).
+pub(crate) const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
+
+/// The diagnostic for a file that cannot be read, at [`FILE_START`].
+pub(crate) fn cannot_read(file: &str, error: &std::io::Error) -> Diagnostic {
+    Diagnostic::new(file, FILE_START, format!("cannot read file: {error}"))
+}
+
+/// The message for a colour channel written negative: `keyword` is the
+/// field (`color`, `Kd`, `Ke`) and `text` the number as written.
+pub(crate) fn negative_channel(keyword: &str, text: &str) -> String {
+    format!("`{keyword}` channel {text} is negative; channels must be >= 0")
+}
+
+/// The message for a reflectance `rho` with a channel at or above one,
+/// naming its largest channel (the first of equal ones); `what` says how
+/// the file wrote it (`` `Kd` ``, `` `k_diffrefl` × `color` ``).
+pub(crate) fn reflectance_too_high(what: &str, rho: Rgb) -> String {
+    let (channel, value) = ["red", "green", "blue"]
+        .into_iter()
+        .zip(rho.to_array())
+        .fold(("red", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
+    format!(
+        "reflectance {what} is {} in the {channel} channel; every channel must be below 1",
+        fmt_num(value)
+    )
+}
 
 /// One problem found while loading, with its position.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -67,12 +106,12 @@ pub struct LoadError {
 impl LoadError {
     /// The diagnostics as an error: sorted by file, then position (stable,
     /// so several messages at one place keep their order), at most
-    /// [`MAX_DIAGNOSTICS`](super::MAX_DIAGNOSTICS).
+    /// [`MAX_DIAGNOSTICS`].
     pub fn from_diagnostics(mut diagnostics: Vec<Diagnostic>) -> LoadError {
         diagnostics.sort_by(|a, b| {
             (a.file.as_str(), a.line, a.col).cmp(&(b.file.as_str(), b.line, b.col))
         });
-        diagnostics.truncate(super::MAX_DIAGNOSTICS);
+        diagnostics.truncate(MAX_DIAGNOSTICS);
         LoadError { diagnostics }
     }
 

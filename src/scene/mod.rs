@@ -12,16 +12,17 @@ pub mod obj;
 mod polygon;
 mod sc;
 
-pub use error::{Diagnostic, LoadError};
+pub use error::{Diagnostic, LoadError, MAX_DIAGNOSTICS};
 pub use obj::load_obj;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
-pub use sc::{
-    load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_DIAGNOSTICS, MAX_EMISSION,
-    UP_PARALLEL_TOLERANCE,
-};
+pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
+
+/// The camera lives in [`crate::camera`], below the scene; these are
+/// re-exported because every scene has one.
+pub use crate::camera::{Camera, DEFAULT_FOV_DEG, DEFAULT_SIZE, UP_PARALLEL_TOLERANCE};
 
 use crate::color::Rgb;
 use glam::Vec3;
@@ -112,78 +113,12 @@ pub struct Polygon {
     pub origin: SourcePos,
 }
 
-/// The viewpoint of the picture.
-///
-/// Invariants: `eye != lookat`, `up` not parallel to `lookat - eye`,
-/// `0 < fov_y < pi`, `width >= 1`, `height >= 1`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Viewpoint, in scene units.
-    pub eye: Vec3,
-    /// Point looked at, in scene units.
-    pub lookat: Vec3,
-    /// Approximate up direction (need not be orthogonal to the view).
-    pub up: Vec3,
-    /// Vertical field of view in radians.
-    pub fov_y: f32,
-    /// Picture width in pixels.
-    pub width: u32,
-    /// Picture height in pixels.
-    pub height: u32,
-}
-
-impl Camera {
-    /// A camera that frames the axis-aligned box `bounds_min..bounds_max`
-    /// (scene units): what a file without a `camera` block gets.
-    ///
-    /// The rule: look at the centre of the box along +z, from the -z side,
-    /// with up +y, the default field of view ([`DEFAULT_FOV_DEG`], vertical)
-    /// and size ([`DEFAULT_SIZE`]), from the distance at which the box's
-    /// bounding sphere exactly fills the vertical field of view:
-    /// `distance = radius / sin(fov_y / 2)`, with `radius` half the box's
-    /// diagonal. The default picture is wider than tall, so the sphere fits
-    /// horizontally too, and the whole scene is in view.
-    ///
-    /// A box of zero size gets a radius of 1 scene unit, so the result is
-    /// always a valid camera (`eye != lookat`), and every field is finite
-    /// for finite bounds.
-    pub fn frame(bounds_min: Vec3, bounds_max: Vec3) -> Camera {
-        let (lo, hi) = (bounds_min.as_dvec3(), bounds_max.as_dvec3());
-        let centre = 0.5 * (lo + hi);
-        let radius = 0.5 * (hi - lo).length();
-        let radius = if radius > 0.0 && radius.is_finite() {
-            radius
-        } else {
-            1.0
-        };
-        let fov_y = DEFAULT_FOV_DEG.to_radians();
-        // Never closer than a few ulps of the centre, so `eye != lookat`
-        // survives the rounding to f32 even for a tiny box far away.
-        let distance = (radius / (0.5 * f64::from(fov_y)).sin()).max(centre.z.abs() * 1e-6);
-        let limit = f64::from(f32::MAX);
-        let eye_z = (centre.z - distance).clamp(-limit, limit);
-        Camera {
-            eye: Vec3::new(centre.x as f32, centre.y as f32, eye_z as f32),
-            lookat: centre.as_vec3(),
-            up: Vec3::Y,
-            fov_y,
-            width: DEFAULT_SIZE.0,
-            height: DEFAULT_SIZE.1,
-        }
-    }
-}
-
-/// Default picture size when the scene gives none, in pixels.
-pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
-/// Default vertical field of view when the scene gives none, in degrees.
-pub const DEFAULT_FOV_DEG: f32 = 45.0;
-
 /// Whether the camera came from the file or was made to frame the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CameraSource {
     /// The file had a `camera` block.
     File,
-    /// No `camera` block: see [`Camera::frame`].
+    /// No camera in the file: see [`Camera::frame`].
     AutoFramed,
 }
 
@@ -217,6 +152,21 @@ impl Scene {
         let (lo, hi) = self.bounds();
         (hi - lo).length()
     }
+
+    /// The scene with its camera taken from the `camera` block of the `.sc`
+    /// file at `camera` (see [`load_camera`]) when given, and then marked
+    /// [`CameraSource::File`]; unchanged when `None`.
+    ///
+    /// This is the one way a camera override (`--camera`) is applied,
+    /// whatever format the scene came from. The scene is loaded first, so
+    /// when both files are wrong the scene's mistakes are the ones reported.
+    pub fn with_camera_from(mut self, camera: Option<&Path>) -> Result<Scene, LoadError> {
+        if let Some(path) = camera {
+            self.camera = load_camera(path)?;
+            self.camera_source = CameraSource::File;
+        }
+        Ok(self)
+    }
 }
 
 /// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, in
@@ -233,57 +183,19 @@ pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
 /// when the extension is `.obj` in any case, else `.sc`. Errors carry the
 /// file name, line and column.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    load_with_camera(path, None)
-}
-
-/// [`load`], with the camera taken from the `camera` block of the `.sc`
-/// file `camera` when given (see [`load_camera`]) instead of the scene's
-/// own or the auto-framed one.
-pub fn load_with_camera(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
     let is_obj = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
-        return obj::load_obj(path, camera);
+        obj::load_obj(path, None)
+    } else {
+        sc::load_file(path)
     }
-    let mut scene = sc::load_file(path)?;
-    if let Some(camera) = camera {
-        scene.camera = sc::load_camera(camera)?;
-        scene.camera_source = CameraSource::File;
-    }
-    Ok(scene)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn frame_fits_the_bounding_sphere_in_the_default_view() {
-        let (lo, hi) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 4.0, 6.0));
-        let c = Camera::frame(lo, hi);
-        assert_eq!(c.lookat, Vec3::new(1.0, 2.0, 4.0));
-        assert_eq!(c.up, Vec3::Y);
-        assert_eq!(c.fov_y, DEFAULT_FOV_DEG.to_radians());
-        assert_eq!((c.width, c.height), DEFAULT_SIZE);
-        // Straight down -z from the centre, at radius / sin(fov / 2).
-        let radius = 0.5 * (hi - lo).length();
-        let distance = radius / (0.5 * c.fov_y).sin();
-        assert!((c.eye - Vec3::new(1.0, 2.0, 4.0 - distance)).length() < 1e-4);
-    }
-
-    #[test]
-    fn frame_is_a_valid_camera_for_degenerate_bounds() {
-        let c = Camera::frame(Vec3::ZERO, Vec3::ZERO);
-        assert_ne!(c.eye, c.lookat);
-        assert!(c.eye.z < 0.0);
-        // A tiny scene far away still gets a view direction after rounding.
-        let far = Vec3::new(0.0, 0.0, 1e7);
-        let c = Camera::frame(far, far + Vec3::splat(1e-6));
-        assert_ne!(c.eye, c.lookat);
-        assert!(c.eye.is_finite());
-        // Huge bounds stay finite.
-        let c = Camera::frame(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
-        assert!(c.eye.is_finite() && c.lookat.is_finite());
-    }
+/// [`load`], then [`Scene::with_camera_from`]: the camera of the `.sc`
+/// file `camera` when given, instead of the scene's own or the
+/// auto-framed one.
+pub fn load_with_camera(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    load(path)?.with_camera_from(camera)
 }

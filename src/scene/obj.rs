@@ -35,11 +35,12 @@
 //! file order). MTL files are read here (they are a handful of lines) so
 //! that each `Kd` and `Ke` has its position for messages.
 //!
-//! The camera comes from a sidecar `.sc` file (see
-//! [`super::sc::load_camera`]) or is [`Camera::frame`]d around the model.
+//! The camera is [`Camera::frame`]d around the model, or comes from a
+//! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
-use super::error::fmt_num;
-use super::sc::MAX_DIAGNOSTICS;
+use super::error::{
+    cannot_read, negative_channel, reflectance_too_high, FILE_START, MAX_DIAGNOSTICS,
+};
 use super::{
     Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError,
     Scene, SourcePos,
@@ -64,21 +65,16 @@ pub const DEFAULT_REFLECTANCE: f64 = 0.8;
 /// straight, not as an ear: it would make a sliver of no area.
 pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 
-/// Where the start of a file is, for problems of the file as a whole.
-const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
-
 /// Reads the OBJ file at `path`, its material libraries, and the camera:
-/// from the `.sc` file `camera` when given (its `camera` block), else
-/// framed around the model ([`Camera::frame`]).
+/// framed around the model ([`Camera::frame`]), or from the `.sc` file
+/// `camera` when given (see [`Scene::with_camera_from`]).
 ///
 /// Errors name the file (the OBJ, an MTL, or the camera file), the line
 /// and the column, and every problem found is reported (up to
 /// [`MAX_DIAGNOSTICS`]).
 pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
-    let camera = camera.map(super::sc::load_camera).transpose()?;
     let file = path.display().to_string();
-    let bytes = std::fs::read(path)
-        .map_err(|e| Diagnostic::new(&file, FILE_START, format!("cannot read file: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
     // Lossy: a stray Latin-1 byte in a comment must not refuse the model;
     // names are decoded the same way in the OBJ and in its MTL files.
     let text = String::from_utf8_lossy(&bytes);
@@ -91,7 +87,7 @@ pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> 
             Err(e) => Err(format!("cannot read material library {display}: {e}")),
         }
     };
-    parse_obj(&text, &file, &read_mtl, camera)
+    parse_obj(&text, &file, &read_mtl)?.with_camera_from(camera)
 }
 
 /// Turns a `mtllib` name into the library's name for messages and its
@@ -100,12 +96,11 @@ pub(crate) type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> +
 
 /// Parses OBJ text named `file`. `read_mtl` turns a `mtllib` name into
 /// the library's name for messages and its text, or says why it cannot.
-/// `camera` replaces the auto-framed camera.
+/// The camera frames the model.
 pub(crate) fn parse_obj(
     text: &str,
     file: &str,
     read_mtl: &ReadMtl<'_>,
-    camera: Option<Camera>,
 ) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let scan = scan_obj(text, file);
@@ -294,18 +289,12 @@ pub(crate) fn parse_obj(
     if !diags.is_empty() {
         return Err(LoadError::from_diagnostics(diags));
     }
-    let (camera, camera_source) = match camera {
-        Some(c) => (c, CameraSource::File),
-        None => {
-            let (lo, hi) = super::polygon_bounds(&polygons);
-            (Camera::frame(lo, hi), CameraSource::AutoFramed)
-        }
-    };
+    let (lo, hi) = super::polygon_bounds(&polygons);
     Ok(Scene {
         polygons,
         materials,
-        camera,
-        camera_source,
+        camera: Camera::frame(lo, hi),
+        camera_source: CameraSource::AutoFramed,
     })
 }
 
@@ -786,17 +775,10 @@ fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
                     Ok(rgb) if keyword == "Ke" => m.ke = rgb,
                     Ok(rgb) => {
                         if rgb.max_channel() >= 1.0 {
-                            let (channel, value) = ["red", "green", "blue"]
-                                .into_iter()
-                                .zip(rgb.to_array())
-                                .fold(("red", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
                             lib.diags.push(Diagnostic::new(
                                 file,
                                 at(col),
-                                format!(
-                                    "reflectance `Kd` is {} in the {channel} channel; every channel must be below 1",
-                                    fmt_num(value)
-                                ),
+                                reflectance_too_high("`Kd`", rgb),
                             ));
                         }
                         m.kd = rgb;
@@ -845,10 +827,7 @@ fn color(w: &[(&str, u32)]) -> Result<Rgb, (u32, String)> {
             Err(_) => return Err((c, format!("invalid number `{word}`"))),
         };
         if x < 0.0 {
-            return Err((
-                c,
-                format!("`{keyword}` channel {word} is negative; channels must be >= 0"),
-            ));
+            return Err((c, negative_channel(keyword, word)));
         }
         *slot = x;
     }
@@ -885,7 +864,7 @@ Kd 0.25
             "lib.mtl" => Ok(("lib.mtl".to_string(), mtl.to_string())),
             other => Err(format!("cannot read material library {other}: not found")),
         };
-        parse_obj(obj, "m.obj", &read, None)
+        parse_obj(obj, "m.obj", &read)
     }
 
     fn messages(e: &LoadError) -> Vec<String> {
