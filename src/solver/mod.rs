@@ -162,6 +162,54 @@ struct Gathered {
     rays: u64,
 }
 
+/// A solver state that breaks [`Progressive`]'s invariants: found by
+/// [`Progressive::validate`] (a bug when it happens) or refused by
+/// [`Progressive::restore`] (a state saved for another solve).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SolverError {
+    /// The radiosity or unshot arrays do not have one entry per mesh
+    /// vertex (radiosity) and per unit of the unshot scheme.
+    #[error("array sizes do not match the mesh")]
+    MeshMismatch,
+    /// A vertex's radiosity is negative or not finite.
+    #[error("vertex {vertex} has radiosity {value:?}")]
+    BadRadiosity {
+        /// The mesh vertex.
+        vertex: usize,
+        /// Its radiosity, in the scene's emission units.
+        value: Rgb,
+    },
+    /// An unshot value is negative or not finite.
+    #[error("{unit} {index} has unshot radiosity {value:?}")]
+    BadUnshot {
+        /// What the value belongs to: "polygon" or "vertex" (by
+        /// [`SolverOptions::unshot`]).
+        unit: &'static str,
+        /// The polygon or mesh vertex.
+        index: usize,
+        /// Its unshot radiosity, in the scene's emission units.
+        value: Rgb,
+    },
+    /// A state to restore has other array sizes than this solve.
+    #[error(
+        "the saved state holds {radiosity} radiosity and {unshot} unshot values; \
+         this solve has {expected_radiosity} and {expected_unshot}"
+    )]
+    StateMismatch {
+        /// Radiosity entries in the state.
+        radiosity: usize,
+        /// Unshot entries in the state.
+        unshot: usize,
+        /// Radiosity entries this solve has (its mesh vertices).
+        expected_radiosity: usize,
+        /// Unshot entries this solve has.
+        expected_unshot: usize,
+    },
+    /// A state to restore holds a negative or non-finite value.
+    #[error("the saved state holds a negative or non-finite value")]
+    BadStateValue,
+}
+
 /// Why the solver stops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
@@ -778,20 +826,23 @@ impl<'a> Progressive<'a> {
     }
 
     /// Checks the invariants; returns the first broken one.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SolverError> {
         if self.radiosity.len() != self.mesh.vertex_count() || !self.unshot.fits(&self.mesh) {
-            return Err("array sizes do not match the mesh".into());
+            return Err(SolverError::MeshMismatch);
         }
         let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
         if let Some(l) = self.radiosity.iter().position(bad) {
-            return Err(format!("vertex {l} has radiosity {:?}", self.radiosity[l]));
+            return Err(SolverError::BadRadiosity {
+                vertex: l,
+                value: self.radiosity[l],
+            });
         }
         if let Some(j) = self.unshot().iter().position(bad) {
-            return Err(format!(
-                "{} {j} has unshot radiosity {:?}",
-                self.unshot.unit(),
-                self.unshot()[j]
-            ));
+            return Err(SolverError::BadUnshot {
+                unit: self.unshot.unit(),
+                index: j,
+                value: self.unshot()[j],
+            });
         }
         Ok(())
     }
@@ -810,21 +861,20 @@ impl<'a> Progressive<'a> {
     /// Replaces the solve's state by a saved one from a solve of the same
     /// scene, mesh and options; refuses (and changes nothing) when the
     /// array sizes differ or a value is not finite and non-negative.
-    pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), String> {
+    pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), SolverError> {
         if state.radiosity.len() != self.radiosity.len()
             || state.unshot.len() != self.unshot.values().len()
         {
-            return Err(format!(
-                "it holds {} radiosity and {} unshot values; this solve has {} and {}",
-                state.radiosity.len(),
-                state.unshot.len(),
-                self.radiosity.len(),
-                self.unshot.values().len()
-            ));
+            return Err(SolverError::StateMismatch {
+                radiosity: state.radiosity.len(),
+                unshot: state.unshot.len(),
+                expected_radiosity: self.radiosity.len(),
+                expected_unshot: self.unshot.values().len(),
+            });
         }
         let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
         if state.radiosity.iter().chain(&state.unshot).any(bad) {
-            return Err("it holds a negative or non-finite value".into());
+            return Err(SolverError::BadStateValue);
         }
         self.radiosity = state.radiosity;
         self.unshot.set_values(state.unshot);
