@@ -28,11 +28,7 @@ use crate::color::Rgb;
 use crate::mesh::refine::{RefineOptions, RefineReport, Refiner, Refused};
 use crate::mesh::{Mesh, MeshRef};
 use crate::scene::Scene;
-use crate::solver::{Progressive, SolverOptions, StepReport, StopReason};
-/// TEMP until the typed solver error lands.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct SolverError(pub String);
+use crate::solver::{Progressive, SolverError, SolverOptions, StepReport, StopReason};
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -194,7 +190,7 @@ impl<'p> Session<'p> {
         &mut self,
         state: crate::solver::checkpoint::SolverState,
     ) -> Result<(), SolverError> {
-        self.solver.restore(state).map_err(SolverError)
+        self.solver.restore(state)
     }
 
     /// Does the next thing: one shooting step, the end of a pass, a
@@ -290,7 +286,7 @@ impl<'p> Session<'p> {
             self.options.solver,
         );
         if let Some(state) = start {
-            solver.restore(state).map_err(SolverError)?;
+            solver.restore(state)?;
         }
         self.solver = solver;
         self.pass_start = PassStart {
@@ -419,7 +415,7 @@ impl<'p> Session<'p> {
 
     /// Checks the solver's invariants.
     pub fn validate(&self) -> Result<(), SolverError> {
-        self.solver.validate().map_err(SolverError)
+        self.solver.validate()
     }
 }
 

@@ -3,8 +3,8 @@
 //! back, refusing a file that is damaged or was saved for another solve.
 
 use crate::output::{self, OutputError};
-use crate::solver::checkpoint::{self, SolverState};
-use crate::solver::Progressive;
+use crate::solver::checkpoint::{self, DecodeError, SolverState};
+use crate::solver::{Progressive, SolverError};
 use std::path::{Path, PathBuf};
 
 /// Why a checkpoint could not be read or used. Every message names the file.
@@ -23,8 +23,8 @@ pub enum CheckpointError {
     Invalid {
         /// The checkpoint file.
         path: PathBuf,
-        /// What is wrong with it.
-        reason: String,
+        /// What is wrong with its bytes.
+        reason: DecodeError,
     },
     /// The checkpoint was written for another scene, mesh or solver options.
     #[error(
@@ -43,7 +43,7 @@ pub enum CheckpointError {
         /// The checkpoint file.
         path: PathBuf,
         /// What the solver refused.
-        reason: String,
+        reason: SolverError,
     },
     /// Writing the checkpoint failed.
     #[error("{0}")]
@@ -66,7 +66,7 @@ pub fn load(path: &Path, fingerprint: u64) -> Result<SolverState, CheckpointErro
     })?;
     let (found, state) = checkpoint::decode(&bytes).map_err(|reason| CheckpointError::Invalid {
         path: path.to_path_buf(),
-        reason: reason.to_string(),
+        reason,
     })?;
     if found != fingerprint {
         return Err(CheckpointError::Mismatch {
@@ -74,4 +74,30 @@ pub fn load(path: &Path, fingerprint: u64) -> Result<SolverState, CheckpointErro
         });
     }
     Ok(state)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Rgb;
+
+    #[test]
+    fn files_are_checked_against_the_fingerprint() {
+        let state = SolverState {
+            radiosity: vec![Rgb::new(0.1, 0.2, 0.3), Rgb::new(1.0 / 3.0, 0.0, 5e-324)],
+            unshot: vec![Rgb::new(7.0, 8.0, 9.0)],
+            steps: 42,
+            rays: 1 << 40,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("solve.ckpt");
+        let bytes = checkpoint::encode_state(7, &state);
+        output::write_atomically(&path, |w| w.write_all(&bytes)).unwrap();
+        assert_eq!(load(&path, 7).unwrap(), state);
+        let e = load(&path, 8).unwrap_err();
+        assert!(matches!(e, CheckpointError::Mismatch { .. }), "{e}");
+        assert!(e.to_string().contains("different scene"), "{e}");
+        let e = load(&dir.path().join("missing"), 7).unwrap_err();
+        assert!(e.to_string().contains("cannot read checkpoint"), "{e}");
+    }
 }

@@ -34,9 +34,9 @@ use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, OutputError};
 use crate::prepare::{self, PhaseSeconds, PrepareError, Prepared};
 use crate::render::{self, Exposure, Rasterizer, RenderError, ViewError};
-use crate::session::SolverError;
 use crate::session::{Event, PassStats, Session};
 use crate::solver::checkpoint::fingerprint;
+use crate::solver::SolverError;
 use progress::Progress;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -333,7 +333,7 @@ fn solve<'p>(
             .restore(state)
             .map_err(|reason| CheckpointError::Restore {
                 path: path.clone(),
-                reason: reason.to_string(),
+                reason,
             })?;
     }
     let save = |session: &Session| -> Result<(), RunError> {

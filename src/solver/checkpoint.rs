@@ -1,6 +1,8 @@
-//! Checkpoints: the state of a progressive solve saved to a file, so that an
+//! Checkpoints: the state of a progressive solve as bytes, so that an
 //! interrupted run can continue to exactly the result an uninterrupted run
-//! gives.
+//! gives. This module only encodes and decodes; reading and writing files
+//! (atomically) and choosing what to do with a refused checkpoint is the
+//! driver's business.
 //!
 //! A solve's future depends only on its per-vertex radiosity, its unshot
 //! radiosity, and the fixed inputs (scene, mesh, solver options); the step
@@ -27,16 +29,14 @@
 //! materials, the mesh's vertices and sample points, and the form-factor
 //! options. It leaves out the stopping rule (threshold, step limit), so a
 //! resumed run may go further than the interrupted one would have. A
-//! checkpoint whose fingerprint differs is refused with a message saying
-//! so; a truncated or corrupted one is refused by its length or checksum,
-//! before anything is allocated from its header's counts.
+//! driver refuses a checkpoint whose fingerprint differs from its solve's;
+//! [`decode`] refuses a truncated or corrupted one by its length or
+//! checksum, before anything is allocated from its header's counts.
 
 use crate::color::Rgb;
 use crate::mesh::Mesh;
-use crate::output::{self, OutputError};
 use crate::scene::Scene;
 use crate::solver::{FormFactorMethod, Progressive, ShooterSamples, SolverOptions};
-use std::path::{Path, PathBuf};
 
 /// The first eight bytes of every checkpoint file.
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
@@ -55,9 +55,10 @@ const CHECKSUM_LEN: usize = 8;
 
 /// Everything a progressive solve needs to continue exactly where it was.
 ///
-/// Invariants a solver checks on restore: `radiosity` has one entry per
-/// mesh vertex, `unshot` the solver's number of unshot entries (today one
-/// per polygon), every channel finite and `>= 0`.
+/// Invariants a solver checks on restore ([`Progressive::restore`]):
+/// `radiosity` has one entry per mesh vertex, `unshot` one per polygon or
+/// per mesh vertex (by [`SolverOptions::unshot`]), every channel finite and
+/// `>= 0`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolverState {
     /// Radiosity per mesh vertex, in the scene's emission units.
@@ -70,47 +71,41 @@ pub struct SolverState {
     pub rays: u64,
 }
 
-/// Why a checkpoint could not be read or used. Every message names the file.
-#[derive(Debug, thiserror::Error)]
-pub enum CheckpointError {
-    /// The file could not be read.
-    #[error("cannot read checkpoint {}: {error}", path.display())]
-    Read {
-        /// The checkpoint file.
-        path: PathBuf,
-        /// What the operating system said.
-        error: std::io::Error,
+/// Why checkpoint bytes cannot be decoded. The messages read as the end of
+/// a sentence about the file ("… is not a usable checkpoint: {this}").
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DecodeError {
+    /// The bytes do not start with [`MAGIC`].
+    #[error("it does not start like a radiosity checkpoint")]
+    NotACheckpoint,
+    /// Too short to hold a header and a checksum.
+    #[error("it is truncated ({len} bytes)")]
+    Truncated {
+        /// Its length, in bytes.
+        len: usize,
     },
-    /// The file is not a checkpoint of a supported version, or is damaged.
-    #[error("{} is not a usable checkpoint: {reason}", path.display())]
-    Invalid {
-        /// The checkpoint file.
-        path: PathBuf,
-        /// What is wrong with it.
-        reason: String,
+    /// A format version this build does not read (it reads [`VERSION`]).
+    #[error("it is format version {found}; this program reads version {VERSION}")]
+    Version {
+        /// The version in the header.
+        found: u32,
     },
-    /// The checkpoint was written for another scene, mesh or solver options.
+    /// The length differs from what the header's entry counts need.
     #[error(
-        "checkpoint {} was saved for a different scene, mesh or form-factor options \
-         (give the same scene, --lenmax, --inset, --form-factor, --shooter-samples and \
-         --no-near-field as the run that saved it)",
-        path.display()
+        "its length ({len} bytes) does not match its header ({radiosity} radiosity and \
+         {unshot} unshot entries): truncated or damaged"
     )]
-    Mismatch {
-        /// The checkpoint file.
-        path: PathBuf,
+    Length {
+        /// Its length, in bytes.
+        len: usize,
+        /// Radiosity entries the header promises.
+        radiosity: u64,
+        /// Unshot entries the header promises.
+        unshot: u64,
     },
-    /// The state does not fit the solver (a bug if the fingerprint matched).
-    #[error("checkpoint {} does not fit this solve: {reason}", path.display())]
-    Restore {
-        /// The checkpoint file.
-        path: PathBuf,
-        /// What the solver refused.
-        reason: String,
-    },
-    /// Writing the checkpoint failed.
-    #[error("{0}")]
-    Write(#[from] OutputError),
+    /// The trailing checksum does not match the bytes before it.
+    #[error("its checksum does not match: the file is damaged")]
+    Checksum,
 }
 
 /// A 64-bit FNV-1a style hash, fed whole words for speed. Stable across
@@ -247,12 +242,12 @@ fn encode_parts(
 
 /// Reads the fingerprint and state from checkpoint bytes, or says what is
 /// wrong with them. Never allocates more than the input's size.
-pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), String> {
+pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), DecodeError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
-        return Err("it does not start like a radiosity checkpoint".into());
+        return Err(DecodeError::NotACheckpoint);
     }
     if bytes.len() < HEADER_LEN + CHECKSUM_LEN {
-        return Err(format!("it is truncated ({} bytes)", bytes.len()));
+        return Err(DecodeError::Truncated { len: bytes.len() });
     }
     let u64_at = |at: usize| {
         let mut b = [0u8; 8];
@@ -263,9 +258,7 @@ pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), String> {
     v.copy_from_slice(&bytes[8..12]);
     let version = u32::from_le_bytes(v);
     if version != VERSION {
-        return Err(format!(
-            "it is format version {version}; this program reads version {VERSION}"
-        ));
+        return Err(DecodeError::Version { found: version });
     }
     let (fingerprint, steps, rays) = (u64_at(12), u64_at(20), u64_at(28));
     let (n_radiosity, n_unshot) = (u64_at(36), u64_at(44));
@@ -274,17 +267,17 @@ pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), String> {
         .and_then(|n| n.checked_mul(RGB_LEN as u64))
         .and_then(|n| n.checked_add((HEADER_LEN + CHECKSUM_LEN) as u64));
     if expected != Some(bytes.len() as u64) {
-        return Err(format!(
-            "its length ({} bytes) does not match its header ({n_radiosity} radiosity and \
-             {n_unshot} unshot entries): truncated or damaged",
-            bytes.len()
-        ));
+        return Err(DecodeError::Length {
+            len: bytes.len(),
+            radiosity: n_radiosity,
+            unshot: n_unshot,
+        });
     }
     let body = &bytes[..bytes.len() - CHECKSUM_LEN];
     let mut h = Fnv::new();
     h.bytes(body);
     if h.0 != u64_at(bytes.len() - CHECKSUM_LEN) {
-        return Err("its checksum does not match: the file is damaged".into());
+        return Err(DecodeError::Checksum);
     }
     let rgb_at = |k: usize| {
         let at = HEADER_LEN + k * RGB_LEN;
@@ -304,48 +297,6 @@ pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), String> {
             rays,
         },
     ))
-}
-
-/// Saves `solver`'s state to `path` atomically (temporary file + rename):
-/// the file is always either the previous checkpoint or the new one.
-pub fn save(path: &Path, fingerprint: u64, solver: &Progressive) -> Result<(), OutputError> {
-    let bytes = encode(fingerprint, solver);
-    output::write_atomically(path, |w| w.write_all(&bytes))
-}
-
-/// Reads the checkpoint at `path` and checks it was saved for a solve with
-/// `fingerprint`.
-pub fn load(path: &Path, fingerprint: u64) -> Result<SolverState, CheckpointError> {
-    let bytes = std::fs::read(path).map_err(|error| CheckpointError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    let (found, state) = decode(&bytes).map_err(|reason| CheckpointError::Invalid {
-        path: path.to_path_buf(),
-        reason,
-    })?;
-    if found != fingerprint {
-        return Err(CheckpointError::Mismatch {
-            path: path.to_path_buf(),
-        });
-    }
-    Ok(state)
-}
-
-/// Loads the checkpoint at `path` into `solver`, which must be a fresh
-/// solve of the same scene, mesh and options.
-pub fn resume(
-    path: &Path,
-    fingerprint: u64,
-    solver: &mut Progressive,
-) -> Result<(), CheckpointError> {
-    let state = load(path, fingerprint)?;
-    solver
-        .restore(state)
-        .map_err(|reason| CheckpointError::Restore {
-            path: path.to_path_buf(),
-            reason,
-        })
 }
 
 #[cfg(test)]
@@ -388,27 +339,14 @@ mod tests {
         // A header promising far more data than there is allocates nothing.
         let mut b = bytes.clone();
         b[36..44].copy_from_slice(&u64::MAX.to_le_bytes());
-        let e = decode(&b).unwrap_err();
+        let e = decode(&b).unwrap_err().to_string();
         assert!(e.contains("does not match its header"), "{e}");
         let mut b = bytes;
         b[8] = 9;
-        assert!(decode(&b).unwrap_err().contains("version 9"));
+        assert!(decode(&b).unwrap_err().to_string().contains("version 9"));
         assert!(decode(b"P6\n3 2\n255\n")
             .unwrap_err()
+            .to_string()
             .contains("does not start"));
-    }
-
-    #[test]
-    fn files_are_checked_against_the_fingerprint() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("solve.ckpt");
-        let bytes = encode_state(7, &state());
-        output::write_atomically(&path, |w| w.write_all(&bytes)).unwrap();
-        assert_eq!(load(&path, 7).unwrap(), state());
-        let e = load(&path, 8).unwrap_err();
-        assert!(matches!(e, CheckpointError::Mismatch { .. }), "{e}");
-        assert!(e.to_string().contains("different scene"), "{e}");
-        let e = load(&dir.path().join("missing"), 7).unwrap_err();
-        assert!(e.to_string().contains("cannot read checkpoint"), "{e}");
     }
 }

@@ -21,6 +21,7 @@
 
 pub mod checkpoint;
 pub mod formfactor;
+mod unshot;
 
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
@@ -30,6 +31,7 @@ use crate::visibility::Visibility;
 use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
+use unshot::UnshotField;
 
 /// Receiver vertices are grouped in runs of this many consecutive vertices
 /// of one polygon (a stretch of a grid row) for shaft culling: a shaft to
@@ -151,6 +153,63 @@ pub struct StepReport {
     pub clear_receivers: u64,
 }
 
+/// What the gather phase of a step counted.
+#[derive(Clone, Copy, Debug)]
+struct Gathered {
+    /// Sample–vertex pairs whose visibility mattered.
+    pairs: u64,
+    /// Shadow rays cast.
+    rays: u64,
+}
+
+/// A solver state that breaks [`Progressive`]'s invariants: found by
+/// [`Progressive::validate`] (a bug when it happens) or refused by
+/// [`Progressive::restore`] (a state saved for another solve).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SolverError {
+    /// The radiosity or unshot arrays do not have one entry per mesh
+    /// vertex (radiosity) and per unit of the unshot scheme.
+    #[error("array sizes do not match the mesh")]
+    MeshMismatch,
+    /// A vertex's radiosity is negative or not finite.
+    #[error("vertex {vertex} has radiosity {value:?}")]
+    BadRadiosity {
+        /// The mesh vertex.
+        vertex: usize,
+        /// Its radiosity, in the scene's emission units.
+        value: Rgb,
+    },
+    /// An unshot value is negative or not finite.
+    #[error("{unit} {index} has unshot radiosity {value:?}")]
+    BadUnshot {
+        /// What the value belongs to: "polygon" or "vertex" (by
+        /// [`SolverOptions::unshot`]).
+        unit: &'static str,
+        /// The polygon or mesh vertex.
+        index: usize,
+        /// Its unshot radiosity, in the scene's emission units.
+        value: Rgb,
+    },
+    /// A state to restore has other array sizes than this solve.
+    #[error(
+        "the saved state holds {radiosity} radiosity and {unshot} unshot values; \
+         this solve has {expected_radiosity} and {expected_unshot}"
+    )]
+    StateMismatch {
+        /// Radiosity entries in the state.
+        radiosity: usize,
+        /// Unshot entries in the state.
+        unshot: usize,
+        /// Radiosity entries this solve has (its mesh vertices).
+        expected_radiosity: usize,
+        /// Unshot entries this solve has.
+        expected_unshot: usize,
+    },
+    /// A state to restore holds a negative or non-finite value.
+    #[error("the saved state holds a negative or non-finite value")]
+    BadStateValue,
+}
+
 /// Why the solver stops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
@@ -165,7 +224,8 @@ pub enum StopReason {
 ///
 /// Invariants (checked by [`Progressive::validate`]): every radiosity and
 /// unshot value is finite and non-negative; one radiosity per mesh vertex
-/// and one unshot value per polygon.
+/// and one unshot value per polygon or per mesh vertex, by
+/// [`SolverOptions::unshot`].
 pub struct Progressive<'a> {
     mesh: MeshRef<'a>,
     visibility: &'a Visibility,
@@ -180,15 +240,7 @@ pub struct Progressive<'a> {
     radiosity: Vec<Rgb>,
     /// Unshot radiosity `Δb`: per polygon or per vertex, by
     /// [`SolverOptions::unshot`].
-    unshot: Vec<Rgb>,
-    /// Per vertex: the area it stands for ([`Mesh::vertex_areas`]).
-    vertex_area: Vec<f64>,
-    /// Per vertex: its weight in its polygon's mean
-    /// ([`Mesh::polygon_vertex_weights`]), for the per-polygon scheme.
-    mean_weight: Vec<f64>,
-    /// Per polygon and shooter sample: where its unshot radiosity is read
-    /// from (per-vertex scheme only).
-    sample_sources: Vec<Vec<SampleSource>>,
+    unshot: UnshotField,
     /// Scratch: the unshot radiosity each sample of the shooter carries.
     shot: Vec<Rgb>,
     /// Per vertex: scratch for the step's `Δrad`.
@@ -213,68 +265,6 @@ pub struct Progressive<'a> {
     initial_unshot_power: f64,
     steps: u64,
     rays: u64,
-}
-
-/// Where a shooter sample's unshot radiosity comes from in the per-vertex
-/// scheme.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum SampleSource {
-    /// The sample is this element vertex.
-    Vertex(u32),
-    /// Linear interpolation in an element triangle: its corners and
-    /// barycentric weights (summing to 1).
-    Triangle([u32; 3], [f32; 3]),
-    /// The area-weighted mean over the polygon's vertices (the one-sample
-    /// centre estimate).
-    PolygonMean,
-}
-
-/// Where each of a polygon's shooter samples reads its unshot radiosity.
-fn sample_sources(
-    mesh: &Mesh,
-    pm: &crate::mesh::PolygonMesh,
-    samples: &[ShooterSample],
-    set: SampleSet,
-) -> Vec<SampleSource> {
-    match set {
-        SampleSet::Centre => return vec![SampleSource::PolygonMean; samples.len()],
-        SampleSet::Vertices => return pm.vertices.clone().map(SampleSource::Vertex).collect(),
-        SampleSet::AtMost(_) => {}
-    }
-    samples
-        .iter()
-        .map(|s| {
-            // The element triangle holding the sample: the one whose
-            // smallest barycentric weight is largest (>= 0 inside).
-            let mut best = (f32::NEG_INFINITY, SampleSource::PolygonMean);
-            for e in pm.elements.clone() {
-                for tri in mesh.elements[e as usize].triangles() {
-                    let [a, b, c] = tri.map(|v| mesh.positions[v.index()]);
-                    let w = barycentric(s.position, a, b, c);
-                    let least = w[0].min(w[1]).min(w[2]);
-                    if least > best.0 {
-                        best = (least, SampleSource::Triangle(tri.map(|v| v.0), w));
-                    }
-                }
-            }
-            best.1
-        })
-        .collect()
-}
-
-/// Barycentric weights of `p` (projected into the triangle's plane) in
-/// the triangle `a b c`; zeros for a degenerate triangle.
-fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f32; 3] {
-    let (e1, e2, d) = (b - a, c - a, p - a);
-    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-    let (dp1, dp2) = (d.dot(e1), d.dot(e2));
-    let det = d11 * d22 - d12 * d12;
-    if det <= 0.0 {
-        return [0.0; 3];
-    }
-    let v = (d22 * dp1 - d12 * dp2) / det;
-    let w = (d11 * dp2 - d12 * dp1) / det;
-    [1.0 - v - w, v, w]
 }
 
 impl<'a> Progressive<'a> {
@@ -315,26 +305,7 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|p| emission[p.index()])
             .collect();
-        let vertex_area = mesh.vertex_areas();
-        let mean_weight = mesh
-            .polygons
-            .iter()
-            .flat_map(|pm| mesh.polygon_vertex_weights(pm))
-            .collect();
-        let (unshot, sample_sources) = match options.unshot {
-            UnshotScheme::Polygon => (emission.clone(), Vec::new()),
-            UnshotScheme::Vertex => (
-                mesh.vertex_polygon
-                    .iter()
-                    .map(|p| emission[p.index()])
-                    .collect(),
-                samples
-                    .iter()
-                    .zip(&mesh.polygons)
-                    .map(|(s, pm)| sample_sources(mesh, pm, s, set))
-                    .collect(),
-            ),
-        };
+        let unshot = UnshotField::new(options.unshot, mesh, &emission, &samples, set);
         let mut tiles = Vec::new();
         let mut tile_of = vec![0u32; mesh.vertex_count()];
         for pm in &mesh.polygons {
@@ -357,9 +328,6 @@ impl<'a> Progressive<'a> {
             samples,
             radiosity,
             unshot,
-            vertex_area,
-            mean_weight,
-            sample_sources,
             shot: Vec::new(),
             delta: vec![Rgb::BLACK; mesh.vertex_count()],
             receives: vec![false; mesh.polygons.len()],
@@ -384,9 +352,10 @@ impl<'a> Progressive<'a> {
         &self.radiosity
     }
 
-    /// Unshot radiosity per polygon.
+    /// Unshot radiosity `Δb`, in the scene's emission units: one value
+    /// per polygon or one per mesh vertex, by [`SolverOptions::unshot`].
     pub fn unshot(&self) -> &[Rgb] {
-        &self.unshot
+        self.unshot.values()
     }
 
     /// Emission per polygon.
@@ -425,7 +394,7 @@ impl<'a> Progressive<'a> {
         let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
         for (j, (rho, pm)) in self.reflectance.iter().zip(&self.mesh.polygons).enumerate() {
             area += pm.area;
-            unshot += self.polygon_unshot_mean(j) * pm.area;
+            unshot += self.unshot.mean(&self.mesh, j) * pm.area;
             reflected += *rho * pm.area;
         }
         if area <= 0.0 {
@@ -465,15 +434,7 @@ impl<'a> Progressive<'a> {
 
     /// Unshot power of polygon `j`, in radiosity × area units.
     fn polygon_unshot_power(&self, j: usize) -> f64 {
-        self.polygon_unshot_mean(j).mean() * self.mesh.polygons[j].area
-    }
-
-    /// Area-weighted mean unshot radiosity of polygon `j`.
-    fn polygon_unshot_mean(&self, j: usize) -> Rgb {
-        match self.options.unshot {
-            UnshotScheme::Polygon => self.unshot[j],
-            UnshotScheme::Vertex => self.polygon_mean(j, &self.unshot),
-        }
+        self.unshot.power(&self.mesh, j)
     }
 
     /// Unshot power at the start (the emitted power).
@@ -531,14 +492,7 @@ impl<'a> Progressive<'a> {
     /// The polygon with the most unshot power (the lowest index on ties),
     /// or `None` when nothing is left to shoot.
     pub fn next_shooter(&self) -> Option<PolygonId> {
-        let mut best: Option<(usize, f64)> = None;
-        for i in 0..self.mesh.polygons.len() {
-            let power = self.polygon_unshot_power(i);
-            if power > 0.0 && best.is_none_or(|(_, b)| power > b) {
-                best = Some((i, power));
-            }
-        }
-        best.map(|(i, _)| PolygonId(i as u32))
+        self.choose_shooter().map(|(shooter, _)| shooter)
     }
 
     /// One shooting step from the polygon with the most unshot power.
@@ -554,60 +508,154 @@ impl<'a> Progressive<'a> {
     /// returning `None`. A window uses it to quit promptly during a long
     /// step.
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
-        let shooter = self.next_shooter()?;
-        let i = shooter.index();
-        let shot_power = self.polygon_unshot_power(i);
-        self.fill_shot(i);
-        self.mark_receivers(i);
+        let (shooter, shot_power) = self.choose_shooter()?;
+        self.read_shooter(shooter);
+        self.cull(shooter);
+        let gathered = self.gather(shooter, cancel)?;
+        Some(self.apply(shooter, shot_power, gathered))
+    }
 
-        let mesh_ref = self.mesh.clone();
-        let mesh: &Mesh = &mesh_ref;
+    /// Phase 1, choose the shooter: the polygon with the most unshot power
+    /// (the lowest index on ties) and that power, in radiosity × area
+    /// units; `None` when nothing is left to shoot.
+    fn choose_shooter(&self) -> Option<(PolygonId, f64)> {
+        let mut best: Option<(usize, f64)> = None;
+        for i in 0..self.mesh.polygons.len() {
+            let power = self.polygon_unshot_power(i);
+            if power > 0.0 && best.is_none_or(|(_, b)| power > b) {
+                best = Some((i, power));
+            }
+        }
+        best.map(|(i, power)| (PolygonId(i as u32), power))
+    }
+
+    /// Phase 2, read the shooter's samples: fills `self.shot` with the
+    /// unshot radiosity each sample of `shooter` carries
+    /// ([`UnshotField::read_shooter`]).
+    fn read_shooter(&mut self, shooter: PolygonId) {
+        let i = shooter.index();
+        self.unshot
+            .read_shooter(&self.mesh, i, self.samples[i].len(), &mut self.shot);
+    }
+
+    /// Phase 3, cull: marks the receivers of `shooter` and, with shaft
+    /// culling, finds the polygons in each receiver's shaft to it and then
+    /// in each thin shaft between a receiver tile and a group of shooter
+    /// samples. Only the gather reads what this leaves in the scratch
+    /// arrays.
+    fn cull(&mut self, shooter: PolygonId) {
+        self.mark_receivers(shooter.index());
+        if self.options.shaft_culling {
+            self.cull_polygon_shafts(shooter);
+            self.cull_tile_shafts(shooter);
+        }
+    }
+
+    /// Shooter samples of polygon `i` are culled in groups of
+    /// [`SHOOTER_GROUP`]: the number of groups, at least 1.
+    fn shooter_groups(&self, i: usize) -> usize {
+        self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1)
+    }
+
+    /// Marks the polygons that can receive from shooter `i`: not `i`
+    /// itself, with some reflectance, some vertex in front of `i`'s plane
+    /// and some sample of `i` in front of their own plane. The others get
+    /// nothing and need no per-vertex work.
+    fn mark_receivers(&mut self, i: usize) {
+        let mesh: &Mesh = &self.mesh;
+        let shooter = &mesh.polygons[i];
+        let origin = self.samples[i]
+            .first()
+            .map(|s| s.position)
+            .unwrap_or_default();
+        for (j, pm) in mesh.polygons.iter().enumerate() {
+            let visible_side = || {
+                let range = pm.vertices.start as usize..pm.vertices.end as usize;
+                let in_front = mesh.sample_positions[range.clone()]
+                    .iter()
+                    .any(|&x| shooter.normal.dot(x - origin) > 0.0);
+                let x0 = mesh.sample_positions[range.start];
+                in_front
+                    && self.samples[i]
+                        .iter()
+                        .any(|s| pm.normal.dot(s.position - x0) > 0.0)
+            };
+            self.receives[j] = j != i
+                && !self.reflectance[j].is_black()
+                && pm.vertex_count() > 0
+                && visible_side();
+        }
+    }
+
+    /// Per receiver: the polygons in its shaft to `shooter`
+    /// (`self.candidates`; empty for polygons that do not receive).
+    fn cull_polygon_shafts(&mut self, shooter: PolygonId) {
+        let visibility = self.visibility;
+        let receives = &self.receives;
+        self.candidates
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(j, c)| {
+                if receives[j] {
+                    visibility.shaft_candidates(shooter, PolygonId(j as u32), c);
+                } else {
+                    c.clear();
+                }
+            });
+    }
+
+    /// Thin shafts between small groups of shooter samples and of receiver
+    /// vertices, searched among their polygons' candidates: per tile and
+    /// sample group, the polygons in the shaft between them
+    /// (`self.tile_candidates`).
+    fn cull_tile_shafts(&mut self, shooter: PolygonId) {
+        let i = shooter.index();
+        let mesh: &Mesh = &self.mesh;
+        let visibility = self.visibility;
+        let groups = self.shooter_groups(i);
+        self.group_points.clear();
+        self.group_points
+            .extend(self.samples[i].iter().map(|s| s.position));
+        let receives = &self.receives;
+        let group_points = &self.group_points;
+        let polygon_candidates = &self.candidates;
+        let tiles = &self.tiles;
+        self.tile_candidates
+            .resize_with(tiles.len() * groups, Vec::new);
+        self.tile_candidates
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(index, c)| {
+                let (t, g) = (index / groups, index % groups);
+                let Some(tile) = tiles.get(t) else {
+                    c.clear();
+                    return;
+                };
+                let j = mesh.vertex_polygon[tile.start as usize].index();
+                if receives[j] && !polygon_candidates[j].is_empty() {
+                    let to = &mesh.sample_positions[tile.start as usize..tile.end as usize];
+                    let from = &group_points
+                        [g * SHOOTER_GROUP..((g + 1) * SHOOTER_GROUP).min(group_points.len())];
+                    visibility.refine_candidates(from, to, &polygon_candidates[j], c);
+                } else {
+                    c.clear();
+                }
+            });
+    }
+
+    /// Phase 4, gather: every receiving vertex's `Δrad = ρ_j · Σ_k Δb_k ·
+    /// F(l → sample k)` into `self.delta` (black for the others), in
+    /// parallel. Each vertex's sum is independent of the others, so the
+    /// bits do not depend on the thread count. Returns `None` once
+    /// `cancel` is set, with the solution untouched (only scratch
+    /// written).
+    fn gather(&mut self, shooter: PolygonId, cancel: &AtomicBool) -> Option<Gathered> {
+        let i = shooter.index();
+        let mesh: &Mesh = &self.mesh;
         let visibility = self.visibility;
         let culling = self.options.shaft_culling;
+        let groups = self.shooter_groups(i);
         let receives = &self.receives;
-        // Shooter samples are culled in groups of SHOOTER_GROUP.
-        let groups = self.samples[i].len().div_ceil(SHOOTER_GROUP).max(1);
-        if culling {
-            self.candidates
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(j, c)| {
-                    if receives[j] {
-                        visibility.shaft_candidates(shooter, PolygonId(j as u32), c);
-                    } else {
-                        c.clear();
-                    }
-                });
-            // Thin shafts between small groups of shooter samples and of
-            // receiver vertices, searched among their polygons' candidates.
-            self.group_points.clear();
-            self.group_points
-                .extend(self.samples[i].iter().map(|s| s.position));
-            let group_points = &self.group_points;
-            let polygon_candidates = &self.candidates;
-            let tiles = &self.tiles;
-            self.tile_candidates
-                .resize_with(tiles.len() * groups, Vec::new);
-            self.tile_candidates
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(index, c)| {
-                    let (t, g) = (index / groups, index % groups);
-                    let Some(tile) = tiles.get(t) else {
-                        c.clear();
-                        return;
-                    };
-                    let j = mesh.vertex_polygon[tile.start as usize].index();
-                    if receives[j] && !polygon_candidates[j].is_empty() {
-                        let to = &mesh.sample_positions[tile.start as usize..tile.end as usize];
-                        let from = &group_points
-                            [g * SHOOTER_GROUP..((g + 1) * SHOOTER_GROUP).min(group_points.len())];
-                        visibility.refine_candidates(from, to, &polygon_candidates[j], c);
-                    } else {
-                        c.clear();
-                    }
-                });
-        }
         let tile_candidates = &self.tile_candidates;
         let tile_of = &self.tile_of;
         let samples = &self.samples[i];
@@ -662,7 +710,17 @@ impl<'a> Progressive<'a> {
         if cancel.load(Ordering::Relaxed) {
             return None;
         }
+        Some(Gathered { pairs, rays })
+    }
 
+    /// Phase 5, apply: adds the gathered `Δrad` to every receiver's
+    /// radiosity and unshot radiosity (polygon by polygon in index order,
+    /// so the sums are the same whatever the thread count), clears the
+    /// shooter's unshot radiosity and counts the step. `shot_power` is what
+    /// [`Progressive::choose_shooter`] found the shooter to hold.
+    fn apply(&mut self, shooter: PolygonId, shot_power: f64, gathered: Gathered) -> StepReport {
+        let mesh: &Mesh = &self.mesh;
+        let culling = self.options.shaft_culling;
         let (mut receivers, mut clear) = (0u64, 0u64);
         for (j, pm) in mesh.polygons.iter().enumerate() {
             if !self.receives[j] {
@@ -670,35 +728,19 @@ impl<'a> Progressive<'a> {
             }
             receivers += 1;
             clear += (culling && self.candidates[j].is_empty()) as u64;
-            let mut gathered = Rgb::BLACK;
             for l in pm.vertices.clone() {
-                let d = self.delta[l as usize];
-                self.radiosity[l as usize] += d;
-                match self.options.unshot {
-                    // Weighted as the polygon's mean is ([`Mesh::
-                    // polygon_vertex_weights`]): 1/n on a regular mesh, as
-                    // the original algorithm, area shares on a refined one.
-                    UnshotScheme::Polygon => gathered += d * self.mean_weight[l as usize],
-                    UnshotScheme::Vertex => self.unshot[l as usize] += d,
-                }
+                self.radiosity[l as usize] += self.delta[l as usize];
             }
-            if self.options.unshot == UnshotScheme::Polygon {
-                self.unshot[j] += gathered;
-            }
+            self.unshot.accumulate(mesh, j, &self.delta);
         }
+        let Gathered { pairs, rays } = gathered;
         self.pairs += pairs;
         self.receiver_pairs += receivers;
         self.clear_receiver_pairs += clear;
-        match self.options.unshot {
-            UnshotScheme::Polygon => self.unshot[i] = Rgb::BLACK,
-            UnshotScheme::Vertex => {
-                let range = &mesh.polygons[i].vertices;
-                self.unshot[range.start as usize..range.end as usize].fill(Rgb::BLACK);
-            }
-        }
+        self.unshot.clear(mesh, shooter.index());
         self.steps += 1;
         self.rays += rays;
-        Some(StepReport {
+        StepReport {
             step: self.steps,
             shooter,
             shot_power,
@@ -707,49 +749,6 @@ impl<'a> Progressive<'a> {
             pairs,
             receivers,
             clear_receivers: clear,
-        })
-    }
-
-    /// Fills `self.shot` with the unshot radiosity each sample of shooter
-    /// `i` carries: the polygon's value, or (per-vertex scheme) the value
-    /// read at the sample.
-    fn fill_shot(&mut self, i: usize) {
-        let n = self.samples[i].len();
-        self.shot.clear();
-        match self.options.unshot {
-            UnshotScheme::Polygon => self.shot.resize(n, self.unshot[i]),
-            UnshotScheme::Vertex => {
-                let mean = self.polygon_unshot_mean(i);
-                let mut shot = std::mem::take(&mut self.shot);
-                self.read_at_samples(i, &self.unshot, mean, &mut shot);
-                self.shot = shot;
-            }
-        }
-    }
-
-    /// Appends to `out` the per-vertex `field` read at each sample of
-    /// polygon `i` (per-vertex scheme: interpolated within the element
-    /// triangle holding the sample); `mean` for samples that stand for the
-    /// whole polygon.
-    fn read_at_samples(&self, i: usize, field: &[Rgb], mean: Rgb, out: &mut Vec<Rgb>) {
-        for source in &self.sample_sources[i] {
-            let value = match *source {
-                SampleSource::Vertex(l) => field[l as usize],
-                SampleSource::Triangle(v, w) => {
-                    let mut sum = Rgb::BLACK;
-                    for (l, weight) in v.iter().zip(w) {
-                        sum += field[*l as usize] * f64::from(weight.max(0.0));
-                    }
-                    sum / f64::from(
-                        w.iter()
-                            .map(|x| x.max(0.0))
-                            .sum::<f32>()
-                            .max(f32::MIN_POSITIVE),
-                    )
-                }
-                SampleSource::PolygonMean => mean,
-            };
-            out.push(value);
         }
     }
 
@@ -772,34 +771,12 @@ impl<'a> Progressive<'a> {
         refined: &Mesh,
         refiner: &Refiner,
     ) -> Option<checkpoint::SolverState> {
-        if self.options.unshot != UnshotScheme::Vertex {
-            return None;
-        }
+        let unshot = self.unshot.carried(refiner)?;
         let previous = refiner.previous_index();
-        let unshot = refiner.carry(&self.unshot);
         if previous.len() != refined.vertex_count() || unshot.len() != refined.vertex_count() {
             return None;
         }
-        let shot_field: Vec<Rgb> = self
-            .radiosity
-            .iter()
-            .zip(&self.unshot)
-            .map(|(b, u)| {
-                Rgb::new(
-                    (b.r - u.r).max(0.0),
-                    (b.g - u.g).max(0.0),
-                    (b.b - u.b).max(0.0),
-                )
-            })
-            .collect();
-        let shot: Vec<Vec<Rgb>> = (0..self.mesh.polygons.len())
-            .map(|i| {
-                let mut values = Vec::new();
-                let mean = self.polygon_mean(i, &shot_field);
-                self.read_at_samples(i, &shot_field, mean, &mut values);
-                values
-            })
-            .collect();
+        let shot = self.unshot.shot_at_samples(&self.mesh, &self.radiosity)?;
         let visibility = self.visibility;
         let near_field = self.options.near_field;
         let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
@@ -848,71 +825,24 @@ impl<'a> Progressive<'a> {
         })
     }
 
-    /// Area-weighted mean of a per-vertex field over polygon `j`.
-    fn polygon_mean(&self, j: usize, field: &[Rgb]) -> Rgb {
-        let pm = &self.mesh.polygons[j];
-        let mut sum = Rgb::BLACK;
-        for l in pm.vertices.clone() {
-            sum += field[l as usize] * self.vertex_area[l as usize];
-        }
-        if pm.area > 0.0 {
-            sum / pm.area
-        } else {
-            Rgb::BLACK
-        }
-    }
-
-    /// Marks the polygons that can receive from shooter `i`: not `i`
-    /// itself, with some reflectance, some vertex in front of `i`'s plane
-    /// and some sample of `i` in front of their own plane. The others get
-    /// nothing and need no per-vertex work.
-    fn mark_receivers(&mut self, i: usize) {
-        let mesh_ref = self.mesh.clone();
-        let mesh: &Mesh = &mesh_ref;
-        let shooter = &mesh.polygons[i];
-        let origin = self.samples[i]
-            .first()
-            .map(|s| s.position)
-            .unwrap_or_default();
-        for (j, pm) in mesh.polygons.iter().enumerate() {
-            let visible_side = || {
-                let range = pm.vertices.start as usize..pm.vertices.end as usize;
-                let in_front = mesh.sample_positions[range.clone()]
-                    .iter()
-                    .any(|&x| shooter.normal.dot(x - origin) > 0.0);
-                let x0 = mesh.sample_positions[range.start];
-                in_front
-                    && self.samples[i]
-                        .iter()
-                        .any(|s| pm.normal.dot(s.position - x0) > 0.0)
-            };
-            self.receives[j] = j != i
-                && !self.reflectance[j].is_black()
-                && pm.vertex_count() > 0
-                && visible_side();
-        }
-    }
-
     /// Checks the invariants; returns the first broken one.
-    pub fn validate(&self) -> Result<(), String> {
-        if self.radiosity.len() != self.mesh.vertex_count()
-            || self.unshot.len()
-                != match self.options.unshot {
-                    UnshotScheme::Polygon => self.mesh.polygons.len(),
-                    UnshotScheme::Vertex => self.mesh.vertex_count(),
-                }
-        {
-            return Err("array sizes do not match the mesh".into());
+    pub fn validate(&self) -> Result<(), SolverError> {
+        if self.radiosity.len() != self.mesh.vertex_count() || !self.unshot.fits(&self.mesh) {
+            return Err(SolverError::MeshMismatch);
         }
         let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
         if let Some(l) = self.radiosity.iter().position(bad) {
-            return Err(format!("vertex {l} has radiosity {:?}", self.radiosity[l]));
+            return Err(SolverError::BadRadiosity {
+                vertex: l,
+                value: self.radiosity[l],
+            });
         }
-        if let Some(j) = self.unshot.iter().position(bad) {
-            return Err(format!(
-                "polygon {j} has unshot radiosity {:?}",
-                self.unshot[j]
-            ));
+        if let Some(j) = self.unshot().iter().position(bad) {
+            return Err(SolverError::BadUnshot {
+                unit: self.unshot.unit(),
+                index: j,
+                value: self.unshot()[j],
+            });
         }
         Ok(())
     }
@@ -922,7 +852,7 @@ impl<'a> Progressive<'a> {
     pub fn state(&self) -> checkpoint::SolverState {
         checkpoint::SolverState {
             radiosity: self.radiosity.clone(),
-            unshot: self.unshot.clone(),
+            unshot: self.unshot().to_vec(),
             steps: self.steps,
             rays: self.rays,
         }
@@ -931,23 +861,23 @@ impl<'a> Progressive<'a> {
     /// Replaces the solve's state by a saved one from a solve of the same
     /// scene, mesh and options; refuses (and changes nothing) when the
     /// array sizes differ or a value is not finite and non-negative.
-    pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), String> {
-        if state.radiosity.len() != self.radiosity.len() || state.unshot.len() != self.unshot.len()
+    pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), SolverError> {
+        if state.radiosity.len() != self.radiosity.len()
+            || state.unshot.len() != self.unshot.values().len()
         {
-            return Err(format!(
-                "it holds {} radiosity and {} unshot values; this solve has {} and {}",
-                state.radiosity.len(),
-                state.unshot.len(),
-                self.radiosity.len(),
-                self.unshot.len()
-            ));
+            return Err(SolverError::StateMismatch {
+                radiosity: state.radiosity.len(),
+                unshot: state.unshot.len(),
+                expected_radiosity: self.radiosity.len(),
+                expected_unshot: self.unshot.values().len(),
+            });
         }
         let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
         if state.radiosity.iter().chain(&state.unshot).any(bad) {
-            return Err("it holds a negative or non-finite value".into());
+            return Err(SolverError::BadStateValue);
         }
         self.radiosity = state.radiosity;
-        self.unshot = state.unshot;
+        self.unshot.set_values(state.unshot);
         self.steps = state.steps;
         self.rays = state.rays;
         Ok(())

@@ -861,22 +861,6 @@ fn per_vertex_unshot_balances_energy_and_is_deterministic() {
     assert!(error < 0.005, "energy error {error}");
 }
 
-#[test]
-fn barycentric_weights_reproduce_the_point() {
-    let (a, b, c) = (
-        glam::Vec3::ZERO,
-        glam::Vec3::new(2.0, 0.0, 0.0),
-        glam::Vec3::new(0.0, 1.0, 1.0),
-    );
-    let p = a * 0.2 + b * 0.5 + c * 0.3;
-    let w = super::barycentric(p, a, b, c);
-    assert!(
-        (w[0] - 0.2).abs() < 1e-6 && (w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.3).abs() < 1e-6,
-        "{w:?}"
-    );
-    assert_eq!(super::barycentric(p, a, a, a), [0.0; 3]);
-}
-
 /// The unit square `BOTTOM` and the samples it shoots from at the default
 /// sample count (8 × 8 cells of a fine mesh).
 fn unit_square_samples() -> (crate::scene::Polygon, Vec<super::formfactor::ShooterSample>) {

@@ -1,0 +1,361 @@
+//! The unshot radiosity `Δb` of a progressive solve, kept per polygon or
+//! per element vertex ([`UnshotScheme`]).
+//!
+//! The two schemes differ in where light waits between shooting steps and
+//! so in four places: how much a polygon has left to shoot, what each of
+//! its shooter samples carries, how received light is added, and what is
+//! cleared after a polygon shoots. [`UnshotField`] holds the values with
+//! what its scheme needs to answer those questions, so the solver asks
+//! without knowing which scheme it runs.
+
+use super::formfactor::{SampleSet, ShooterSample};
+use super::UnshotScheme;
+use crate::color::Rgb;
+use crate::mesh::refine::Refiner;
+use crate::mesh::{Mesh, PolygonMesh};
+
+/// Unshot radiosity `Δb` (in the scene's emission units) and how it is laid
+/// out over a mesh.
+///
+/// Invariant: [`UnshotField::fits`] the mesh it was made for, that is one
+/// value per polygon ([`UnshotScheme::Polygon`]) or one per mesh vertex
+/// ([`UnshotScheme::Vertex`]); [`super::Progressive::validate`] checks it
+/// and that every value is finite and non-negative.
+#[derive(Clone, Debug)]
+pub(crate) struct UnshotField {
+    /// One value per polygon or per mesh vertex, by `layout`.
+    values: Vec<Rgb>,
+    /// The scheme, with what it needs beyond the values.
+    layout: Layout,
+}
+
+/// What each scheme needs to read and write its values.
+#[derive(Clone, Debug)]
+enum Layout {
+    /// One value per polygon.
+    Polygon {
+        /// Per vertex: its weight in its polygon's mean
+        /// ([`Mesh::polygon_vertex_weights`]), with which received light
+        /// is averaged into the polygon's value.
+        mean_weight: Vec<f64>,
+    },
+    /// One value per element vertex.
+    Vertex {
+        /// Per vertex: the area it stands for ([`Mesh::vertex_areas`]), in
+        /// square scene units, for polygon means.
+        vertex_area: Vec<f64>,
+        /// Per polygon and shooter sample: where its unshot radiosity is
+        /// read from.
+        sources: Vec<Vec<SampleSource>>,
+    },
+}
+
+/// Where a shooter sample's unshot radiosity comes from in the per-vertex
+/// scheme.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SampleSource {
+    /// The sample is this element vertex.
+    Vertex(u32),
+    /// Linear interpolation in an element triangle: its corners and
+    /// barycentric weights (summing to 1).
+    Triangle([u32; 3], [f32; 3]),
+    /// The area-weighted mean over the polygon's vertices (the one-sample
+    /// centre estimate).
+    PolygonMean,
+}
+
+impl UnshotField {
+    /// The field at the start of a solve: every polygon's (or vertex's)
+    /// `Δb = e`, its polygon's emission. `samples` are every polygon's
+    /// shooter samples, chosen as `set` says.
+    pub(crate) fn new(
+        scheme: UnshotScheme,
+        mesh: &Mesh,
+        emission: &[Rgb],
+        samples: &[Vec<ShooterSample>],
+        set: SampleSet,
+    ) -> Self {
+        match scheme {
+            UnshotScheme::Polygon => UnshotField {
+                values: emission.to_vec(),
+                layout: Layout::Polygon {
+                    mean_weight: mesh
+                        .polygons
+                        .iter()
+                        .flat_map(|pm| mesh.polygon_vertex_weights(pm))
+                        .collect(),
+                },
+            },
+            UnshotScheme::Vertex => UnshotField {
+                values: mesh
+                    .vertex_polygon
+                    .iter()
+                    .map(|p| emission[p.index()])
+                    .collect(),
+                layout: Layout::Vertex {
+                    vertex_area: mesh.vertex_areas(),
+                    sources: samples
+                        .iter()
+                        .zip(&mesh.polygons)
+                        .map(|(s, pm)| sample_sources(mesh, pm, s, set))
+                        .collect(),
+                },
+            },
+        }
+    }
+
+    /// The values: one per polygon or one per mesh vertex, by the scheme.
+    pub(crate) fn values(&self) -> &[Rgb] {
+        &self.values
+    }
+
+    /// The number of values this field has on `mesh`.
+    pub(crate) fn expected_len(&self, mesh: &Mesh) -> usize {
+        match self.layout {
+            Layout::Polygon { .. } => mesh.polygons.len(),
+            Layout::Vertex { .. } => mesh.vertex_count(),
+        }
+    }
+
+    /// True when the field has one value per unit of its scheme on `mesh`.
+    pub(crate) fn fits(&self, mesh: &Mesh) -> bool {
+        self.values.len() == self.expected_len(mesh)
+    }
+
+    /// What one value stands for ("polygon" or "vertex"), for messages.
+    pub(crate) fn unit(&self) -> &'static str {
+        match self.layout {
+            Layout::Polygon { .. } => "polygon",
+            Layout::Vertex { .. } => "vertex",
+        }
+    }
+
+    /// Replaces the values; the caller has checked that there are
+    /// [`UnshotField::expected_len`] of them, each finite and `>= 0`.
+    pub(crate) fn set_values(&mut self, values: Vec<Rgb>) {
+        self.values = values;
+    }
+
+    /// Area-weighted mean unshot radiosity of polygon `j`.
+    pub(crate) fn mean(&self, mesh: &Mesh, j: usize) -> Rgb {
+        match &self.layout {
+            Layout::Polygon { .. } => self.values[j],
+            Layout::Vertex { vertex_area, .. } => {
+                polygon_mean(&mesh.polygons[j], vertex_area, &self.values)
+            }
+        }
+    }
+
+    /// Unshot power of polygon `j`, `mean(Δb_j) · A_j` (the channel mean),
+    /// in radiosity × area units.
+    pub(crate) fn power(&self, mesh: &Mesh, j: usize) -> f64 {
+        self.mean(mesh, j).mean() * mesh.polygons[j].area
+    }
+
+    /// Writes into `out` (cleared first) the unshot radiosity each of
+    /// shooter `i`'s `samples` samples carries: the polygon's value, or
+    /// (per-vertex scheme) the field read at the sample.
+    pub(crate) fn read_shooter(&self, mesh: &Mesh, i: usize, samples: usize, out: &mut Vec<Rgb>) {
+        out.clear();
+        match &self.layout {
+            Layout::Polygon { .. } => out.resize(samples, self.values[i]),
+            Layout::Vertex {
+                vertex_area,
+                sources,
+            } => {
+                let mean = polygon_mean(&mesh.polygons[i], vertex_area, &self.values);
+                read_at_samples(&sources[i], &self.values, mean, out);
+            }
+        }
+    }
+
+    /// Adds what polygon `j` received in a step, `delta` (per mesh vertex,
+    /// read at `j`'s vertices), to its unshot radiosity.
+    pub(crate) fn accumulate(&mut self, mesh: &Mesh, j: usize, delta: &[Rgb]) {
+        let pm = &mesh.polygons[j];
+        match &self.layout {
+            Layout::Polygon { mean_weight } => {
+                // Weighted as the polygon's mean is ([`Mesh::
+                // polygon_vertex_weights`]): 1/n on a regular mesh, as
+                // the original algorithm, area shares on a refined one.
+                let mut gathered = Rgb::BLACK;
+                for l in pm.vertices.clone() {
+                    gathered += delta[l as usize] * mean_weight[l as usize];
+                }
+                self.values[j] += gathered;
+            }
+            Layout::Vertex { .. } => {
+                for l in pm.vertices.clone() {
+                    self.values[l as usize] += delta[l as usize];
+                }
+            }
+        }
+    }
+
+    /// Sets shooter `i`'s unshot radiosity to zero: it has shot it all.
+    pub(crate) fn clear(&mut self, mesh: &Mesh, i: usize) {
+        match self.layout {
+            Layout::Polygon { .. } => self.values[i] = Rgb::BLACK,
+            Layout::Vertex { .. } => {
+                let range = &mesh.polygons[i].vertices;
+                self.values[range.start as usize..range.end as usize].fill(Rgb::BLACK);
+            }
+        }
+    }
+
+    /// The unshot field carried over to the mesh `refiner` returned last
+    /// ([`Refiner::carry`]), so that every polygon keeps its unshot power;
+    /// `None` for the per-polygon scheme, which does not continue a solve
+    /// on a refined mesh.
+    pub(crate) fn carried(&self, refiner: &Refiner) -> Option<Vec<Rgb>> {
+        match self.layout {
+            Layout::Polygon { .. } => None,
+            Layout::Vertex { .. } => Some(refiner.carry(&self.values)),
+        }
+    }
+
+    /// Per polygon, what each of its shooter samples has shot so far:
+    /// `b − Δb` (clamped at zero per channel) read at the sample as
+    /// shooting reads `Δb`. `radiosity` is `b` per mesh vertex. `None` for
+    /// the per-polygon scheme, which cannot tell where on a polygon the
+    /// light it shot came from.
+    pub(crate) fn shot_at_samples(&self, mesh: &Mesh, radiosity: &[Rgb]) -> Option<Vec<Vec<Rgb>>> {
+        let Layout::Vertex {
+            vertex_area,
+            sources,
+        } = &self.layout
+        else {
+            return None;
+        };
+        let shot_field: Vec<Rgb> = radiosity
+            .iter()
+            .zip(&self.values)
+            .map(|(b, u)| {
+                Rgb::new(
+                    (b.r - u.r).max(0.0),
+                    (b.g - u.g).max(0.0),
+                    (b.b - u.b).max(0.0),
+                )
+            })
+            .collect();
+        Some(
+            mesh.polygons
+                .iter()
+                .zip(sources)
+                .map(|(pm, sources)| {
+                    let mut values = Vec::new();
+                    let mean = polygon_mean(pm, vertex_area, &shot_field);
+                    read_at_samples(sources, &shot_field, mean, &mut values);
+                    values
+                })
+                .collect(),
+        )
+    }
+}
+
+/// Area-weighted mean of a per-vertex `field` over polygon `pm`, with
+/// `vertex_area` the area each vertex stands for.
+fn polygon_mean(pm: &PolygonMesh, vertex_area: &[f64], field: &[Rgb]) -> Rgb {
+    let mut sum = Rgb::BLACK;
+    for l in pm.vertices.clone() {
+        sum += field[l as usize] * vertex_area[l as usize];
+    }
+    if pm.area > 0.0 {
+        sum / pm.area
+    } else {
+        Rgb::BLACK
+    }
+}
+
+/// Appends to `out` the per-vertex `field` read at each of a polygon's
+/// samples, whose `sources` say where (interpolated within the element
+/// triangle holding the sample); `mean` for samples that stand for the
+/// whole polygon.
+fn read_at_samples(sources: &[SampleSource], field: &[Rgb], mean: Rgb, out: &mut Vec<Rgb>) {
+    for source in sources {
+        let value = match *source {
+            SampleSource::Vertex(l) => field[l as usize],
+            SampleSource::Triangle(v, w) => {
+                let mut sum = Rgb::BLACK;
+                for (l, weight) in v.iter().zip(w) {
+                    sum += field[*l as usize] * f64::from(weight.max(0.0));
+                }
+                sum / f64::from(
+                    w.iter()
+                        .map(|x| x.max(0.0))
+                        .sum::<f32>()
+                        .max(f32::MIN_POSITIVE),
+                )
+            }
+            SampleSource::PolygonMean => mean,
+        };
+        out.push(value);
+    }
+}
+
+/// Where each of a polygon's shooter samples reads its unshot radiosity.
+fn sample_sources(
+    mesh: &Mesh,
+    pm: &PolygonMesh,
+    samples: &[ShooterSample],
+    set: SampleSet,
+) -> Vec<SampleSource> {
+    match set {
+        SampleSet::Centre => return vec![SampleSource::PolygonMean; samples.len()],
+        SampleSet::Vertices => return pm.vertices.clone().map(SampleSource::Vertex).collect(),
+        SampleSet::AtMost(_) => {}
+    }
+    samples
+        .iter()
+        .map(|s| {
+            // The element triangle holding the sample: the one whose
+            // smallest barycentric weight is largest (>= 0 inside).
+            let mut best = (f32::NEG_INFINITY, SampleSource::PolygonMean);
+            for e in pm.elements.clone() {
+                for tri in mesh.elements[e as usize].triangles() {
+                    let [a, b, c] = tri.map(|v| mesh.positions[v.index()]);
+                    let w = barycentric(s.position, a, b, c);
+                    let least = w[0].min(w[1]).min(w[2]);
+                    if least > best.0 {
+                        best = (least, SampleSource::Triangle(tri.map(|v| v.0), w));
+                    }
+                }
+            }
+            best.1
+        })
+        .collect()
+}
+
+/// Barycentric weights of `p` (projected into the triangle's plane) in
+/// the triangle `a b c`; zeros for a degenerate triangle.
+fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f32; 3] {
+    let (e1, e2, d) = (b - a, c - a, p - a);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (dp1, dp2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if det <= 0.0 {
+        return [0.0; 3];
+    }
+    let v = (d22 * dp1 - d12 * dp2) / det;
+    let w = (d11 * dp2 - d12 * dp1) / det;
+    [1.0 - v - w, v, w]
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn barycentric_weights_reproduce_the_point() {
+        let (a, b, c) = (
+            glam::Vec3::ZERO,
+            glam::Vec3::new(2.0, 0.0, 0.0),
+            glam::Vec3::new(0.0, 1.0, 1.0),
+        );
+        let p = a * 0.2 + b * 0.5 + c * 0.3;
+        let w = super::barycentric(p, a, b, c);
+        assert!(
+            (w[0] - 0.2).abs() < 1e-6 && (w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.3).abs() < 1e-6,
+            "{w:?}"
+        );
+        assert_eq!(super::barycentric(p, a, a, a), [0.0; 3]);
+    }
+}
