@@ -2,8 +2,10 @@
 #![warn(missing_docs)]
 
 pub mod batch;
+pub mod cli;
 pub mod color;
 pub mod config;
+pub mod drive;
 pub mod mesh;
 pub mod output;
 pub mod prepare;
