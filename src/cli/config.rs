@@ -30,8 +30,8 @@ pub enum Mode {
     /// `--resume`.
     Batch,
     /// Open the window; when it cannot open (no display, or the display
-    /// refuses), say why and run as [`Mode::Batch`] writes
-    /// `<scene>.png` in the current directory instead.
+    /// refuses), say why and run as [`Mode::Batch`] instead, writing
+    /// `<scene>.png` in the current directory.
     Window,
 }
 
