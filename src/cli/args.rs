@@ -1,6 +1,6 @@
 //! The raw arguments: clap's view of the command line, one field per
 //! option, parsed but not yet checked against each other or against the
-//! ranges their meaning needs (that is [`super::config`]'s job).
+//! ranges their meaning needs (that is [`super::invocation`]'s job).
 //!
 //! Each option's doc comment is its help: the first paragraph is the one
 //! line `-h` shows, the whole comment is what `--help` shows.

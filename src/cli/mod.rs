@@ -4,7 +4,7 @@
 //! the rest of the program sees (never `argv`).
 //!
 //! The layout follows ripgrep's `flags/`: `args` holds the raw options,
-//! `values` the value parsers, `config` the validation and the decisions
+//! `values` the value parsers, `invocation` the validation and the decisions
 //! taken once (window or batch). Bad values are [`ValueError`]s reported by
 //! clap or [`UsageError`]s from the conversion; both mean exit code 2.
 //!
@@ -18,9 +18,9 @@
 //! ```
 
 mod args;
-mod config;
+mod invocation;
 mod values;
 
 pub use args::{Args, EXIT_CODES};
-pub use config::{Invocation, Mode, UsageError};
+pub use invocation::{Invocation, Mode, UsageError};
 pub use values::{parse_shooter_samples, parse_size, ValueError};
