@@ -14,7 +14,7 @@ use std::sync::atomic::AtomicBool;
 /// results, `Ok(None)` when the window ran and the user closed it.
 ///
 /// A batch run stops with [`RunError::Interrupted`] once `cancel` is set.
-/// `arm_cancel` is called exactly once, just before a batch run starts and
+/// `arm_cancel` is called at most once, just before a batch run starts, and
 /// never when the window runs, so that a Ctrl-C handler setting `cancel` is
 /// installed only where `cancel` is polled: the window quits with its own
 /// keys, and a Ctrl-C in its terminal ends it the ordinary way.
