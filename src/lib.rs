@@ -3,8 +3,10 @@
 
 pub mod batch;
 pub mod camera;
+pub mod cli;
 pub mod color;
 pub mod config;
+pub mod drive;
 pub mod mesh;
 pub mod output;
 pub mod prepare;

@@ -242,6 +242,57 @@ fn help_documents_every_option() {
     }
 }
 
+/// `-h` gives one line per option; `--help` adds each option's long text.
+#[test]
+fn short_help_is_one_line_per_option_and_long_help_more() {
+    let short = run_in(&root(), &["-h"]);
+    let long = run_in(&root(), &["--help"]);
+    assert!(short.status.success() && long.status.success());
+    let short = String::from_utf8_lossy(&short.stdout).into_owned();
+    let long = String::from_utf8_lossy(&long.stdout).into_owned();
+    // Every line that names an option carries its summary on the same line.
+    let option_lines: Vec<&str> = short
+        .lines()
+        .filter(|l| l.trim_start().starts_with('-'))
+        .collect();
+    assert!(option_lines.len() > 30, "{short}");
+    for line in &option_lines {
+        let words = line.split_whitespace().count();
+        assert!(words > 2, "no summary on the option's line: `{line}`");
+    }
+    // Nothing but the option lines, a few headings and the exit codes.
+    assert!(
+        short.lines().count() < option_lines.len() + 15,
+        "-h is not short:\n{short}"
+    );
+    assert!(short.contains("130 interrupted"), "{short}");
+    // The long text is in --help only.
+    for detail in [
+        "a quadrature of the cell to 6",
+        "95th-percentile luminance",
+        "Possible values:",
+    ] {
+        assert!(long.contains(detail), "--help lacks `{detail}`");
+        assert!(!short.contains(detail), "-h has `{detail}`");
+    }
+    assert!(long.lines().count() > 2 * short.lines().count());
+}
+
+#[test]
+fn a_bad_choice_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [&["--unshot", "element"][..], &["--form-factor", "Wallace"]] {
+        let out = run_in(dir.path(), args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("possible values"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+    assert!(listing(dir.path()).is_empty());
+}
+
 #[test]
 fn without_a_display_it_says_why_and_writes_the_picture() {
     let dir = tempfile::tempdir().unwrap();

@@ -368,13 +368,33 @@ pub fn build(scene: &Scene, options: &MeshOptions) -> Result<Mesh, MeshError> {
     build_with_limit(scene, options, MAX_ELEMENTS)
 }
 
+/// `lenmax` itself when it is a usable longest element edge (a positive,
+/// finite number of scene units), else [`MeshError::BadLenmax`]. The one
+/// test of a lenmax: the command line checks its `--lenmax` with it before
+/// anything is loaded, and [`build`] and [`estimate`] check theirs.
+pub fn check_lenmax(lenmax: f32) -> Result<f32, MeshError> {
+    if lenmax.is_finite() && lenmax > 0.0 {
+        Ok(lenmax)
+    } else {
+        Err(MeshError::BadLenmax(lenmax))
+    }
+}
+
+/// `inset` itself when it is a usable boundary inset (a fraction of an
+/// element edge in `[0, 0.5)`, so an evaluation point stays well inside
+/// the boundary elements of its vertex), else [`MeshError::BadInset`]. The
+/// one test of an inset, as [`check_lenmax`] is of a lenmax.
+pub fn check_inset(inset: f32) -> Result<f32, MeshError> {
+    if inset.is_finite() && (0.0..0.5).contains(&inset) {
+        Ok(inset)
+    } else {
+        Err(MeshError::BadInset(inset))
+    }
+}
+
 fn check_options(options: &MeshOptions) -> Result<(), MeshError> {
-    if !(options.lenmax.is_finite() && options.lenmax > 0.0) {
-        return Err(MeshError::BadLenmax(options.lenmax));
-    }
-    if !(options.inset.is_finite() && (0.0..0.5).contains(&options.inset)) {
-        return Err(MeshError::BadInset(options.inset));
-    }
+    check_lenmax(options.lenmax)?;
+    check_inset(options.inset)?;
     Ok(())
 }
 
@@ -1135,6 +1155,22 @@ mod tests {
                     "sample {q} is not strictly inside"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn lenmax_and_inset_checks_accept_exactly_their_ranges() {
+        for good in [f32::MIN_POSITIVE, 0.01, 1e6] {
+            assert_eq!(check_lenmax(good), Ok(good));
+        }
+        for bad in [0.0, -0.0, -1.0, f32::NAN, f32::INFINITY] {
+            assert!(matches!(check_lenmax(bad), Err(MeshError::BadLenmax(_))));
+        }
+        for good in [0.0, DEFAULT_INSET, 0.499] {
+            assert_eq!(check_inset(good), Ok(good));
+        }
+        for bad in [-0.01, 0.5, 1.0, f32::NAN, f32::INFINITY] {
+            assert!(matches!(check_inset(bad), Err(MeshError::BadInset(_))));
         }
     }
 

@@ -44,6 +44,11 @@ pub const DEFAULT_THRESHOLD: f64 = 0.25;
 /// quarter of the initial edge length.
 pub const DEFAULT_LEVELS: u32 = 2;
 
+/// Most [`RefineOptions::levels`] accepted: each level can quadruple the
+/// elements where it splits, and six already cut an element's edges into
+/// 64, more than any shadow boundary of a sensible initial mesh needs.
+pub const MAX_LEVELS: u32 = 6;
+
 /// Values below this fraction of the field's area-weighted mean count as
 /// black when comparing a leaf's values (see the module docs).
 pub const DARK_FLOOR: f64 = 0.02;
@@ -55,12 +60,41 @@ pub struct RefineOptions {
     /// largest of them; in `(0, 1)`.
     pub threshold: f64,
     /// Split an initial element at most this many times (each halves the
-    /// edge length); at least 1.
+    /// edge length); in `1..=`[`MAX_LEVELS`].
     pub levels: u32,
     /// Refuse a pass whose mesh would have more elements than this (then
     /// [`Refiner::refine`] changes nothing and [`Refiner::refused`] says
     /// how many it would have had).
     pub max_elements: u64,
+}
+
+/// A [`RefineOptions`] field out of its range. The messages name the
+/// field, so a front end can prefix its own spelling of the option.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum OptionsError {
+    /// [`RefineOptions::threshold`] is not in `(0, 1)`: at 0 every leaf
+    /// with any variation splits, at 1 none ever does.
+    #[error("threshold must be above 0 and below 1, got {0}")]
+    Threshold(f64),
+    /// [`RefineOptions::levels`] is not in `1..=`[`MAX_LEVELS`].
+    #[error("levels must be between 1 and {MAX_LEVELS}, got {0}")]
+    Levels(u32),
+}
+
+impl RefineOptions {
+    /// Checks the documented ranges of [`RefineOptions::threshold`] and
+    /// [`RefineOptions::levels`] (every `max_elements` is usable: it only
+    /// refuses passes). The one test of these options, used by the command
+    /// line before anything is loaded.
+    pub fn validate(&self) -> Result<(), OptionsError> {
+        if !(self.threshold.is_finite() && self.threshold > 0.0 && self.threshold < 1.0) {
+            return Err(OptionsError::Threshold(self.threshold));
+        }
+        if !(1..=MAX_LEVELS).contains(&self.levels) {
+            return Err(OptionsError::Levels(self.levels));
+        }
+        Ok(())
+    }
 }
 
 impl Default for RefineOptions {
@@ -692,6 +726,29 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn options_are_validated_against_their_documented_ranges() {
+        assert_eq!(RefineOptions::default().validate(), Ok(()));
+        let with = |threshold, levels| RefineOptions {
+            threshold,
+            levels,
+            ..RefineOptions::default()
+        };
+        assert_eq!(with(0.999, MAX_LEVELS).validate(), Ok(()));
+        for t in [0.0, 1.0, -0.5, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                with(t, 1).validate(),
+                Err(OptionsError::Threshold(_))
+            ));
+        }
+        for levels in [0, MAX_LEVELS + 1] {
+            assert_eq!(
+                with(0.5, levels).validate(),
+                Err(OptionsError::Levels(levels))
+            );
         }
     }
 

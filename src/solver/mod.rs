@@ -61,12 +61,14 @@ pub const DEFAULT_THRESHOLD: f64 = 1e-3;
 pub const DEFAULT_SHOOTER_SAMPLES: u32 = 64;
 
 /// How form factors are estimated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum FormFactorMethod {
     /// Wallace's ray-traced sum over shooter sample points.
+    #[value(name = "wallace")]
     Wallace,
     /// One ray from the shooter's centre with the point-to-disc form factor:
     /// cheap, with blocky shadows.
+    #[value(name = "center")]
     Center,
 }
 
@@ -104,15 +106,17 @@ pub struct SolverOptions {
 }
 
 /// Where unshot radiosity is kept between shooting steps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum UnshotScheme {
     /// One value per polygon, the mean of what its vertices received: a
     /// polygon shoots as if lit evenly (the original algorithm).
+    #[value(name = "polygon")]
     Polygon,
     /// One value per element vertex: each shooter sample carries the
     /// unshot radiosity interpolated at its position (linearly within the
     /// element triangle holding it, as the picture shades), and a polygon's
     /// unshot power is the sum over its vertices of unshot × vertex area.
+    #[value(name = "vertex")]
     Vertex,
 }
 

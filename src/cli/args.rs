@@ -1,0 +1,230 @@
+//! The raw arguments: clap's view of the command line, one field per
+//! option, parsed but not yet checked against each other or against the
+//! ranges their meaning needs (that is [`super::invocation`]'s job).
+//!
+//! Each option's doc comment is its help: the first paragraph is the one
+//! line `-h` shows, the whole comment is what `--help` shows.
+
+use super::values::{parse_shooter_samples, parse_size};
+use crate::config;
+use crate::mesh::refine;
+use crate::mesh::DEFAULT_INSET;
+use crate::solver::{FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_THRESHOLD};
+use std::path::PathBuf;
+
+/// The exit codes, shown after both the short and the long help.
+pub const EXIT_CODES: &str =
+    "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage, \
+     130 interrupted (Ctrl-C; nothing is written but the --checkpoint).";
+
+/// Progressive-refinement radiosity renderer (ray-traced form factors after
+/// Wallace, Elmquist and Haines 1989).
+///
+/// Reads a .sc or .obj scene, meshes every polygon into elements, shoots
+/// light from the polygon with the most unshot power until the unshot power
+/// falls below the threshold, and writes a Gouraud-shaded picture.
+#[derive(clap::Parser, Clone, Debug, PartialEq)]
+#[command(name = "radiosity", version, about, after_help = EXIT_CODES)]
+pub struct Args {
+    /// Scene file: .sc, or .obj (Wavefront OBJ with its MTL materials).
+    ///
+    /// Without it, the bundled scenes/rtable.sc.
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Picture to write: .png or .tif/.tiff, .exr or .pfm.
+    ///
+    /// .png and .tif/.tiff are 8-bit and tone-mapped; .exr and .pfm hold
+    /// 32-bit float linear radiosity. Default: <scene-name>.png in the
+    /// current directory.
+    #[arg(short, long, value_name = "FILE")]
+    pub(crate) output: Option<PathBuf>,
+
+    /// Longest element edge, in scene units.
+    ///
+    /// Default: 1/80 of the scene's bounding-box diagonal.
+    #[arg(long, value_name = "L")]
+    pub(crate) lenmax: Option<f32>,
+
+    /// Inset of boundary vertices, as a fraction of an element edge.
+    ///
+    /// Boundary vertices are evaluated this far inside their polygon, so
+    /// room corners do not come out dark; 0 disables it.
+    #[arg(long, value_name = "F", default_value_t = DEFAULT_INSET)]
+    pub(crate) inset: f32,
+
+    /// Stop when the unshot power falls below this fraction of the emitted
+    /// power.
+    #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD)]
+    pub(crate) threshold: f64,
+
+    /// Stop after this many shooting steps at most.
+    #[arg(long, value_name = "N")]
+    pub(crate) max_steps: Option<u64>,
+
+    /// Form factor estimate.
+    #[arg(long, value_name = "METHOD", value_enum, default_value_t = FormFactorMethod::Wallace)]
+    pub(crate) form_factor: FormFactorMethod,
+
+    /// Shooter sample points per shooter: at most N, or `all`.
+    ///
+    /// Each shooter shoots from a regular grid of at most N cells (no more
+    /// than it has element vertices), one shadow ray each; `all` uses every
+    /// element vertex as a point sample (the original scheme, without the
+    /// near field; slow on fine meshes). Unit-square form factors are
+    /// within 0.06 % of exact at 16 or more; more points sample penumbrae
+    /// more finely.
+    // The literal is solver::DEFAULT_SHOOTER_SAMPLES (ShooterSamples has no
+    // Display for `default_value_t`); a unit test keeps the two equal.
+    #[arg(long, value_name = "N|all", default_value = "64", value_parser = parse_shooter_samples)]
+    pub(crate) shooter_samples: ShooterSamples,
+
+    /// Use the disc approximation however near the receiver.
+    ///
+    /// Every shooter sample then uses the plain disc approximation
+    /// a/(πr² + a); by default the exact point-to-cell form factor is used
+    /// within 1.5 cell diameters, a quadrature of the cell to 6.
+    #[arg(long)]
+    pub(crate) no_near_field: bool,
+
+    /// Test shadow rays against the whole scene (slower, same result).
+    ///
+    /// By default a shadow ray is tested only against the polygons in the
+    /// shaft between shooter and receiver; this is for comparison.
+    #[arg(long)]
+    pub(crate) no_shaft_culling: bool,
+
+    /// Where unshot radiosity is kept between shooting steps.
+    #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]
+    pub(crate) unshot: UnshotScheme,
+
+    /// Refine the mesh where the light changes sharply, and solve on.
+    ///
+    /// Once the solve converges, split the elements whose vertex
+    /// luminances differ by more than --adaptive-threshold (relative to the
+    /// largest), keep the mesh crack-free, and continue the solve on the
+    /// refined mesh (new vertices gather the light shot so far); repeat up
+    /// to --adaptive-levels times. Sharpens shadow boundaries where the
+    /// regular mesh blurs them.
+    #[arg(long, conflicts_with_all = ["checkpoint", "resume"])]
+    pub(crate) adaptive: bool,
+
+    /// Relative luminance difference that splits an element (--adaptive).
+    ///
+    /// An element is split when its vertex luminances differ by more than
+    /// this fraction of the largest of them.
+    #[arg(long, value_name = "T", default_value_t = refine::DEFAULT_THRESHOLD, requires = "adaptive")]
+    pub(crate) adaptive_threshold: f64,
+
+    /// Split each initial element at most this many times (--adaptive).
+    ///
+    /// Each split halves the element's edges.
+    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS, requires = "adaptive")]
+    pub(crate) adaptive_levels: u32,
+
+    /// Draw the element mesh over the written picture.
+    ///
+    /// As the window's `m` key does; 8-bit pictures only (.png or .tiff).
+    #[arg(long)]
+    pub(crate) mesh_lines: bool,
+
+    /// Picture size in pixels, overriding the scene's camera.
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub(crate) size: Option<(u32, u32)>,
+
+    /// Exposure multiplier for 8-bit pictures.
+    ///
+    /// Default: automatic (the 95th-percentile luminance maps to 0.9).
+    #[arg(long, value_name = "X")]
+    pub(crate) exposure: Option<f32>,
+
+    /// Write counts and seconds per phase as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) stats: Option<PathBuf>,
+
+    /// Take the camera from this .sc file.
+    ///
+    /// Its `camera` block is used (for .obj scenes, which have none; it
+    /// also overrides a .sc scene's camera). Without it an .obj scene is
+    /// framed automatically.
+    #[arg(long, value_name = "FILE.sc")]
+    pub(crate) camera: Option<PathBuf>,
+
+    /// Write the solved element mesh (.glb or .ply).
+    ///
+    /// .glb is glTF 2.0 binary (display colours as COLOR_0, linear
+    /// radiosity as _RADIOSITY); .ply is binary little-endian (float
+    /// radiosity and 8-bit colour per vertex). Runs in batch mode, as -o
+    /// does.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) export: Option<PathBuf>,
+
+    /// Write one CSV row per shooting step.
+    ///
+    /// Columns: step, shooter, unshot fraction, rays, seconds. Runs in batch
+    /// mode, as -o does.
+    #[arg(long, value_name = "FILE.csv")]
+    pub(crate) log: Option<PathBuf>,
+
+    /// Plot the unshot fraction per step as a PNG.
+    ///
+    /// The unshot fraction against the step, on a log axis. Runs in batch
+    /// mode, as -o does.
+    #[arg(long, value_name = "FILE.png")]
+    pub(crate) plot: Option<PathBuf>,
+
+    /// Worker threads for the solver and renderer.
+    ///
+    /// Default: all cores.
+    #[arg(long, value_name = "N")]
+    pub(crate) threads: Option<usize>,
+
+    /// Do not open a window even when a display is available.
+    ///
+    /// Solve and write the picture, as with -o.
+    #[arg(long)]
+    pub(crate) no_window: bool,
+
+    /// Show the ambient term on top of the solution.
+    ///
+    /// The ambient term (Cohen et al. 1988) is the unshot power spread
+    /// evenly and reflected; shown on top of the solution it keeps early
+    /// pictures from being too dark, fades as the solve converges and never
+    /// enters the solution. Default: on in the window, off for files.
+    #[arg(long, conflicts_with = "no_ambient")]
+    pub(crate) ambient: bool,
+
+    /// Never show the ambient term (see --ambient).
+    #[arg(long)]
+    pub(crate) no_ambient: bool,
+
+    /// Refuse meshes with more elements than this.
+    ///
+    /// The mesh is refused before it is built, and the message says which
+    /// --lenmax fits. The default allows meshes of up to about 3.7 GB
+    /// (estimated; 2.7 GB measured).
+    #[arg(long, value_name = "N", default_value_t = config::DEFAULT_MAX_ELEMENTS)]
+    pub(crate) max_elements: u64,
+
+    /// Save the solver state to this file, to resume it later.
+    ///
+    /// It is saved every --checkpoint-every seconds, on Ctrl-C and at the
+    /// end, so an interrupted solve can be resumed. Implies a batch run (no
+    /// window).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) checkpoint: Option<PathBuf>,
+
+    /// Seconds between checkpoints.
+    #[arg(long, value_name = "SECS", default_value_t = config::DEFAULT_CHECKPOINT_EVERY.as_secs_f64())]
+    pub(crate) checkpoint_every: f64,
+
+    /// Continue the solve saved in this checkpoint.
+    ///
+    /// Give the same scene and mesh and form-factor options; the result is
+    /// that of an uninterrupted run. Implies a batch run (no window).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) resume: Option<PathBuf>,
+
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}

@@ -1,0 +1,26 @@
+//! The command line: clap's definitions ([`Args`]), the parsers for
+//! structured values ([`parse_size`], [`parse_shooter_samples`]) and the
+//! conversion of the raw arguments into the one validated [`Invocation`]
+//! the rest of the program sees (never `argv`).
+//!
+//! The layout follows ripgrep's `flags/`: `args` holds the raw options,
+//! `values` the value parsers, `invocation` the validation and the decisions
+//! taken once (window or batch). Bad values are [`ValueError`]s reported by
+//! clap or [`UsageError`]s from the conversion; both mean exit code 2.
+//!
+//! ```
+//! use clap::Parser;
+//! use radiosity::cli::{Args, Invocation, Mode};
+//!
+//! let args = Args::try_parse_from(["radiosity", "scene.sc", "-o", "out.png"]).unwrap();
+//! let invocation = Invocation::try_from(args).unwrap();
+//! assert_eq!(invocation.mode, Mode::Batch);
+//! ```
+
+mod args;
+mod invocation;
+mod values;
+
+pub use args::{Args, EXIT_CODES};
+pub use invocation::{Invocation, Mode, UsageError};
+pub use values::{parse_shooter_samples, parse_size, ValueError};

@@ -1,0 +1,74 @@
+//! One run of the program from a validated [`Invocation`]: the batch run,
+//! or the window with its fallback to the batch run when no window can
+//! open. Both drivers are the [`batch`] and [`viewer`] entry points; this
+//! module only chooses between them, so the front end has one call to make.
+
+use crate::batch::{self, RunError, RunStats};
+use crate::cli::{Invocation, Mode};
+use crate::config::RunConfig;
+use crate::prepare::{self, Prepared};
+use crate::viewer::{self, ViewerError};
+use std::sync::atomic::AtomicBool;
+
+/// Runs `invocation`: `Ok(Some(stats))` when a batch run wrote its
+/// results, `Ok(None)` when the window ran and the user closed it.
+///
+/// A batch run stops with [`RunError::Interrupted`] once `cancel` is set.
+/// `arm_cancel` is called at most once, just before a batch run starts, and
+/// never when the window runs, so that a Ctrl-C handler setting `cancel` is
+/// installed only where `cancel` is polled: the window quits with its own
+/// keys, and a Ctrl-C in its terminal ends it the ordinary way.
+pub fn run(
+    invocation: &Invocation,
+    cancel: &AtomicBool,
+    arm_cancel: impl FnOnce(),
+) -> Result<Option<RunStats>, RunError> {
+    let config = &invocation.config;
+    match invocation.mode {
+        Mode::Batch => batch(config, None, cancel, arm_cancel),
+        Mode::Window => {
+            // Says why the picture goes to a file instead of a window.
+            let fallback = |why: &str| {
+                if !invocation.quiet() {
+                    eprintln!(
+                        "{why}: writing {} in the current directory instead",
+                        config.output_path().display()
+                    );
+                }
+            };
+            if let Err(why) = viewer::display_available() {
+                // Bad outputs are refused before the notice, which would
+                // otherwise promise a file that is never written.
+                batch::check_outputs(config)?;
+                fallback(&why);
+                return batch(config, None, cancel, arm_cancel);
+            }
+            let prepared = prepare::prepare(config)?;
+            match viewer::run(&prepared, config) {
+                Ok(()) => Ok(None),
+                Err(ViewerError::CannotOpen(why)) => {
+                    fallback(&why);
+                    batch(config, Some(&prepared), cancel, arm_cancel)
+                }
+                Err(ViewerError::View(e)) => Err(RunError::View(e)),
+                Err(ViewerError::Render(e)) => Err(RunError::Render(e)),
+            }
+        }
+    }
+}
+
+/// The batch run, from the scene or from a scene already `prepared` for a
+/// window that could not open: the one place a run is made cancellable.
+fn batch(
+    config: &RunConfig,
+    prepared: Option<&Prepared>,
+    cancel: &AtomicBool,
+    arm_cancel: impl FnOnce(),
+) -> Result<Option<RunStats>, RunError> {
+    arm_cancel();
+    match prepared {
+        None => batch::run(config, cancel),
+        Some(prepared) => batch::run_prepared(config, prepared, cancel),
+    }
+    .map(Some)
+}
