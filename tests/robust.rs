@@ -382,3 +382,56 @@ fn outputs_never_clobber_the_input_or_each_other() {
     }
     assert_eq!(std::fs::read_to_string(&input).unwrap(), text);
 }
+
+/// A resumed run's `--log` continues the log of the run that saved the
+/// checkpoint: the same steps, shooters, powers, unshot fractions and rays
+/// as one uninterrupted run, from step 1, and its clock never goes back.
+#[test]
+fn a_resumed_log_continues_the_interrupted_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("rtable.sc");
+    let scene = scene.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            scene,
+            "--lenmax",
+            "0.12",
+            "--shooter-samples",
+            "16",
+            "--threshold",
+            "0.01",
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        let out = run_in(dir.path(), &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    };
+    run(&["-o", "full.png", "--log", "full.csv"]);
+    // Stopped by a step limit after 12 steps, then resumed to the end.
+    run(&[
+        "-o",
+        "part.png",
+        "--max-steps",
+        "12",
+        "--checkpoint",
+        "ck.bin",
+    ]);
+    run(&["-o", "rest.png", "--resume", "ck.bin", "--log", "rest.csv"]);
+    let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
+    let (full, rest) = (read("full.csv"), read("rest.csv"));
+    let columns = |log: &str| -> Vec<String> {
+        log.lines()
+            .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+            .collect()
+    };
+    assert!(full.lines().count() > 13, "{full}");
+    assert_eq!(columns(&full), columns(&rest));
+    let seconds: Vec<f64> = rest
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit_once(',').unwrap().1.parse().unwrap())
+        .collect();
+    assert!(seconds.windows(2).all(|w| w[1] >= w[0]), "{seconds:?}");
+    let bytes = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    assert_eq!(bytes("full.png"), bytes("rest.png"));
+}

@@ -327,29 +327,33 @@ fn solve<'p>(
     cancel: &AtomicBool,
 ) -> Result<Solved<'p>, RunError> {
     let fingerprint = fingerprint(&prepared.scene, session.mesh(), &config.solver);
+    // The step log: a resumed run's continues the one saved with its
+    // checkpoint, and its clock continues from that log's last step.
+    let mut records = Vec::new();
     if let Some(path) = &config.resume {
-        let state = checkpoint::load(path, fingerprint)?;
+        let (state, log) = checkpoint::load(path, fingerprint)?;
         session
             .restore(state)
             .map_err(|reason| CheckpointError::Restore {
                 path: path.clone(),
                 reason,
             })?;
+        records = log;
     }
-    let save = |session: &Session| -> Result<(), RunError> {
+    let clock_offset = records.last().map_or(0.0, |r: &StepRecord| r.seconds);
+    let save = |session: &Session, records: &[StepRecord]| -> Result<(), RunError> {
         if let Some(path) = &config.checkpoint {
-            checkpoint::save(path, fingerprint, session.solver())?;
+            checkpoint::save(path, fingerprint, session.solver(), records)?;
         }
         Ok(())
     };
     let mut progress = Progress::new(config.progress, config.solver.threshold);
     let mut last_save = Instant::now();
     let start = Instant::now();
-    let mut records = Vec::new();
     loop {
         if cancel.load(Ordering::SeqCst) {
             progress.clear();
-            save(session)?;
+            save(session, &records)?;
             return Err(RunError::Interrupted {
                 steps: session.totals().steps,
                 checkpoint: config.checkpoint.clone(),
@@ -357,10 +361,6 @@ fn solve<'p>(
         }
         match session.advance(cancel)? {
             Event::Step(report) => {
-                if config.checkpoint.is_some() && last_save.elapsed() >= config.checkpoint_every {
-                    save(session)?;
-                    last_save = Instant::now();
-                }
                 records.push(StepRecord {
                     step: report.step,
                     shooter: report.shooter.0,
@@ -368,8 +368,12 @@ fn solve<'p>(
                     shot_power: report.shot_power,
                     unshot_fraction: report.unshot_fraction,
                     rays: report.rays,
-                    seconds: start.elapsed().as_secs_f64(),
+                    seconds: clock_offset + start.elapsed().as_secs_f64(),
                 });
+                if config.checkpoint.is_some() && last_save.elapsed() >= config.checkpoint_every {
+                    save(session, &records)?;
+                    last_save = Instant::now();
+                }
                 progress.step(&report, session.solver().rays());
             }
             Event::Stopped(_) | Event::Cancelled => {}
@@ -396,7 +400,7 @@ fn solve<'p>(
     if config.progress && config.adaptive.is_some() {
         say_pass(session, None);
     }
-    save(session)?;
+    save(session, &records)?;
     session.validate()?;
     let mut shown = Vec::new();
     session.shown(&mut shown);

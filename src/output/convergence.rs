@@ -11,7 +11,7 @@
 //! | `shot_power` | the power it shot, radiosity × area (scene units) |
 //! | `unshot_fraction` | unshot power left after the step ÷ emitted power |
 //! | `rays` | shadow rays cast in the step |
-//! | `seconds` | wall-clock seconds from the start of the solve to the end of the step |
+//! | `seconds` | wall-clock seconds from the start of the solve to the end of the step (a resumed solve's clock continues the saved one's) |
 //!
 //! Numbers are written in Rust's shortest round-trip form, so reading them
 //! back gives the very values of the run.

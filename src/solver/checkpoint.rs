@@ -9,21 +9,27 @@
 //! and ray counters are carried along for the statistics. Every value is
 //! stored as its exact `f64` bits, so a resumed solve continues bit for bit.
 //!
-//! The file format (version 1), all integers little-endian:
+//! The file format (version 2), all integers little-endian:
 //!
 //! ```text
 //! offset  size        field
 //! 0       8           magic "RADCKPT\0"
-//! 8       4           version (u32) = 1
+//! 8       4           version (u32) = 2
 //! 12      8           fingerprint (u64) of scene + mesh + solver options
 //! 20      8           steps taken (u64)
 //! 28      8           shadow rays cast (u64)
 //! 36      8           radiosity entries R (u64, one per mesh vertex)
 //! 44      8           unshot entries U (u64)
-//! 52      24 R        radiosity: r, g, b as f64 bits per vertex
+//! 52      8           driver record length X (u64, in bytes)
+//! 60      24 R        radiosity: r, g, b as f64 bits per vertex
 //! ...     24 U        unshot radiosity: r, g, b as f64 bits per entry
+//! ...     X           the driver's record, opaque here (the batch run keeps
+//!                     its step log there, so a resumed log continues)
 //! end-8   8           checksum (u64): FNV-1a of every byte before it
 //! ```
+//!
+//! Version 1 is version 2 without the record-length field and the record
+//! (its header is 52 bytes); it is still read, with an empty record.
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
 //! materials, the mesh's vertices and sample points, and the form-factor
@@ -42,10 +48,16 @@ use crate::solver::{FormFactorMethod, Progressive, ShooterSamples, SolverOptions
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
+
+/// The oldest format version this build still reads.
+pub const OLDEST_VERSION: u32 = 1;
 
 /// Bytes before the radiosity data.
-const HEADER_LEN: usize = 52;
+const HEADER_LEN: usize = 60;
+
+/// Bytes before the radiosity data in version 1.
+const V1_HEADER_LEN: usize = 52;
 
 /// Bytes of one stored [`Rgb`].
 const RGB_LEN: usize = 24;
@@ -84,8 +96,11 @@ pub enum DecodeError {
         /// Its length, in bytes.
         len: usize,
     },
-    /// A format version this build does not read (it reads [`VERSION`]).
-    #[error("it is format version {found}; this program reads version {VERSION}")]
+    /// A format version this build does not read (it reads
+    /// [`OLDEST_VERSION`] to [`VERSION`]).
+    #[error(
+        "it is format version {found}; this program reads versions {OLDEST_VERSION} to {VERSION}"
+    )]
     Version {
         /// The version in the header.
         found: u32,
@@ -93,7 +108,7 @@ pub enum DecodeError {
     /// The length differs from what the header's entry counts need.
     #[error(
         "its length ({len} bytes) does not match its header ({radiosity} radiosity and \
-         {unshot} unshot entries): truncated or damaged"
+         {unshot} unshot entries, {record} record bytes): truncated or damaged"
     )]
     Length {
         /// Its length, in bytes.
@@ -102,6 +117,8 @@ pub enum DecodeError {
         radiosity: u64,
         /// Unshot entries the header promises.
         unshot: u64,
+        /// Driver record bytes the header promises.
+        record: u64,
     },
     /// The trailing checksum does not match the bytes before it.
     #[error("its checksum does not match: the file is damaged")]
@@ -186,25 +203,39 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     h.0
 }
 
-/// The bytes of a checkpoint of `solver`'s current state.
-pub fn encode(fingerprint: u64, solver: &Progressive) -> Vec<u8> {
+/// A decoded checkpoint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    /// The [`fingerprint`] of the solve it was saved from.
+    pub fingerprint: u64,
+    /// The solver's state.
+    pub state: SolverState,
+    /// The driver's record saved with it (empty if none, or version 1).
+    pub record: Vec<u8>,
+}
+
+/// The bytes of a checkpoint of `solver`'s current state, with the
+/// driver's `record` (opaque here).
+pub fn encode(fingerprint: u64, solver: &Progressive, record: &[u8]) -> Vec<u8> {
     encode_parts(
         fingerprint,
         solver.radiosity(),
         solver.unshot(),
         solver.steps(),
         solver.rays(),
+        record,
     )
 }
 
-/// The bytes of a checkpoint of `state`.
-pub fn encode_state(fingerprint: u64, state: &SolverState) -> Vec<u8> {
+/// The bytes of a checkpoint of `state`, with the driver's `record`.
+pub fn encode_state(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
     encode_parts(
         fingerprint,
         &state.radiosity,
         &state.unshot,
         state.steps,
         state.rays,
+        record,
     )
 }
 
@@ -214,8 +245,9 @@ fn encode_parts(
     unshot: &[Rgb],
     steps: u64,
     rays: u64,
+    record: &[u8],
 ) -> Vec<u8> {
-    let len = HEADER_LEN + RGB_LEN * (radiosity.len() + unshot.len()) + CHECKSUM_LEN;
+    let len = HEADER_LEN + RGB_LEN * (radiosity.len() + unshot.len()) + record.len() + CHECKSUM_LEN;
     let mut out = Vec::with_capacity(len);
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
@@ -225,6 +257,7 @@ fn encode_parts(
         rays,
         radiosity.len() as u64,
         unshot.len() as u64,
+        record.len() as u64,
     ] {
         out.extend_from_slice(&w.to_le_bytes());
     }
@@ -233,6 +266,7 @@ fn encode_parts(
             out.extend_from_slice(&x.to_bits().to_le_bytes());
         }
     }
+    out.extend_from_slice(record);
     let mut h = Fnv::new();
     h.bytes(&out);
     out.extend_from_slice(&h.0.to_le_bytes());
@@ -240,13 +274,14 @@ fn encode_parts(
     out
 }
 
-/// Reads the fingerprint and state from checkpoint bytes, or says what is
-/// wrong with them. Never allocates more than the input's size.
-pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), DecodeError> {
+/// Reads the fingerprint, state and driver record from checkpoint bytes
+/// (version 1 or 2), or says what is wrong with them. Never allocates more
+/// than the input's size.
+pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(DecodeError::NotACheckpoint);
     }
-    if bytes.len() < HEADER_LEN + CHECKSUM_LEN {
+    if bytes.len() < V1_HEADER_LEN + CHECKSUM_LEN {
         return Err(DecodeError::Truncated { len: bytes.len() });
     }
     let u64_at = |at: usize| {
@@ -257,20 +292,31 @@ pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), DecodeError> {
     let mut v = [0u8; 4];
     v.copy_from_slice(&bytes[8..12]);
     let version = u32::from_le_bytes(v);
-    if version != VERSION {
+    if !(OLDEST_VERSION..=VERSION).contains(&version) {
         return Err(DecodeError::Version { found: version });
+    }
+    let header_len = if version == 1 {
+        V1_HEADER_LEN
+    } else {
+        HEADER_LEN
+    };
+    if bytes.len() < header_len + CHECKSUM_LEN {
+        return Err(DecodeError::Truncated { len: bytes.len() });
     }
     let (fingerprint, steps, rays) = (u64_at(12), u64_at(20), u64_at(28));
     let (n_radiosity, n_unshot) = (u64_at(36), u64_at(44));
+    let n_record = if version == 1 { 0 } else { u64_at(52) };
     let expected = n_radiosity
         .checked_add(n_unshot)
         .and_then(|n| n.checked_mul(RGB_LEN as u64))
-        .and_then(|n| n.checked_add((HEADER_LEN + CHECKSUM_LEN) as u64));
+        .and_then(|n| n.checked_add(n_record))
+        .and_then(|n| n.checked_add((header_len + CHECKSUM_LEN) as u64));
     if expected != Some(bytes.len() as u64) {
         return Err(DecodeError::Length {
             len: bytes.len(),
             radiosity: n_radiosity,
             unshot: n_unshot,
+            record: n_record,
         });
     }
     let body = &bytes[..bytes.len() - CHECKSUM_LEN];
@@ -280,7 +326,7 @@ pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), DecodeError> {
         return Err(DecodeError::Checksum);
     }
     let rgb_at = |k: usize| {
-        let at = HEADER_LEN + k * RGB_LEN;
+        let at = header_len + k * RGB_LEN;
         Rgb::new(
             f64::from_bits(u64_at(at)),
             f64::from_bits(u64_at(at + 8)),
@@ -288,15 +334,17 @@ pub fn decode(bytes: &[u8]) -> Result<(u64, SolverState), DecodeError> {
         )
     };
     let (nr, nu) = (n_radiosity as usize, n_unshot as usize);
-    Ok((
+    let record_start = header_len + (nr + nu) * RGB_LEN;
+    Ok(Checkpoint {
         fingerprint,
-        SolverState {
+        state: SolverState {
             radiosity: (0..nr).map(rgb_at).collect(),
             unshot: (nr..nr + nu).map(rgb_at).collect(),
             steps,
             rays,
         },
-    ))
+        record: body[record_start..].to_vec(),
+    })
 }
 
 #[cfg(test)]
@@ -314,16 +362,38 @@ mod tests {
 
     #[test]
     fn round_trip_keeps_every_bit() {
-        let bytes = encode_state(0xfeed, &state());
-        let (fp, back) = decode(&bytes).unwrap();
+        let bytes = encode_state(0xfeed, &state(), b"log");
+        let Checkpoint {
+            fingerprint: fp,
+            state: back,
+            record,
+        } = decode(&bytes).unwrap();
+        assert_eq!(record, b"log");
         assert_eq!(fp, 0xfeed);
         assert_eq!(back, state());
         assert_eq!(back.radiosity[1].b.to_bits(), 5e-324f64.to_bits());
     }
 
     #[test]
+    fn version_1_files_still_read() {
+        // Version 1 is version 2 without the record-length field.
+        let v2 = encode_state(5, &state(), b"");
+        let mut v1 = v2[..8].to_vec();
+        v1.extend_from_slice(&1u32.to_le_bytes());
+        v1.extend_from_slice(&v2[12..52]);
+        v1.extend_from_slice(&v2[60..v2.len() - CHECKSUM_LEN]);
+        let mut h = Fnv::new();
+        h.bytes(&v1);
+        v1.extend_from_slice(&h.0.to_le_bytes());
+        let back = decode(&v1).unwrap();
+        assert_eq!(back.fingerprint, 5);
+        assert_eq!(back.state, state());
+        assert!(back.record.is_empty());
+    }
+
+    #[test]
     fn damage_of_any_kind_is_refused() {
-        let bytes = encode_state(1, &state());
+        let bytes = encode_state(1, &state(), b"record");
         // Every truncation.
         for len in 0..bytes.len() {
             assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");
