@@ -135,7 +135,7 @@ fn encode_log(log: &[StepRecord]) -> Vec<u8> {
 /// The step log back from a driver record; `None` when its length is not
 /// a whole number of steps.
 fn decode_log(bytes: &[u8]) -> Option<Vec<StepRecord>> {
-    if bytes.len() % LOG_RECORD_LEN != 0 {
+    if !bytes.len().is_multiple_of(LOG_RECORD_LEN) {
         return None;
     }
     let words = |chunk: &[u8]| -> [u64; 7] {
