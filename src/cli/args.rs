@@ -23,6 +23,9 @@ pub const EXIT_CODES: &str =
 /// Reads a .sc or .obj scene, meshes every polygon into elements, shoots
 /// light from the polygon with the most unshot power until the unshot power
 /// falls below the threshold, and writes a Gouraud-shaded picture.
+// The field docs are plain help text, where `<scene-name>` is a
+// placeholder, not an HTML tag.
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(clap::Parser, Clone, Debug, PartialEq)]
 #[command(name = "radiosity", version, about, after_help = EXIT_CODES)]
 pub struct Args {

@@ -6,7 +6,7 @@
 use crate::solver::ShooterSamples;
 
 /// An option value that does not parse. clap prints the message after its
-/// own "invalid value 'TEXT' for '--OPTION <NAME>': "; it is still a whole
+/// own `invalid value 'TEXT' for '--OPTION <NAME>': `; it is still a whole
 /// sentence naming the option, so it reads the same wherever it is shown.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ValueError {
