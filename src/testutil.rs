@@ -129,9 +129,10 @@ fn closed_box_faces_inward() {
     }
 }
 
-/// A closed 2-unit box with one glowing wall (emission 10, reflectance
-/// 0.3) and the others of reflectance 0.7 and 0.4: every polygon reflects,
-/// so its energy balance is a closed form.
+/// A closed 2-unit box whose ceiling glows (emission 10) and reflects
+/// (0.3), with walls of reflectances 0.7 and 0.4: every polygon reflects,
+/// so its energy balance is a closed form. (A lamp hanging inside would
+/// absorb light on its black back, which no wall's balance sees.)
 pub fn glowing_box() -> Scene {
     scene(
         closed_box(2.0, [1, 2, 1, 0, 1, 2]),

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::mesh::{self, MeshOptions};
-use crate::testutil::{closed_box, grey, polygon, scene};
+use crate::testutil::{closed_box, glowing_box, grey, polygon, scene, shadowed_box};
 
 /// Exact form factor between two coaxial parallel unit squares one unit
 /// apart (Howell's catalogue, C-11).
@@ -330,25 +330,7 @@ fn continued_refinement_keeps_closed_forms() {
 /// the sum of the steps' contributions exactly, up to rounding.
 #[test]
 fn continued_refinement_matches_a_fresh_solve() {
-    let mut polygons = closed_box(2.0, [1, 2, 1, 0, 1, 2]);
-    // Facing up, low over the floor: a sharp shadow under it.
-    polygons.push(polygon(
-        1,
-        &[
-            [0.6, 0.3, 0.6],
-            [0.6, 0.3, 1.4],
-            [1.4, 0.3, 1.4],
-            [1.4, 0.3, 0.6],
-        ],
-    ));
-    let s = scene(
-        polygons,
-        vec![
-            grey("lamp", 10.0, 0.3),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    );
+    let s = shadowed_box();
     assert!(s.polygons[6].normal.y > 0.0);
     let options = SolverOptions {
         threshold: 1e-4,
@@ -530,20 +512,6 @@ fn energy_balance_in_an_open_box() {
         };
         assert!(error < bound, "{unshot:?}: energy error {error}");
     }
-}
-
-/// A box whose ceiling glows and reflects, with walls of different
-/// reflectances. (A lamp hanging inside would absorb light on its black
-/// back, which no wall's balance sees.)
-fn glowing_box() -> Scene {
-    scene(
-        closed_box(2.0, [1, 2, 1, 0, 1, 2]),
-        vec![
-            grey("lamp", 10.0, 0.3),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    )
 }
 
 /// `|absorbed + unshot − emitted| / emitted` of a solve of a closed scene
