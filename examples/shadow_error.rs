@@ -79,12 +79,7 @@ fn main() {
             prepare::prepare(&config).expect("the scene prepared once already");
         let view = prepared.view(&config).expect("the camera file's camera");
         let t = Instant::now();
-        let mut session = Session::new(
-            &prepared.scene,
-            &prepared.mesh,
-            &prepared.visibility,
-            config.session_options(false),
-        );
+        let mut session = Session::from_prepared(&prepared, config.session_options(false));
         session
             .run_to_end(&AtomicBool::new(false))
             .expect("an uncancelled solve");

@@ -43,12 +43,7 @@ fn main() {
         }
     };
     let start = std::time::Instant::now();
-    let mut session = Session::new(
-        &prepared.scene,
-        &prepared.mesh,
-        &prepared.visibility,
-        config.session_options(false),
-    );
+    let mut session = Session::from_prepared(&prepared, config.session_options(false));
     if let Err(e) = session.run_to_end(&AtomicBool::new(false)) {
         eprintln!("{e}");
         std::process::exit(1);

@@ -27,6 +27,7 @@
 use crate::color::Rgb;
 use crate::mesh::refine::{RefineOptions, RefineReport, Refiner, Refused};
 use crate::mesh::{Mesh, MeshRef};
+use crate::prepare::Prepared;
 use crate::scene::Scene;
 use crate::solver::{Progressive, SolverError, SolverOptions, StepReport, StopReason};
 use crate::visibility::Visibility;
@@ -181,6 +182,16 @@ impl<'p> Session<'p> {
                 rays: 0,
             },
         }
+    }
+
+    /// Starts a session on a prepared scene's mesh.
+    pub fn from_prepared(prepared: &'p Prepared, options: SessionOptions) -> Session<'p> {
+        Session::new(
+            &prepared.scene,
+            &prepared.mesh,
+            &prepared.visibility,
+            options,
+        )
     }
 
     /// Continues from a saved state of a solve of the same scene, mesh and

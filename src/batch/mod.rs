@@ -210,12 +210,7 @@ pub fn run_prepared(
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
-    let mut session = Session::new(
-        &prepared.scene,
-        &prepared.mesh,
-        &prepared.visibility,
-        config.session_options(false),
-    );
+    let mut session = Session::from_prepared(prepared, config.session_options(false));
     let solved = solve(config, prepared, &mut session, cancel)?;
     seconds.solve = t.elapsed().as_secs_f64();
     let mesh: &crate::mesh::Mesh = &solved.mesh;

@@ -191,12 +191,7 @@ fn solve_in_background<'p>(
     progress: &Mutex<Progress<'p>>,
     control: &Control,
 ) {
-    let mut session = Session::new(
-        &prepared.scene,
-        &prepared.mesh,
-        &prepared.visibility,
-        config.session_options(true),
-    );
+    let mut session = Session::from_prepared(prepared, config.session_options(true));
     let levels = session.max_refinements();
     if let Ok(mut p) = progress.lock() {
         session.shown(&mut p.radiosity);
