@@ -19,7 +19,7 @@ use radiosity::config::{RunConfig, SceneSource};
 use radiosity::mesh::refine::RefineOptions;
 use radiosity::prepare::{self, Prepared};
 use radiosity::render::Frame;
-use radiosity::session::Session;
+use radiosity::session::{Session, SessionOptions};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -79,7 +79,8 @@ fn main() {
             prepare::prepare(&config).expect("the scene prepared once already");
         let view = prepared.view(&config).expect("the camera file's camera");
         let t = Instant::now();
-        let mut session = Session::from_prepared(&prepared, config.session_options(false));
+        let mut session =
+            Session::from_prepared(&prepared, SessionOptions::for_run(&config, false));
         session
             .run_to_end(&AtomicBool::new(false))
             .expect("an uncancelled solve");

@@ -14,7 +14,7 @@ use radiosity::color::Rgb;
 use radiosity::config::{RunConfig, SceneSource};
 use radiosity::mesh::refine::RefineOptions;
 use radiosity::prepare;
-use radiosity::session::Session;
+use radiosity::session::{Session, SessionOptions};
 use radiosity::solver::UnshotScheme;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -43,7 +43,7 @@ fn main() {
         }
     };
     let start = std::time::Instant::now();
-    let mut session = Session::from_prepared(&prepared, config.session_options(false));
+    let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&config, false));
     if let Err(e) = session.run_to_end(&AtomicBool::new(false)) {
         eprintln!("{e}");
         std::process::exit(1);

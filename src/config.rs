@@ -5,7 +5,6 @@
 
 use crate::mesh::{self, refine::RefineOptions};
 use crate::render::Exposure;
-use crate::session::SessionOptions;
 use crate::solver::SolverOptions;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -164,17 +163,5 @@ impl RunConfig {
         self.output
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("{}.png", self.scene.stem())))
-    }
-
-    /// The solve session's options; `ambient_default` is whether the
-    /// ambient term is shown when the user did not say (on in the window,
-    /// off for files).
-    pub fn session_options(&self, ambient_default: bool) -> SessionOptions {
-        SessionOptions {
-            solver: self.solver,
-            refine: self.adaptive,
-            max_elements: self.max_elements,
-            ambient: self.ambient.unwrap_or(ambient_default),
-        }
     }
 }

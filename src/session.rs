@@ -25,6 +25,7 @@
 //! refined mesh is solved afresh.
 
 use crate::color::Rgb;
+use crate::config::RunConfig;
 use crate::mesh::refine::{RefineOptions, RefineReport, Refiner, Refused};
 use crate::mesh::{Mesh, MeshRef};
 use crate::prepare::Prepared;
@@ -51,6 +52,20 @@ pub struct SessionOptions {
     /// Show the ambient term ([`Progressive::ambient`]) on top of the
     /// solution in [`Session::shown`].
     pub ambient: bool,
+}
+
+impl SessionOptions {
+    /// The options a run configured by `config` solves with;
+    /// `ambient_default` is whether the ambient term is shown when the
+    /// user did not say (on in the window, off for files).
+    pub fn for_run(config: &RunConfig, ambient_default: bool) -> SessionOptions {
+        SessionOptions {
+            solver: config.solver,
+            refine: config.adaptive,
+            max_elements: config.max_elements,
+            ambient: config.ambient.unwrap_or(ambient_default),
+        }
+    }
 }
 
 /// What one [`Session::advance`] did.

@@ -34,7 +34,7 @@ use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, OutputError};
 use crate::prepare::{self, PhaseSeconds, PrepareError, Prepared};
 use crate::render::{self, Exposure, Rasterizer, RenderError, ViewError};
-use crate::session::{Event, PassStats, Session};
+use crate::session::{Event, PassStats, Session, SessionOptions};
 use crate::solver::checkpoint::fingerprint;
 use crate::solver::SolverError;
 use progress::Progress;
@@ -210,7 +210,7 @@ pub fn run_prepared(
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
-    let mut session = Session::from_prepared(prepared, config.session_options(false));
+    let mut session = Session::from_prepared(prepared, SessionOptions::for_run(config, false));
     let solved = solve(config, prepared, &mut session, cancel)?;
     seconds.solve = t.elapsed().as_secs_f64();
     let mesh: &crate::mesh::Mesh = &solved.mesh;

@@ -28,7 +28,7 @@ use crate::mesh::MeshRef;
 use crate::output;
 use crate::prepare::Prepared;
 use crate::render::{self, Exposure, Rasterizer, View};
-use crate::session::{Event, Session};
+use crate::session::{Event, Session, SessionOptions};
 use crate::solver::StopReason;
 use controls::CameraControl;
 use image::RgbImage;
@@ -191,7 +191,7 @@ fn solve_in_background<'p>(
     progress: &Mutex<Progress<'p>>,
     control: &Control,
 ) {
-    let mut session = Session::from_prepared(prepared, config.session_options(true));
+    let mut session = Session::from_prepared(prepared, SessionOptions::for_run(config, true));
     let levels = session.max_refinements();
     if let Ok(mut p) = progress.lock() {
         session.shown(&mut p.radiosity);
