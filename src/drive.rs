@@ -40,7 +40,7 @@ pub fn run(
                 // Bad outputs are refused before the notice, which would
                 // otherwise promise a file that is never written.
                 batch::check_outputs(config)?;
-                fallback(&why);
+                fallback(&why.to_string());
                 return batch(config, None, cancel, arm_cancel);
             }
             let prepared = prepare::prepare(config)?;

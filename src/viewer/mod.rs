@@ -86,15 +86,26 @@ pub enum ViewerError {
     View(#[from] render::ViewError),
 }
 
-/// Whether a window can be tried at all: `Err` says why not (no display).
-pub fn display_available() -> Result<(), String> {
+/// Why no window can be tried at all.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NoDisplay {
+    /// Only a Wayland display: the window needs X11 (XWayland).
+    #[error("WAYLAND_DISPLAY is set but DISPLAY is not: the window needs X11 (XWayland)")]
+    WaylandOnly,
+    /// No display at all.
+    #[error("no display (DISPLAY is not set)")]
+    Unset,
+}
+
+/// Whether a window can be tried at all: `Err` says why not.
+pub fn display_available() -> Result<(), NoDisplay> {
     let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
     if set("DISPLAY") {
         Ok(())
     } else if set("WAYLAND_DISPLAY") {
-        Err("WAYLAND_DISPLAY is set but DISPLAY is not: the window needs X11 (XWayland)".into())
+        Err(NoDisplay::WaylandOnly)
     } else {
-        Err("no display (DISPLAY is not set)".into())
+        Err(NoDisplay::Unset)
     }
 }
 
@@ -128,7 +139,7 @@ struct Control {
 /// Opens the window and runs until the user quits. Returns an error
 /// without side effects when no window can be opened.
 pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
-    display_available().map_err(ViewerError::CannotOpen)?;
+    display_available().map_err(|why| ViewerError::CannotOpen(why.to_string()))?;
     let home = {
         let view = prepared.view(config)?;
         let mut camera = prepared.scene.camera;
