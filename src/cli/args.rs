@@ -100,7 +100,7 @@ pub struct Args {
     #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]
     pub(crate) unshot: UnshotScheme,
 
-    /// Refine the mesh where the light changes sharply, and solve on.
+    /// Refine the mesh where the light changes sharply, and go on solving.
     ///
     /// Once the solve converges, split the elements whose vertex
     /// luminances differ by more than --adaptive-threshold (relative to the
