@@ -373,11 +373,13 @@ fn solve<'p>(
             }
             Event::Stopped(_) | Event::Cancelled => {}
             Event::Refined(report) => {
-                progress.restart_rate();
+                // A bar of its own for each pass, under the line saying
+                // what the last pass did.
+                progress.clear();
                 if config.progress {
-                    progress.clear();
                     say_pass(session, Some(&report));
                 }
+                progress = Progress::new(config.progress, config.solver.threshold);
                 // A fresh solve numbers its steps from 1 again: the log
                 // and plot show only the last one.
                 if session.solver().steps() == 0 {

@@ -44,11 +44,6 @@ impl Progress {
         }
     }
 
-    /// Starts the rate estimate afresh (a new pass on a refined mesh).
-    pub fn restart_rate(&mut self) {
-        self.rate = RateEstimate::default();
-    }
-
     /// Shows a finished step; `rays` is every ray cast so far.
     pub fn step(&mut self, report: &StepReport, rays: u64) {
         let elapsed = self.start.elapsed();
