@@ -226,12 +226,50 @@ impl Vec3Like {
     }
 }
 
-/// Solves `s` on its regular mesh, then refines twice and continues the
-/// solve on each refinement ([`Progressive::refined_state`]), as
-/// `--adaptive` does. Elements are marked by the solution's luminance, or,
-/// with `cut`, by a step across the plane `x = cut` (so that a uniform
-/// solution gets refined too).
-fn solve_continued(s: &Scene, lenmax: f32, cut: Option<f32>, options: SolverOptions) -> Solved {
+/// Solves `s` adaptively as `--adaptive` does, through the solve session:
+/// on its regular mesh, then refined by the solution's luminance and
+/// continued twice ([`Progressive::refined_state`]).
+fn solve_adaptively(s: &Scene, lenmax: f32, options: SolverOptions) -> Solved {
+    use crate::session::{Session, SessionOptions};
+    use std::sync::atomic::AtomicBool;
+    let mesh = mesh::build(
+        s,
+        &MeshOptions {
+            lenmax,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(s);
+    let mut session = Session::new(
+        s,
+        &mesh,
+        &vis,
+        SessionOptions {
+            solver: options,
+            refine: Some(Default::default()),
+            max_elements: crate::mesh::MAX_ELEMENTS,
+            ambient: false,
+        },
+    );
+    assert!(session.run_to_end(&AtomicBool::new(false)).unwrap());
+    assert_eq!(session.passes().len(), 3);
+    session.validate().unwrap();
+    let solver = session.solver();
+    Solved {
+        radiosity: solver.radiosity().to_vec(),
+        steps: solver.steps(),
+        initial_power: solver.initial_unshot_power(),
+        unshot_power: solver.unshot_power(),
+        mesh: session.mesh().clone(),
+    }
+}
+
+/// [`solve_adaptively`] with the elements marked by a step of the field
+/// across the plane `x = cut` instead of the luminance, so that a uniform
+/// solution gets refined too. (A session refines by luminance only, so this
+/// drives the refiner itself.)
+fn solve_continued(s: &Scene, lenmax: f32, cut: f32, options: SolverOptions) -> Solved {
     use crate::mesh::refine::{RefineOptions, Refiner};
     let mut mesh = mesh::build(
         s,
@@ -251,14 +289,11 @@ fn solve_continued(s: &Scene, lenmax: f32, cut: Option<f32>, options: SolverOpti
         }
         while !solver.is_done() && solver.step().is_some() {}
         solver.validate().unwrap();
-        let field: Vec<f64> = match cut {
-            Some(cut) => mesh
-                .positions
-                .iter()
-                .map(|p| if p.x < cut { 0.2 } else { 1.0 })
-                .collect(),
-            None => solver.radiosity().iter().map(|b| b.luminance()).collect(),
-        };
+        let field: Vec<f64> = mesh
+            .positions
+            .iter()
+            .map(|p| if p.x < cut { 0.2 } else { 1.0 })
+            .collect();
         let options = RefineOptions::default();
         let next = if refiner.passes() < options.levels {
             refiner.refine(s, &field, &options)
@@ -297,7 +332,7 @@ fn continued_refinement_keeps_closed_forms() {
         threshold: 1e-4,
         ..Default::default()
     };
-    let solved = solve_continued(&uniform, 0.1, Some(0.37), options);
+    let solved = solve_continued(&uniform, 0.1, 0.37, options);
     let exact = e / (1.0 - rho);
     let worst = solved
         .radiosity
@@ -311,7 +346,7 @@ fn continued_refinement_keeps_closed_forms() {
     let solved = solve_continued(
         &glowing,
         0.1,
-        Some(0.77),
+        0.77,
         SolverOptions {
             threshold: 1e-5,
             ..Default::default()
@@ -336,7 +371,7 @@ fn continued_refinement_matches_a_fresh_solve() {
         threshold: 1e-4,
         ..Default::default()
     };
-    let continued = solve_continued(&s, 0.1, None, options);
+    let continued = solve_adaptively(&s, 0.1, options);
     let fresh = solve_on(&s, continued.mesh.clone(), options);
     let areas = continued.mesh.vertex_areas();
     let total_area: f64 = areas.iter().sum();
