@@ -1,4 +1,5 @@
-//! Preparing a scene for solving: load it (with a camera override), check
+//! Preparing a scene for solving: load it (with a camera override), say
+//! on stderr what the loader changed or ignored ([`scene::Warning`]), check
 //! the mesh size against the element limit before allocating anything,
 //! mesh it and build the visibility BVH. What the batch run, the window
 //! and the examples all start from.
@@ -75,6 +76,11 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let t = Instant::now();
     let scene = load_scene(&config.scene, config.camera.as_deref())?;
     seconds.load = t.elapsed().as_secs_f64();
+    // Said before the solve, whatever `--quiet` says: a warning explains a
+    // picture that is not what the user expected.
+    for warning in &scene.warnings {
+        eprintln!("{warning}");
+    }
 
     let t = Instant::now();
     let mut mesh_options = MeshOptions::for_scene(&scene);

@@ -75,6 +75,7 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
             height: 24,
         },
         camera_source: CameraSource::File,
+        warnings: Vec::new(),
     }
 }
 

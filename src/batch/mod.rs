@@ -137,6 +137,10 @@ pub struct RunStats {
     /// checkpoint), in that order.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub also_written: Vec<String>,
+    /// The warnings said on loading, as printed (`FILE:LINE:COL: warning:
+    /// ...`); empty (and not written) when there were none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Scene polygons.
     pub polygons: usize,
     /// Mesh elements.
@@ -269,6 +273,12 @@ pub fn run_prepared(
         also_written: config
             .extra_outputs()
             .map(|p| p.display().to_string())
+            .collect(),
+        warnings: prepared
+            .scene
+            .warnings
+            .iter()
+            .map(|w| w.to_string())
             .collect(),
         polygons: prepared.scene.polygons.len(),
         elements: mesh.elements.len(),

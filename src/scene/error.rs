@@ -96,6 +96,56 @@ impl fmt::Display for Diagnostic {
     }
 }
 
+/// Something a loader accepted but changed or ignored, for the user to
+/// know: a quirk of an exporter with one sensible reading. Printed as one
+/// line, `FILE:LINE:COL: warning: MESSAGE` (or `FILE: warning: MESSAGE`
+/// when it concerns the whole file), on stderr, even with `--quiet`.
+/// Loaders summarise a kind of quirk found many times in one warning (a
+/// count and the first position), so a file with thousands of faults gets
+/// a few lines.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    /// The file as the user named it.
+    pub file: String,
+    /// Where in it, if the warning points at one place.
+    pub pos: Option<SourcePos>,
+    /// What was changed or ignored: one line, no trailing period.
+    pub message: String,
+}
+
+impl Warning {
+    /// A warning at `pos` in `file`.
+    pub fn at(file: &str, pos: SourcePos, message: impl Into<String>) -> Self {
+        Warning {
+            file: file.to_owned(),
+            pos: Some(pos),
+            message: message.into(),
+        }
+    }
+
+    /// A warning about the whole of `file`.
+    pub fn file(file: &str, message: impl Into<String>) -> Self {
+        Warning {
+            file: file.to_owned(),
+            pos: None,
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.pos {
+            Some(pos) => write!(
+                f,
+                "{}:{}:{}: warning: {}",
+                self.file, pos.line, pos.col, self.message
+            ),
+            None => write!(f, "{}: warning: {}", self.file, self.message),
+        }
+    }
+}
+
 /// A failed load: at least one diagnostic, printed one per line.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub struct LoadError {
@@ -212,5 +262,18 @@ mod tests {
         assert_eq!(fmt_num(1e-9), "1e-9");
         assert_eq!(fmt_num(-2.5e-12), "-2.5e-12");
         assert_eq!(fmt_num(123456.0), "123456");
+    }
+}
+
+#[cfg(test)]
+mod warning_tests {
+    use super::*;
+
+    #[test]
+    fn warnings_read_as_one_line_with_their_place() {
+        let at = Warning::at("room.obj", SourcePos { line: 12, col: 3 }, "`Kd` 1 clamped");
+        assert_eq!(at.to_string(), "room.obj:12:3: warning: `Kd` 1 clamped");
+        let whole = Warning::file("room.obj", "nothing emits light");
+        assert_eq!(whole.to_string(), "room.obj: warning: nothing emits light");
     }
 }

@@ -12,7 +12,7 @@ pub mod obj;
 mod polygon;
 mod sc;
 
-pub use error::{Diagnostic, LoadError, MAX_DIAGNOSTICS};
+pub use error::{Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
 pub use obj::load_obj;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
@@ -133,6 +133,9 @@ pub struct Scene {
     pub camera: Camera,
     /// Where the camera came from.
     pub camera_source: CameraSource,
+    /// What the loader accepted but changed or ignored, in file order;
+    /// the drivers print them before solving.
+    pub warnings: Vec<Warning>,
 }
 
 impl Scene {

@@ -295,6 +295,7 @@ pub(crate) fn parse_obj(
         materials,
         camera: Camera::frame(lo, hi),
         camera_source: CameraSource::AutoFramed,
+        warnings: Vec::new(),
     })
 }
 

@@ -948,6 +948,7 @@ impl<'a> Parser<'a> {
             materials: self.materials,
             camera,
             camera_source,
+            warnings: Vec::new(),
         })
     }
 
