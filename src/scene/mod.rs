@@ -7,12 +7,18 @@
 //! reflectance below one), so later stages may rely on it.
 
 mod error;
+mod framing;
 pub mod hall;
 pub mod obj;
 mod polygon;
 mod sc;
 
 pub use error::{Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
+pub use framing::{
+    frame_camera, EYE_ACROSS_FRACTIONS, EYE_ALONG_FRACTIONS, EYE_CLEARANCE_FRACTION,
+    EYE_HEIGHT_FRACTIONS, FRAMING_RAYS, RAY_EDGE_TOLERANCE, RAY_PARALLEL_COSINE, ROOM_FOV_DEG,
+    ROOM_MIN_FRONT_FRACTION, ROOM_PROBE_OFFSET,
+};
 pub use obj::load_obj;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
@@ -118,7 +124,7 @@ pub struct Polygon {
 pub enum CameraSource {
     /// The file had a `camera` block.
     File,
-    /// No camera in the file: see [`Camera::frame`].
+    /// No camera in the file: see [`frame_camera`].
     AutoFramed,
 }
 

@@ -35,15 +35,16 @@
 //! file order). MTL files are read here (they are a handful of lines) so
 //! that each `Kd` and `Ke` has its position for messages.
 //!
-//! The camera is [`Camera::frame`]d around the model, or comes from a
+//! The camera is framed by [`super::frame_camera`] (from inside a room,
+//! from outside an object), or comes from a
 //! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
 use super::error::{
     cannot_read, negative_channel, reflectance_too_high, FILE_START, MAX_DIAGNOSTICS,
 };
 use super::{
-    Camera, CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError,
-    Scene, SourcePos,
+    CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
+    SourcePos,
 };
 use crate::color::Rgb;
 use glam::{DVec2, DVec3, Vec3};
@@ -66,7 +67,7 @@ pub const DEFAULT_REFLECTANCE: f64 = 0.8;
 pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 
 /// Reads the OBJ file at `path`, its material libraries, and the camera:
-/// framed around the model ([`Camera::frame`]), or from the `.sc` file
+/// framed around the model ([`super::frame_camera`]), or from the `.sc` file
 /// `camera` when given (see [`Scene::with_camera_from`]).
 ///
 /// Errors name the file (the OBJ, an MTL, or the camera file), the line
@@ -289,11 +290,10 @@ pub(crate) fn parse_obj(
     if !diags.is_empty() {
         return Err(LoadError::from_diagnostics(diags));
     }
-    let (lo, hi) = super::polygon_bounds(&polygons);
     Ok(Scene {
+        camera: super::frame_camera(&polygons),
         polygons,
         materials,
-        camera: Camera::frame(lo, hi),
         camera_source: CameraSource::AutoFramed,
         warnings: Vec::new(),
     })

@@ -66,8 +66,10 @@ pub const KEYWORDS: &[&str] = &[
 /// polygon is valid (see [`Polygon::new`](crate::scene::Polygon::new)),
 /// every material obeys the invariants of
 /// [`Material`](crate::scene::Material), and the camera has passed
-/// [`Camera::check`]. A file with no camera gets [`Camera::frame`] of the
-/// scene's bounds; a file with no polygon is an error.
+/// [`Camera::check`]. A file with no camera gets
+/// [`frame_camera`](crate::scene::frame_camera) of its polygons (from
+/// inside a room, from outside an object); a file with no polygon is an
+/// error.
 pub fn parse_str(source: &str, file: &str) -> Result<Scene, LoadError> {
     let source = source.strip_prefix('\u{feff}').unwrap_or(source);
     let mut parser = Parser::new(file, lex(source));

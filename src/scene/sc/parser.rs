@@ -938,10 +938,10 @@ impl<'a> Parser<'a> {
         self.report_pending(true)?;
         let (camera, camera_source) = match self.camera {
             Some(c) => (c, CameraSource::File),
-            None => {
-                let (lo, hi) = crate::scene::polygon_bounds(&self.polygons);
-                (Camera::frame(lo, hi), CameraSource::AutoFramed)
-            }
+            None => (
+                crate::scene::frame_camera(&self.polygons),
+                CameraSource::AutoFramed,
+            ),
         };
         Ok(Scene {
             polygons: self.polygons,
