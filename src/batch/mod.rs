@@ -138,7 +138,9 @@ pub struct RunStats {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub also_written: Vec<String>,
     /// The warnings said on loading, as printed (`FILE:LINE:COL: warning:
-    /// ...`); empty (and not written) when there were none.
+    /// ...`), then the one about a (nearly) black picture
+    /// ([`render::PictureCoverage::dark_warning`]) if it was said; empty
+    /// (and not written) when there were none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
     /// Scene polygons.
@@ -229,8 +231,17 @@ pub fn run_prepared(
     }
     let t = Instant::now();
     let mut rasterizer = Rasterizer::new();
-    let frame = rasterizer.render(mesh, &solved.shown, &view)?;
+    rasterizer.render(mesh, &solved.shown, &view)?;
+    let frame = rasterizer.frame();
     seconds.render = t.elapsed().as_secs_f64();
+    // One line on a (nearly) black picture, whatever `--quiet` says, like
+    // the load warnings: it explains a picture the user did not expect.
+    let dark = render::PictureCoverage::of(frame, rasterizer.front_faces())
+        .dark_warning()
+        .map(|w| format!("warning: {w}"));
+    if let Some(line) = &dark {
+        eprintln!("{line}");
+    }
 
     if cancel.load(Ordering::SeqCst) {
         return Err(interrupted());
@@ -279,6 +290,7 @@ pub fn run_prepared(
             .warnings
             .iter()
             .map(|w| w.to_string())
+            .chain(dark)
             .collect(),
         polygons: prepared.scene.polygons.len(),
         elements: mesh.elements.len(),

@@ -14,15 +14,21 @@
 //!    with [`auto_exposure`]) and encodes it with the sRGB curve for 8-bit
 //!    pictures. High-dynamic-range outputs take the linear [`Frame`] as it is.
 //!
+//! [`PictureCoverage`] counts what a drawn picture shows (background, back
+//! faces, unlit or lit front faces, from [`Rasterizer::front_faces`]) and
+//! words the warning for a picture that came out (nearly) black.
+//!
 //! The module knows nothing of files or windows: the viewer shows and the
 //! batch command writes the very same frames.
 
 pub mod camera;
+pub mod coverage;
 pub mod overlay;
 pub mod raster;
 pub mod tonemap;
 
 pub use camera::{View, ViewError};
+pub use coverage::{PictureCoverage, DARK_PICTURE_FRACTION};
 pub use overlay::{draw_mesh_edges, MESH_COLOR};
 pub use raster::{Frame, Rasterizer, RenderError};
 pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};

@@ -147,6 +147,8 @@ pub struct Rasterizer {
     frame: Frame,
     /// Per pixel, `1 / z` of the nearest surface so far (`0` = nothing).
     inv_depth: Vec<f64>,
+    /// Per pixel, whether the nearest surface so far is a front face.
+    front: Vec<bool>,
     triangles: Vec<ScreenTriangle>,
 }
 
@@ -162,6 +164,7 @@ impl Rasterizer {
         Rasterizer {
             frame: Frame::new(0, 0),
             inv_depth: Vec::new(),
+            front: Vec::new(),
             triangles: Vec::new(),
         }
     }
@@ -176,6 +179,14 @@ impl Rasterizer {
     /// where nothing was drawn). Overlays use it for their depth test.
     pub fn inv_depth(&self) -> &[f64] {
         &self.inv_depth
+    }
+
+    /// Per pixel of the last picture, row-major from the top, whether the
+    /// nearest surface is a front face: `false` for back faces and for
+    /// background. With [`Frame::covered`] it tells the three apart (see
+    /// [`super::PictureCoverage`]).
+    pub fn front_faces(&self) -> &[bool] {
+        &self.front
     }
 
     /// Draws `mesh` seen through `view`, shading every element vertex with
@@ -195,6 +206,8 @@ impl Rasterizer {
         self.frame.reset(width, height);
         self.inv_depth.clear();
         self.inv_depth.resize(self.frame.len(), 0.0);
+        self.front.clear();
+        self.front.resize(self.frame.len(), false);
 
         let setup = Setup::new(view);
         self.triangles.clear();
@@ -228,8 +241,9 @@ impl Rasterizer {
             .par_chunks_mut(BAND_ROWS * w)
             .zip(self.frame.covered.par_chunks_mut(BAND_ROWS * w))
             .zip(self.inv_depth.par_chunks_mut(BAND_ROWS * w))
+            .zip(self.front.par_chunks_mut(BAND_ROWS * w))
             .enumerate()
-            .for_each(|(band, ((pixels, covered), depth))| {
+            .for_each(|(band, (((pixels, covered), depth), front))| {
                 let mut target = Band {
                     width: w,
                     first_row: band * BAND_ROWS,
@@ -237,6 +251,7 @@ impl Rasterizer {
                     pixels,
                     covered,
                     depth,
+                    front,
                 };
                 for t in triangles {
                     target.draw(t);
@@ -375,6 +390,8 @@ struct ScreenTriangle {
     /// Per edge opposite vertex `i`: `0` for top-left edges (pixel centres
     /// exactly on them are inside), `1` otherwise.
     bias: [i64; 3],
+    /// Whether the eye sees the front of the triangle's polygon.
+    front: bool,
     /// Inclusive pixel bounds: columns `x0..=x1`, rows `y0..=y1`.
     x0: usize,
     x1: usize,
@@ -451,7 +468,7 @@ impl<'v> Setup<'v> {
         // rule covers them once as well.
         for i in 1..poly.len - 1 {
             if let (Some(a), Some(b), Some(c)) = (screen[0], screen[i], screen[i + 1]) {
-                if let Some(t) = self.triangle(a, b, c) {
+                if let Some(t) = self.triangle(a, b, c, front) {
                     out.push(t);
                 }
             }
@@ -483,6 +500,7 @@ impl<'v> Setup<'v> {
         a: ScreenVertex,
         b: ScreenVertex,
         c: ScreenVertex,
+        front: bool,
     ) -> Option<ScreenTriangle> {
         let area = edge(&a, &b, c.x, c.y);
         let v = match area.signum() {
@@ -512,6 +530,7 @@ impl<'v> Setup<'v> {
                 i64::from(!is_top_left(&v[2], &v[0])),
                 i64::from(!is_top_left(&v[0], &v[1])),
             ],
+            front,
             // Non-negative and inside the picture after the clamps above.
             x0: x0 as usize,
             x1: x1 as usize,
@@ -529,6 +548,7 @@ struct Band<'a> {
     pixels: &'a mut [[f32; 3]],
     covered: &'a mut [bool],
     depth: &'a mut [f64],
+    front: &'a mut [bool],
 }
 
 impl Band<'_> {
@@ -561,6 +581,7 @@ impl Band<'_> {
                 }
                 self.depth[i] = inv_z;
                 self.covered[i] = true;
+                self.front[i] = t.front;
                 let channel = |k: usize| {
                     ((l0 * a.c_over_z[k] + l1 * b.c_over_z[k] + l2 * c.c_over_z[k]) / inv_z) as f32
                 };
@@ -723,6 +744,25 @@ mod tests {
         assert_eq!(covered_count(&frame), 100 * 100);
         assert_eq!(frame.pixel(30, 30), Some([0.0; 3]));
         assert_eq!(frame.pixel(80, 80), Some([1.0; 3]));
+    }
+
+    #[test]
+    fn front_faces_tell_back_faces_from_front_and_background() {
+        let mut back = rect(10.0, 10.0, 60.0, 60.0, 2.0);
+        back.reverse();
+        let lit = rect(0.0, 0.0, 100.0, 50.0, 4.0);
+        let mut b = Builder::default();
+        b.polygon(&lit, &[1.0; 4]).polygon(&back, &[3.0; 4]);
+        let mut r = Rasterizer::new();
+        r.render(b.mesh.as_ref().unwrap(), &b.radiosity, &view())
+            .unwrap();
+        let front = r.front_faces();
+        assert_eq!(front.len(), 100 * 100);
+        let at = |x: usize, y: usize| front[y * 100 + x];
+        // Back face over the lit quad, the lit quad alone, background.
+        assert!(!at(30, 30) && r.frame().is_covered(30, 30));
+        assert!(at(80, 20));
+        assert!(!at(80, 80) && !r.frame().is_covered(80, 80));
     }
 
     #[test]
