@@ -720,3 +720,144 @@ fn help_documents_the_model_options() {
         assert!(help.contains(option), "--help lacks {option}");
     }
 }
+
+/// A closed room 6 × 3 × 4 as Blender 2.93 exports it, every wall facing
+/// inwards, with a lamp (`Ke`) just under the ceiling, facing down. With
+/// `outward`, every face is wound the other way: a closed box seen from
+/// outside.
+fn room_obj(outward: bool) -> String {
+    let faces = [
+        [1, 4, 3, 2],    // floor, +y
+        [5, 6, 7, 8],    // ceiling, -y
+        [1, 2, 6, 5],    // z = 0, +z
+        [4, 8, 7, 3],    // z = 4, -z
+        [1, 5, 8, 4],    // x = 0, +x
+        [2, 3, 7, 6],    // x = 6, -x
+        [9, 10, 11, 12], // lamp, -y
+    ];
+    let mut s = String::from(
+        "# Blender v2.93.0 OBJ File: ''\n# www.blender.org\nmtllib room.mtl\no Room\n\
+         v 0.000000 0.000000 0.000000\nv 6.000000 0.000000 0.000000\n\
+         v 6.000000 0.000000 4.000000\nv 0.000000 0.000000 4.000000\n\
+         v 0.000000 3.000000 0.000000\nv 6.000000 3.000000 0.000000\n\
+         v 6.000000 3.000000 4.000000\nv 0.000000 3.000000 4.000000\n\
+         v 2.500000 2.990000 1.500000\nv 3.500000 2.990000 1.500000\n\
+         v 3.500000 2.990000 2.500000\nv 2.500000 2.990000 2.500000\n\
+         vn 0.0000 1.0000 0.0000\nusemtl Wall\ns off\n",
+    );
+    for (k, f) in faces.iter().enumerate() {
+        if k == 6 {
+            s.push_str("usemtl Lamp\n");
+        }
+        let mut f = *f;
+        if outward {
+            f.reverse();
+        }
+        s.push_str(&format!(
+            "f {}//1 {}//1 {}//1 {}//1\n",
+            f[0], f[1], f[2], f[3]
+        ));
+    }
+    s
+}
+
+const ROOM_MTL: &str = "\
+# Blender MTL File: 'room.blend'
+# Material Count: 2
+
+newmtl Lamp
+Ns 225.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.000000 0.000000 0.000000
+Ks 0.500000 0.500000 0.500000
+Ke 10.000000 10.000000 10.000000
+Ni 1.450000
+d 1.000000
+illum 2
+
+newmtl Wall
+Ns 225.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.800000 0.800000 0.800000
+Ks 0.500000 0.500000 0.500000
+Ke 0.000000 0.000000 0.000000
+Ni 1.450000
+d 1.000000
+illum 2
+";
+
+/// The line of `--stats`' warnings and stderr about a nearly black picture.
+const DARK_WARNING: &str = "the picture is nearly black";
+
+#[test]
+fn an_auto_framed_obj_room_is_seen_from_inside_and_lit() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "room.mtl", ROOM_MTL);
+    let obj = write(dir.path(), "room.obj", &room_obj(false));
+    // The camera is inside the room (framed from outside, every pixel
+    // was the black back of a wall).
+    let loaded = scene::load(&obj).unwrap();
+    assert_eq!(loaded.camera_source, scene::CameraSource::AutoFramed);
+    let (lo, hi) = loaded.bounds();
+    let eye = loaded.camera.eye;
+    assert!(eye.cmpgt(lo).all() && eye.cmplt(hi).all(), "{eye}");
+    let out = run_in(
+        dir.path(),
+        &[
+            "room.obj",
+            "--size",
+            "64x48",
+            "--lenmax",
+            "1",
+            "--max-steps",
+            "20",
+            "-q",
+            "-o",
+            "room.png",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains(DARK_WARNING), "{}", stderr(&out));
+    let picture = image::open(dir.path().join("room.png")).unwrap().to_rgb8();
+    let values: Vec<f64> = picture.pixels().flat_map(|p| p.0).map(f64::from).collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    assert!(mean > 40.0, "mean brightness {mean} of 255");
+}
+
+#[test]
+fn a_picture_of_back_faces_warns_once() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "room.mtl", ROOM_MTL);
+    write(dir.path(), "box.obj", &room_obj(true));
+    // The eye forced inside a box whose faces point outwards.
+    write(
+        dir.path(),
+        "inside.sc",
+        "camera\n  eye 3 1.5 1\n  lookat 3 1.5 4\n  up 0 1 0\n  fov 60\n  size 64 48\nend\n",
+    );
+    let out = run_in(
+        dir.path(),
+        &[
+            "box.obj",
+            "--camera",
+            "inside.sc",
+            "--lenmax",
+            "1",
+            "--max-steps",
+            "5",
+            "-q",
+            "-o",
+            "box.png",
+            "--stats",
+            "stats.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains(DARK_WARNING)).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].starts_with("warning: "), "{err}");
+    assert!(lines[0].contains("backs of polygons"), "{err}");
+    let stats = read_json(dir.path(), "stats.json");
+    assert_eq!(stats["warnings"][0].as_str(), Some(lines[0]));
+}
