@@ -357,10 +357,15 @@ impl Scene {
                     named.push(format!("and {} more", hints.len() - listed));
                 }
                 format!(
-                    "{} {} like a lamp: make it emit with --emit NAME=VALUE \
+                    "{} {}: make {} emit with --emit NAME=VALUE \
                      (radiosity in the scene's units, V or R,G,B), for instance --emit '{name}=10'",
                     named.join(", "),
-                    if hints.len() == 1 { "looks" } else { "look" },
+                    if hints.len() == 1 {
+                        "looks like a lamp"
+                    } else {
+                        "look like lamps"
+                    },
+                    if hints.len() == 1 { "it" } else { "them" },
                 )
             }
             None => {
@@ -656,6 +661,13 @@ mod tests {
             "room.obj: warning: nothing emits light, so the picture will be black; \
              object `Lamp` looks like a lamp: make it emit with --emit NAME=VALUE \
              (radiosity in the scene's units, V or R,G,B), for instance --emit 'Lamp=10'"
+        );
+        let mut two = room();
+        two.materials[1].name = "Glow".to_string();
+        let message = two.nothing_emits_warning("room.obj").unwrap().to_string();
+        assert!(
+            message.contains("object `Lamp`, material `Glow` look like lamps: make them emit"),
+            "{message}"
         );
         let mut lit = room();
         lit.set_emission("Lamp", Rgb::splat(1.0)).unwrap();
