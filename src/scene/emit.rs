@@ -15,6 +15,7 @@
 use super::error::Warning;
 use super::{Material, MaterialId, PolygonId, Scene};
 use crate::color::Rgb;
+use std::collections::HashMap;
 use std::fmt;
 
 /// Parts of a name that suggest a lamp, matched case-insensitively
@@ -329,8 +330,9 @@ impl Scene {
             .zip(&used)
             .filter(|(_, &u)| u)
             .map(|(m, _)| ("material", m.name.as_str()));
+        let mut seen = std::collections::HashSet::new();
         for (kind, name) in groups.chain(materials) {
-            if looks_like_lamp(name) && !out.contains(&(kind, name)) {
+            if looks_like_lamp(name) && seen.insert((kind, name)) {
                 out.push((kind, name));
             }
         }
@@ -395,9 +397,13 @@ impl Scene {
 pub(crate) struct GroupScan {
     /// Every `(kind, name)`, in order of first appearance.
     names: Vec<(GroupKind, String)>,
-    /// Each distinct membership faces have had, as indices into `names`;
-    /// `sets[0]` is the empty one.
+    /// The index of each `(kind, name)` in `names` (files with many
+    /// thousands of objects are common).
+    name_index: HashMap<(GroupKind, String), u32>,
+    /// Each distinct membership faces have had, as indices into `names`.
     sets: Vec<Vec<u32>>,
+    /// The index of each membership in `sets`.
+    set_index: HashMap<Vec<u32>, u32>,
     /// The object named last, as an index into `names`.
     object: Option<u32>,
     /// The groups named last, as indices into `names`.
@@ -426,13 +432,15 @@ impl GroupScan {
     }
 
     fn intern(&mut self, kind: GroupKind, name: &str) -> u32 {
-        match self.names.iter().position(|(k, n)| *k == kind && n == name) {
-            Some(i) => i as u32,
-            None => {
-                self.names.push((kind, name.to_string()));
-                self.names.len() as u32 - 1
-            }
+        let next = self.names.len() as u32;
+        let index = *self
+            .name_index
+            .entry((kind, name.to_string()))
+            .or_insert(next);
+        if index == next {
+            self.names.push((kind, name.to_string()));
         }
+        index
     }
 
     /// The membership of a face written now, for [`GroupScan::assign`].
@@ -440,21 +448,16 @@ impl GroupScan {
         if let Some(c) = self.current {
             return c;
         }
-        if self.sets.is_empty() {
-            self.sets.push(Vec::new());
-        }
         let set: Vec<u32> = self
             .object
             .into_iter()
             .chain(self.groups.iter().copied())
             .collect();
-        let index = match self.sets.iter().position(|s| *s == set) {
-            Some(i) => i as u32,
-            None => {
-                self.sets.push(set);
-                self.sets.len() as u32 - 1
-            }
-        };
+        let next = self.sets.len() as u32;
+        let index = *self.set_index.entry(set.clone()).or_insert(next);
+        if index == next {
+            self.sets.push(set);
+        }
         self.current = Some(index);
         index
     }
