@@ -3,6 +3,7 @@
 //! arguments; tests and examples build it with [`RunConfig::new`] and
 //! field updates. Values here are already validated.
 
+use crate::color::Rgb;
 use crate::mesh::{self, refine::RefineOptions};
 use crate::render::Exposure;
 use crate::solver::SolverOptions;
@@ -104,6 +105,12 @@ pub struct RunConfig {
     pub adaptive: Option<RefineOptions>,
     /// Draw the element mesh over the picture (8-bit pictures only).
     pub mesh_lines: bool,
+    /// `--emit NAME=VALUE`, in order: the material, OBJ object or group
+    /// `NAME` emits `VALUE` (radiosity in the scene's units, every channel
+    /// finite, `>= 0` and at most [`crate::scene::MAX_EMISSION`]). Applied
+    /// after loading by [`crate::scene::Scene::set_emission`]; an unknown
+    /// name fails the run. Empty by default.
+    pub emit: Vec<(String, Rgb)>,
 }
 
 impl RunConfig {
@@ -130,6 +137,7 @@ impl RunConfig {
             ambient: None,
             adaptive: None,
             mesh_lines: false,
+            emit: Vec::new(),
         }
     }
 }

@@ -1,5 +1,7 @@
-//! Preparing a scene for solving: load it (with a camera override), say
-//! on stderr what the loader changed or ignored ([`scene::Warning`]), check
+//! Preparing a scene for solving: load it (with a camera override), make
+//! what `--emit` names emit ([`Scene::set_emission`]), say on stderr what
+//! the loader changed or ignored and whether nothing emits
+//! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), check
 //! the mesh size against the element limit before allocating anything,
 //! mesh it and build the visibility BVH. What the batch run, the window
 //! and the examples all start from.
@@ -7,7 +9,7 @@
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
-use crate::scene::{self, LoadError, Scene};
+use crate::scene::{self, LoadError, Scene, UnknownName};
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::path::Path;
@@ -24,6 +26,10 @@ pub enum PrepareError {
     /// large.
     #[error("{0}")]
     Mesh(#[from] MeshError),
+    /// A name given to `--emit` is no material, object or group of the
+    /// scene; the message lists the names there are.
+    #[error("--emit: {0}")]
+    UnknownName(#[from] UnknownName),
 }
 
 /// Seconds spent in each phase of a run.
@@ -74,7 +80,13 @@ impl Prepared {
 pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let scene = load_scene(&config.scene, config.camera.as_deref())?;
+    let mut scene = load_scene(&config.scene, config.camera.as_deref())?;
+    for (name, emission) in &config.emit {
+        scene.set_emission(name, *emission)?;
+    }
+    if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
+        scene.warnings.push(warning);
+    }
     seconds.load = t.elapsed().as_secs_f64();
     // Said before the solve, whatever `--quiet` says: a warning explains a
     // picture that is not what the user expected.

@@ -861,3 +861,200 @@ fn a_picture_of_back_faces_warns_once() {
     let stats = read_json(dir.path(), "stats.json");
     assert_eq!(stats["warnings"][0].as_str(), Some(lines[0]));
 }
+
+/// A room and a lamp as Blender exports them, the lamp a mesh whose
+/// material does not emit (the light itself is not in the file).
+const DARK_ROOM_OBJ: &str = "\
+# Blender v2.93.0 OBJ File: ''
+# www.blender.org
+mtllib room.mtl
+o Room
+v 0 0 0
+v 4 0 0
+v 4 0 4
+v 0 0 4
+v 0 3 0
+v 4 3 0
+v 4 3 4
+v 0 3 4
+vn 0 1 0
+usemtl Wall
+s off
+f 1//1 4//1 3//1 2//1
+f 5//1 6//1 7//1 8//1
+f 1//1 2//1 6//1 5//1
+f 2//1 3//1 7//1 6//1
+f 3//1 4//1 8//1 7//1
+f 4//1 1//1 5//1 8//1
+o Lamp
+v 1.5 2.9 1.5
+v 2.5 2.9 1.5
+v 2.5 2.9 2.5
+v 1.5 2.9 2.5
+usemtl Wall
+f 9 10 11 12
+";
+
+const DARK_ROOM_MTL: &str = "\
+# Blender MTL File: 'None'
+newmtl Wall
+Ns 225.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.700000 0.700000 0.700000
+Ks 0.500000 0.500000 0.500000
+Ke 0.000000 0.000000 0.000000
+illum 2
+";
+
+/// Writes the dark room into `dir`, with a camera inside it.
+fn write_dark_room(dir: &Path) {
+    write(dir, "room.obj", DARK_ROOM_OBJ);
+    write(dir, "room.mtl", DARK_ROOM_MTL);
+    write(
+        dir,
+        "camera.sc",
+        "camera\n  eye 2 1.5 3.9\n  lookat 2 1.5 0\n  up 0 1 0\n  fov 70\n  size 48 36\nend\n",
+    );
+}
+
+/// Runs the dark room with `extra` options, writing `room.png` and
+/// `stats.json`.
+fn run_dark_room(dir: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "room.obj",
+        "--camera",
+        "camera.sc",
+        "--lenmax",
+        "0.5",
+        "-o",
+        "room.png",
+        "--stats",
+        "stats.json",
+    ];
+    args.extend_from_slice(extra);
+    run_in(dir, &args)
+}
+
+/// Mean of the 8-bit channels of `dir/name`, from 0 to 255.
+fn mean_brightness(dir: &Path, name: &str) -> f64 {
+    let img = image::open(dir.join(name)).unwrap().to_rgb8();
+    let sum: u64 = img.as_raw().iter().map(|&c| c as u64).sum();
+    sum as f64 / img.as_raw().len() as f64
+}
+
+#[test]
+fn a_model_with_nothing_emitting_says_so_and_names_the_lamp() {
+    let dir = tempfile::tempdir().unwrap();
+    write_dark_room(dir.path());
+    let out = run_dark_room(dir.path(), &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].starts_with("room.obj: warning: nothing emits light"),
+        "{err}"
+    );
+    assert!(warnings[0].contains("`Lamp`"), "{err}");
+    assert!(warnings[0].contains("--emit"), "{err}");
+    assert!(!warnings[0].contains("`Room`"), "{err}");
+    assert!(
+        err.contains("nothing emits, nothing solved → room.png"),
+        "{err}"
+    );
+    let stats = read_json(dir.path(), "stats.json");
+    assert_eq!(stats["converged"], false);
+    assert_eq!(stats["nothing_emits"], true);
+    assert_eq!(stats["steps"], 0);
+    assert_eq!(stats["warnings"].as_array().map(Vec::len), Some(1));
+    assert!(mean_brightness(dir.path(), "room.png") < 1.0);
+}
+
+#[test]
+fn emit_lights_the_lamp_object_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    write_dark_room(dir.path());
+    let out = run_dark_room(dir.path(), &["--emit", "Lamp=10", "-q"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning:"), "{}", stderr(&out));
+    let stats = read_json(dir.path(), "stats.json");
+    assert!(stats["steps"].as_u64().unwrap() > 0, "{stats}");
+    assert_eq!(stats["converged"], true);
+    assert!(stats.get("nothing_emits").is_none(), "{stats}");
+    assert!(stats.get("warnings").is_none(), "{stats}");
+    let lit = mean_brightness(dir.path(), "room.png");
+    assert!(lit > 40.0, "mean brightness {lit}");
+
+    // The lamp shares `Wall` with the room, so only the lamp emits: the
+    // whole room emitting instead would light the picture evenly.
+    let scene = radiosity::scene::load(&dir.path().join("room.obj")).unwrap();
+    let mut lamp_only = scene.clone();
+    assert_eq!(lamp_only.set_emission("Lamp", Rgb::splat(10.0)), Ok(1));
+    let emitting = |s: &Scene| {
+        (0..s.polygons.len())
+            .filter(|&i| {
+                !s.material_of(scene::PolygonId(i as u32))
+                    .emission()
+                    .is_black()
+            })
+            .count()
+    };
+    assert_eq!(emitting(&lamp_only), 1);
+    assert_eq!(lamp_only.materials.len(), scene.materials.len() + 1);
+}
+
+#[test]
+fn emit_refuses_unknown_names_and_bad_values() {
+    let dir = tempfile::tempdir().unwrap();
+    write_dark_room(dir.path());
+    let out = run_dark_room(dir.path(), &["--emit", "Nope=1"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("error: --emit: no material, object or group is named `Nope`"),
+        "{err}"
+    );
+    assert!(err.contains("`Lamp`") && err.contains("`Room`"), "{err}");
+    assert!(err.contains("`Wall`"), "{err}");
+    for bad in ["Lamp=-1", "Lamp=a,b"] {
+        let out = run_dark_room(dir.path(), &["--emit", bad]);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {}", stderr(&out));
+        assert!(stderr(&out).contains("--emit must look like"), "{bad}");
+    }
+    // Nothing was written by any of them.
+    assert_eq!(listing(dir.path()), ["camera.sc", "room.mtl", "room.obj"]);
+}
+
+#[test]
+fn a_checkpoint_is_refused_when_the_emission_changed() {
+    let dir = tempfile::tempdir().unwrap();
+    write_dark_room(dir.path());
+    let save = run_dark_room(
+        dir.path(),
+        &[
+            "--emit",
+            "Lamp=10",
+            "--max-steps",
+            "2",
+            "--checkpoint",
+            "c.bin",
+            "-q",
+        ],
+    );
+    assert!(save.status.success(), "{}", stderr(&save));
+    let same = run_dark_room(
+        dir.path(),
+        &["--emit", "Lamp=10", "--resume", "c.bin", "-q"],
+    );
+    assert!(same.status.success(), "{}", stderr(&same));
+    let other = run_dark_room(
+        dir.path(),
+        &["--emit", "Lamp=20", "--resume", "c.bin", "-q"],
+    );
+    assert_eq!(other.status.code(), Some(2), "{}", stderr(&other));
+    assert!(
+        stderr(&other).contains("was saved for a different scene"),
+        "{}",
+        stderr(&other)
+    );
+}

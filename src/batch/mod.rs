@@ -166,8 +166,16 @@ pub struct RunStats {
     /// The exposure the 8-bit picture and the exported display colours
     /// used (dimensionless): the given one, or the automatic one.
     pub exposure: f32,
-    /// True when the threshold was reached (false: step limit).
+    /// True when the threshold was reached; false at the step limit, and
+    /// false when nothing emits (`nothing_emits`): then nothing was
+    /// solved, and a picture that is black is no converged solution.
     pub converged: bool,
+    /// True when no polygon emits light (see
+    /// [`Scene::emits`](crate::scene::Scene::emits)), after `--emit`: the
+    /// picture is black and the load warnings say so. Written only when
+    /// true.
+    #[serde(skip_serializing_if = "is_false")]
+    pub nothing_emits: bool,
     /// With `--adaptive`, one entry per pass, the coarsest first; then
     /// `elements` and `vertices` above are the last mesh's and the steps,
     /// rays and pairs totals over every pass. Empty (and not written)
@@ -306,7 +314,8 @@ pub fn run_prepared(
         },
         unshot_fraction: session.unshot_fraction(),
         exposure,
-        converged: session.converged(),
+        converged: session.converged() && prepared.scene.emits(),
+        nothing_emits: !prepared.scene.emits(),
         adaptive: if config.adaptive.is_some() {
             session.passes().to_vec()
         } else {
@@ -454,7 +463,8 @@ fn say_pass(session: &Session, refined: Option<&crate::mesh::refine::RefineRepor
     );
 }
 
-/// A one-line summary of a finished run, naming every file written.
+/// A one-line summary of a finished run, naming every file written; for a
+/// scene in which nothing emits, only that.
 pub fn summary(stats: &RunStats) -> String {
     let steps = match (stats.adaptive.first(), stats.adaptive.len()) {
         (Some(first), solves) if solves > 1 => format!(
@@ -468,6 +478,10 @@ pub fn summary(stats: &RunStats) -> String {
         written.push_str(", ");
         written.push_str(also);
     }
+    if stats.nothing_emits {
+        // No steps, no unshot power: there was nothing to solve.
+        return format!("{}: nothing emits, nothing solved → {written}", stats.scene);
+    }
     format!(
         "{}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {written}",
         stats.scene,
@@ -476,4 +490,9 @@ pub fn summary(stats: &RunStats) -> String {
         stats.unshot_fraction * 100.0,
         if stats.converged { "" } else { " (step limit)" },
     )
+}
+
+/// For `skip_serializing_if`: the field is written only when true.
+fn is_false(b: &bool) -> bool {
+    !*b
 }

@@ -5,7 +5,8 @@
 //! Each option's doc comment is its help: the first paragraph is the one
 //! line `-h` shows, the whole comment is what `--help` shows.
 
-use super::values::{parse_shooter_samples, parse_size};
+use super::values::{parse_emit, parse_shooter_samples, parse_size};
+use crate::color::Rgb;
 use crate::config;
 use crate::mesh::refine;
 use crate::mesh::DEFAULT_INSET;
@@ -143,6 +144,19 @@ pub struct Args {
     /// Write counts and seconds per phase as JSON to this file.
     #[arg(long, value_name = "FILE")]
     pub(crate) stats: Option<PathBuf>,
+
+    /// Make a material, OBJ object or group emit light (repeatable).
+    ///
+    /// NAME=V or NAME=R,G,B: the material, the object (`o`) or the group
+    /// (`g`) named NAME (case matters) emits this radiosity, in the
+    /// scene's units, instead of what it emitted; its reflectance is kept
+    /// (in the emission's colour when the two differ). An object or group
+    /// that shares its material with other polygons gets a copy of its
+    /// own, so only it emits. For models whose lights are not in the file:
+    /// when nothing emits, a warning names what looks like a lamp. An
+    /// unknown NAME is an error listing the names there are.
+    #[arg(long, value_name = "NAME=VALUE", value_parser = parse_emit)]
+    pub(crate) emit: Vec<(String, Rgb)>,
 
     /// Take the camera from this .sc file.
     ///

@@ -155,6 +155,7 @@ impl TryFrom<Args> for Invocation {
             },
             adaptive: args.adaptive.then_some(refine),
             mesh_lines: args.mesh_lines,
+            emit: args.emit,
         };
         let mode = if args.no_window
             || config.output.is_some()
@@ -248,6 +249,10 @@ mod tests {
             "--checkpoint-every",
             "2.5",
             "--no-ambient",
+            "--emit",
+            "Lamp=10",
+            "--emit",
+            "shade=1,2,3",
             "-q",
         ]);
         assert_eq!(c.scene, SceneSource::File(PathBuf::from("room.sc")));
@@ -275,6 +280,13 @@ mod tests {
         assert_eq!(c.max_elements, 5000);
         assert_eq!(c.checkpoint_every, Duration::from_millis(2500));
         assert_eq!(c.ambient, Some(false));
+        assert_eq!(
+            c.emit,
+            [
+                ("Lamp".to_string(), crate::color::Rgb::splat(10.0)),
+                ("shade".to_string(), crate::color::Rgb::new(1.0, 2.0, 3.0)),
+            ]
+        );
         assert!(!c.progress);
         assert_eq!(config(&["--ambient"]).ambient, Some(true));
     }
@@ -318,6 +330,8 @@ mod tests {
             &["--shooter-samples", "zero"],
             &["--size", "10by10"],
             &["--size", "0x10"],
+            &["--emit", "Lamp=-1"],
+            &["--emit", "Lamp=a,b"],
         ] {
             let e = parse(args).unwrap_err();
             assert_eq!(

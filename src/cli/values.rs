@@ -3,6 +3,8 @@
 //! like. clap calls them while parsing, so a bad value is a usage error
 //! (exit code 2) naming the option.
 
+use crate::color::Rgb;
+use crate::scene::MAX_EMISSION;
 use crate::solver::ShooterSamples;
 
 /// An option value that does not parse. clap prints the message after its
@@ -16,6 +18,15 @@ pub enum ValueError {
     /// `--shooter-samples` is neither `all` nor a whole number at least 1.
     #[error("--shooter-samples must be `all` or a whole number >= 1, got `{0}`")]
     ShooterSamples(String),
+    /// `--emit` is not `NAME=VALUE` with a non-empty name and a radiosity
+    /// `V` or `R,G,B`, each channel a number from 0 to
+    /// [`MAX_EMISSION`].
+    #[error(
+        "--emit must look like NAME=10 or NAME=10,8,6 (a radiosity per channel, \
+         from 0 to {max:e}), got `{0}`",
+        max = MAX_EMISSION
+    )]
+    Emit(String),
 }
 
 /// Parses `--size`: `WxH` (or `WXH`), width and height in pixels, both
@@ -41,6 +52,32 @@ pub fn parse_shooter_samples(text: &str) -> Result<ShooterSamples, ValueError> {
         Ok(n) if n >= 1 => Ok(ShooterSamples::AtMost(n)),
         _ => Err(ValueError::ShooterSamples(text.to_string())),
     }
+}
+
+/// Parses `--emit`: `NAME=VALUE`, split at the last `=` (so a name may
+/// hold one), with `NAME` not empty and `VALUE` a radiosity in the
+/// scene's units, `V` (grey) or `R,G,B`, every channel finite, `>= 0` and
+/// at most [`MAX_EMISSION`]. Whether the scene has such a name is the
+/// scene's to say, once it is loaded.
+pub fn parse_emit(text: &str) -> Result<(String, Rgb), ValueError> {
+    let bad = || ValueError::Emit(text.to_string());
+    let (name, value) = text.rsplit_once('=').ok_or_else(bad)?;
+    if name.is_empty() {
+        return Err(bad());
+    }
+    let channels = value
+        .split(',')
+        .map(|c| match c.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() && (0.0..=MAX_EMISSION).contains(&x) => Ok(x),
+            _ => Err(bad()),
+        })
+        .collect::<Result<Vec<f64>, ValueError>>()?;
+    let rgb = match channels[..] {
+        [v] => Rgb::splat(v),
+        [r, g, b] => Rgb::new(r, g, b),
+        _ => return Err(bad()),
+    };
+    Ok((name.to_string(), rgb))
 }
 
 #[cfg(test)]
@@ -73,6 +110,39 @@ mod tests {
                 "{bad}"
             );
         }
+    }
+
+    #[test]
+    fn emit_is_a_name_and_a_grey_or_coloured_radiosity() {
+        assert_eq!(
+            parse_emit("Lamp=10"),
+            Ok(("Lamp".to_string(), Rgb::splat(10.0)))
+        );
+        assert_eq!(
+            parse_emit("Ceiling Light=10,8, 6"),
+            Ok(("Ceiling Light".to_string(), Rgb::new(10.0, 8.0, 6.0)))
+        );
+        assert_eq!(parse_emit("a=b=0"), Ok(("a=b".to_string(), Rgb::BLACK)));
+        for bad in [
+            "Lamp",
+            "=10",
+            "Lamp=",
+            "Lamp=-1",
+            "Lamp=a,b",
+            "Lamp=1,2",
+            "Lamp=1,2,3,4",
+            "Lamp=nan",
+            "Lamp=inf",
+            "Lamp=1e21",
+            "Lamp=1,,2",
+        ] {
+            assert_eq!(parse_emit(bad), Err(ValueError::Emit(bad.into())), "{bad}");
+        }
+        assert_eq!(
+            parse_emit("Lamp=-1").unwrap_err().to_string(),
+            "--emit must look like NAME=10 or NAME=10,8,6 (a radiosity per channel, \
+             from 0 to 1e20), got `Lamp=-1`"
+        );
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! everything the format promises (planar, convex, non-degenerate polygons;
 //! reflectance below one), so later stages may rely on it.
 
+mod emit;
 mod error;
 mod framing;
 pub mod hall;
@@ -13,6 +14,9 @@ pub mod obj;
 mod polygon;
 mod sc;
 
+pub use emit::{
+    looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
+};
 pub use error::{Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
 pub use framing::{
     frame_camera, EYE_ACROSS_FRACTIONS, EYE_ALONG_FRACTIONS, EYE_CLEARANCE_FRACTION,
@@ -142,6 +146,13 @@ pub struct Scene {
     /// What the loader accepted but changed or ignored, in file order;
     /// the drivers print them before solving.
     pub warnings: Vec<Warning>,
+    /// The named sets of polygons the file defines: OBJ objects (`o`) and
+    /// groups (`g`), in order of first appearance, each listing its
+    /// polygons (see [`Group`]); empty for `.sc` scenes, which name
+    /// materials only. Kept beside the polygons rather than on them so
+    /// that a polygon may belong to several; [`Scene::set_emission`]
+    /// reads them.
+    pub groups: Vec<Group>,
 }
 
 impl Scene {

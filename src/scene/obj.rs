@@ -19,8 +19,11 @@
 //!   one colour): its reflectance is `Ke × lum(Kd) / lum(Ke)`, capped below
 //!   one.
 //!
-//! What is ignored: texture coordinates, normals, smoothing groups, object
-//! and group names, lines (`l`) and points (`p`), and every other MTL
+//! Object (`o`) and group (`g`) names are recorded in [`Scene::groups`],
+//! for `--emit` and the warning when nothing emits.
+//!
+//! What is ignored: texture coordinates, normals, smoothing groups, lines
+//! (`l`) and points (`p`), and every other MTL
 //! statement (`Ka`, `Ks`, `Ns`, `illum`, `map_*`, …), none of which
 //! changes a diffuse radiosity solution. Faces before any `usemtl` get
 //! the built-in material [`DEFAULT_MATERIAL_NAME`] with reflectance
@@ -39,6 +42,7 @@
 //! from outside an object), or comes from a
 //! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
+use super::emit::GroupScan;
 use super::error::{
     cannot_read, negative_channel, reflectance_too_high, FILE_START, MAX_DIAGNOSTICS,
 };
@@ -227,6 +231,7 @@ pub(crate) fn parse_obj(
     let mut default_id = None;
     let mut polygons = Vec::new();
     let mut faces = scan.faces.iter();
+    let mut groups = scan.names.groups();
     for model in &models {
         let mesh = &model.mesh;
         let material = match mesh.material_id {
@@ -279,7 +284,12 @@ pub(crate) fn parse_obj(
                 })
                 .collect();
             match face_polygons(material, vertices, face.pos) {
-                Ok(ps) => polygons.extend(ps),
+                Ok(ps) => {
+                    let first = polygons.len();
+                    polygons.extend(ps);
+                    scan.names
+                        .assign(&mut groups, face.names, first..polygons.len());
+                }
                 Err(message) => diags.push(Diagnostic::new(file, face.pos, message)),
             }
         }
@@ -296,6 +306,7 @@ pub(crate) fn parse_obj(
         materials,
         camera_source: CameraSource::AutoFramed,
         warnings: Vec::new(),
+        groups: GroupScan::finish(groups),
     })
 }
 
@@ -434,11 +445,15 @@ struct Scan {
     faces: Vec<FaceLine>,
     usemtls: Vec<Named>,
     mtllibs: Vec<MtlLib>,
+    /// The `o` and `g` statements.
+    names: GroupScan,
 }
 
 struct FaceLine {
     pos: SourcePos,
     is_line: bool,
+    /// Its objects and groups, for [`GroupScan::assign`].
+    names: u32,
 }
 
 struct Named {
@@ -489,6 +504,7 @@ fn scan_obj(text: &str, file: &str) -> Scan {
         faces: Vec::new(),
         usemtls: Vec::new(),
         mtllibs: Vec::new(),
+        names: GroupScan::default(),
     };
     // Positive indices may refer to any vertex of the file (tobj resolves
     // them at the end), negative ones count back from the current line.
@@ -564,6 +580,7 @@ fn scan_obj(text: &str, file: &str) -> Scan {
                     scan.faces.push(FaceLine {
                         pos: at(col),
                         is_line,
+                        names: scan.names.current(),
                     });
                 }
             }
@@ -579,6 +596,9 @@ fn scan_obj(text: &str, file: &str) -> Scan {
                     });
                 }
             }
+            "o" | "g" => scan
+                .names
+                .statement(keyword, &line.trim_start()[keyword.len()..]),
             "mtllib" => {
                 if line.split_once(' ').map_or("", |x| x.1.trim()).is_empty() {
                     error(col, "`mtllib` needs a file name".into());

@@ -320,6 +320,7 @@ impl<'a> Ui<'a> {
         let mut last_draw = Instant::now() - REDRAW_INTERVAL;
         let mut dirty = true;
         let mut title = String::new();
+        let emits = self.prepared.scene.emits();
         while self.window.is_open() {
             let keys: Vec<Key> = self
                 .presses
@@ -359,6 +360,8 @@ impl<'a> Ui<'a> {
                 dirty = false;
             }
             let state = match stopped {
+                // Nothing was solved: the load warning said why.
+                Some(_) if !emits => " · nothing emits".into(),
                 Some(StopReason::Converged) if pass.0 > 1 => {
                     format!(" · converged after {} refinements", pass.0 - 1)
                 }

@@ -949,6 +949,7 @@ impl<'a> Parser<'a> {
             camera,
             camera_source,
             warnings: Vec::new(),
+            groups: Vec::new(),
         })
     }
 
