@@ -244,8 +244,10 @@ pub fn run_prepared(
     seconds.render = t.elapsed().as_secs_f64();
     // One line on a (nearly) black picture, whatever `--quiet` says, like
     // the load warnings: it explains a picture the user did not expect.
+    // Not when nothing emits: the load warning has said why already.
     let dark = render::PictureCoverage::of(frame, rasterizer.front_faces())
         .dark_warning()
+        .filter(|_| prepared.scene.emits())
         .map(|w| format!("warning: {w}"));
     if let Some(line) = &dark {
         eprintln!("{line}");
