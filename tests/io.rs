@@ -693,23 +693,77 @@ fn batch_outputs_are_checked_before_solving() {
 
 #[test]
 fn bad_obj_files_are_refused_with_positions() {
+    // `Kd` 1.2 and zero-area faces are warnings now (see
+    // `exported_obj_quirks_load_with_one_line_warnings`); negative
+    // channels and out-of-range indices stay errors.
     let dir = tempfile::tempdir().unwrap();
-    write(dir.path(), "bad.mtl", "newmtl shiny\nKd 1.2 0.5 0.5\n");
+    write(dir.path(), "bad.mtl", "newmtl shiny\nKd 1.2 -0.5 0.5\n");
     write(
         dir.path(),
         "bad.obj",
-        "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\nusemtl shiny\nf 1 2 3\n",
+        "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\nusemtl shiny\nf 1 2 9\n",
     );
     let out = run_in(dir.path(), &["bad.obj", "-o", "bad.png"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let err = stderr(&out);
     for expected in [
-        "bad.mtl:2:1: error: reflectance `Kd` is 1.2 in the red channel; every channel must be below 1",
-        "bad.obj:6:1: error: degenerate face: polygon has zero area",
+        "bad.mtl:2:8: error: `Kd` channel -0.5 is negative; channels must be >= 0",
+        "bad.obj:6:7: error: vertex index 9 in `9` is out of range: 3 vertices are defined in the file (indices count from 1)",
     ] {
         assert!(err.contains(expected), "missing {expected:?} in:\n{err}");
     }
     assert_eq!(listing(dir.path()), ["bad.mtl", "bad.obj"]);
+}
+
+/// A room as Blender 2.93 writes it (CRLF, as when saved on Windows):
+/// a white floor (`Kd 1 1 1`), a lamp, a glass pane, a textured wall whose
+/// texture was not shipped, a sliver face and a material nobody defined.
+const QUIRKY_OBJ: &str = "# Blender v2.93.0 OBJ File: ''\r\n# www.blender.org\r\n\
+mtllib room.mtl\r\no Floor\r\nv 0 0 0\r\nv 0 0 1\r\nv 1 0 1\r\nv 1 0 0\r\n\
+vt 0 0\r\nvn 0 1 0\r\nusemtl white\r\ns off\r\nf 1/1/1 2/1/1 3/1/1 4/1/1\r\n\
+f 1/1/1 3/1/1 3/1/1\r\no Lamp\r\nv 0 1 0\r\nv 1 1 0\r\nv 1 1 1\r\nv 0 1 1\r\n\
+vn 0 -1 0\r\nusemtl lamp\r\ns off\r\nf 5//2 6//2 7//2 8//2\r\n\
+o Pane\r\nusemtl glass\r\nf 1 4 6 5\r\no Wall\r\nusemtl brick\r\nf 1 5 8 2\r\n\
+o Extra\r\nusemtl Material.001\r\nf 4 3 7 6\r\n";
+
+const QUIRKY_MTL: &str = "# Blender MTL File: 'room.blend'\r\n# Material Count: 4\r\n\r\n\
+newmtl white\r\nNs 225.000000\r\nKa 1.000000 1.000000 1.000000\r\nKd 1.000000 1.000000 1.000000\r\n\
+Ks 0.000000 0.000000 0.000000\r\nKe 0.000000 0.000000 0.000000\r\nNi 1.450000\r\nd 1.000000\r\nillum 1\r\n\r\n\
+newmtl lamp\r\nNs 0.000000\r\nKa 1.000000 1.000000 1.000000\r\nKd 0.000000 0.000000 0.000000\r\n\
+Ks 0.000000 0.000000 0.000000\r\nKe 10.000000 10.000000 10.000000\r\nNi 1.000000\r\nd 1.000000\r\nillum 1\r\n\r\n\
+newmtl glass\r\nNs 900.000000\r\nKa 1.000000 1.000000 1.000000\r\nKd 0.800000 0.800000 0.800000\r\n\
+Ks 0.500000 0.500000 0.500000\r\nKe 0.000000 0.000000 0.000000\r\nNi 1.500000\r\nd 0.300000\r\nillum 7\r\n\r\n\
+newmtl brick\r\nNs 225.000000\r\nKd 0.600000 0.600000 0.600000\r\nillum 1\r\nmap_Kd textures\\brick.png\r\n";
+
+#[test]
+fn exported_obj_quirks_load_with_one_line_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "room.obj", QUIRKY_OBJ);
+    write(dir.path(), "room.mtl", QUIRKY_MTL);
+    let out = run_in(
+        dir.path(),
+        &["room.obj", "-o", "room.png", "--max-steps", "4", "-q"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let picture = image::open(dir.path().join("room.png")).unwrap();
+    assert!(picture.width() > 0 && picture.height() > 0);
+    let err = stderr(&out);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("warning:")).collect();
+    let expected = [
+        "room.mtl:7:1: warning: material `white`: `Kd 1 1 1` reflects all light or more; scaled to 0.95 0.95 0.95 (brightest channel 0.95)",
+        "room.mtl: warning: treated as diffuse: glass (Ks 0.5, d 0.3, illum 7, Ni 1.5)",
+        "room.mtl:38:1: warning: cannot read 1 `map_Kd` texture(s), first textures/brick.png (material `brick`): ",
+        "room.mtl:38:1: warning: 1 `map_Kd` path(s) written with `\\` (first `textures\\brick.png`), read with `/`",
+        "room.obj:31:1: warning: undefined material `Material.001` (1 `usemtl` line(s), the first here): no `mtllib` defines it; its faces get the default material",
+        "room.obj:14:1: warning: dropped 1 degenerate face(s) (no area, or a vertex repeated); the first here: ",
+    ];
+    for e in expected {
+        assert!(
+            warnings.iter().any(|w| w.starts_with(e)),
+            "missing {e:?} in:\n{err}"
+        );
+    }
+    assert_eq!(warnings.len(), expected.len(), "{err}");
 }
 
 #[test]

@@ -10,24 +10,59 @@
 //!   of a face is the side from which its vertices run counter-clockwise,
 //!   as in the OBJ convention;
 //! - `usemtl NAME` picks the material of the faces that follow; materials
-//!   come from the `mtllib` files named in the OBJ, relative to its folder;
+//!   come from the `mtllib` files named in the OBJ, relative to its folder.
+//!   A `mtllib` line may name several files (`mtllib a.mtl b.mtl`); a name
+//!   that is one existing file is read as one, even with spaces in it;
 //! - in a material, `Kd` is the diffuse reflectance (`k_diffrefl` 1 × Kd)
 //!   and `Ke` the emitted radiosity (`k_emission` 1 × Ke), in the scene's
-//!   radiosity units. Every channel of `Kd` must be below 1, as in `.sc`.
-//!   A material with both a non-black `Kd` and a non-black `Ke` keeps the
-//!   colour of `Ke` exactly and the luminance of `Kd` (a [`Material`] has
-//!   one colour): its reflectance is `Ke × lum(Kd) / lum(Ke)`, capped below
-//!   one.
+//!   radiosity units. A material with both a non-black `Kd` and a
+//!   non-black `Ke` keeps the colour of `Ke` exactly and the luminance of
+//!   `Kd` (a [`Material`] has one colour): its reflectance is
+//!   `Ke × lum(Kd) / lum(Ke)`, capped below one;
+//! - `map_Kd FILE` (options such as `-s 1 1 1` skipped, the path relative
+//!   to the MTL's folder): the average colour of the texture multiplies
+//!   `Kd`. The average is of linear values: 8- and 16-bit images (png,
+//!   jpg, tga, ppm/pnm, bmp) are sRGB-decoded before averaging, float
+//!   images are taken as linear; alpha is ignored. A radiosity solution
+//!   has one reflectance per polygon, so the texture's mean is what a
+//!   face reflects on average.
+//!
+//! What is changed, each with a warning (`FILE:LINE:COL: warning: ...`,
+//! one line; a quirk found many times is one warning with a count and the
+//! first position) — the model still loads:
+//!
+//! - a `Kd` with a channel at or above one is scaled so its brightest
+//!   channel is [`MAX_MTL_REFLECTANCE`], keeping its hue (one warning per
+//!   material);
+//! - a material without `Kd` gets [`DEFAULT_REFLECTANCE`] (one warning per
+//!   MTL file naming them);
+//! - a `map_Kd` texture that cannot be read leaves `Kd` as it is;
+//! - `\` in `mtllib` and `map_Kd` paths is read as `/`;
+//! - a `mtllib` file that cannot be read defines nothing, and a `usemtl`
+//!   of a material no library defines gives its faces the default material
+//!   (one warning per name, up to [`MAX_UNDEFINED_WARNINGS`]);
+//! - faces of no area, with a repeated vertex, or smaller than the
+//!   smallest polygon are dropped (3ds Max writes such faces at UV seams).
+//!   A face of four or more vertices keeps the triangles of it that have
+//!   an area, silently.
 //!
 //! Object (`o`) and group (`g`) names are recorded in [`Scene::groups`],
 //! for `--emit` and the warning when nothing emits.
 //!
 //! What is ignored: texture coordinates, normals, smoothing groups, lines
-//! (`l`) and points (`p`), and every other MTL
-//! statement (`Ka`, `Ks`, `Ns`, `illum`, `map_*`, …), none of which
-//! changes a diffuse radiosity solution. Faces before any `usemtl` get
-//! the built-in material [`DEFAULT_MATERIAL_NAME`] with reflectance
-//! [`DEFAULT_REFLECTANCE`] (Blender's default base colour).
+//! (`l`) and points (`p`), `Ka`, `Ns`, other maps,
+//! and what makes a material specular, a mirror, glass or metal: non-black
+//! `Ks`, `illum` 3 to 9, `d` below 1 or `Tr` above 0, `Ni` (with `illum`
+//! 4, 6 or 7), `Pm` above 0 and `Pr` below 1. Such materials are treated
+//! as diffuse, named in one warning per MTL file. Faces before any
+//! `usemtl` get the built-in material [`DEFAULT_MATERIAL_NAME`] with
+//! reflectance [`DEFAULT_REFLECTANCE`] (Blender's default base colour).
+//!
+//! What is refused (errors with positions): numbers that do not parse or
+//! are not finite, out-of-range indices, faces with fewer than three
+//! vertices, faces that overlap themselves, negative `Kd`/`Ke` channels,
+//! a material defined twice or used before the `mtllib` that defines it,
+//! and a file with no faces left.
 //!
 //! The geometry is parsed by the `tobj` crate with `triangulate: false`, so
 //! quads stay quads. `tobj` reports no positions, so this module checks
@@ -43,12 +78,10 @@
 //! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
 use super::emit::GroupScan;
-use super::error::{
-    cannot_read, negative_channel, reflectance_too_high, FILE_START, MAX_DIAGNOSTICS,
-};
+use super::error::{cannot_read, fmt_num, negative_channel, FILE_START, MAX_DIAGNOSTICS};
 use super::{
     CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
-    SourcePos,
+    SourcePos, Warning,
 };
 use crate::color::Rgb;
 use glam::{DVec2, DVec3, Vec3};
@@ -64,6 +97,22 @@ pub const DEFAULT_MATERIAL_NAME: &str = "(no usemtl)";
 /// Reflectance of [`DEFAULT_MATERIAL_NAME`], every channel, dimensionless:
 /// 0.8, the default base colour of a new Blender material.
 pub const DEFAULT_REFLECTANCE: f64 = 0.8;
+
+/// The brightest diffuse reflectance taken from an MTL file, dimensionless.
+/// A `Kd` with a channel at or above one (many exporters write `Kd 1 1 1`
+/// for "white") is scaled so that its brightest channel is this, keeping
+/// the ratios between channels (its hue). 0.95 is about the whitest real
+/// paint or plaster; closer to one, light bounces for ever and the solve
+/// converges slowly, and at one it never loses energy.
+pub const MAX_MTL_REFLECTANCE: f64 = 0.95;
+
+/// A warning that lists names (materials) lists at most this many, then
+/// says how many more, so that it stays one readable line.
+pub const MAX_NAMES_IN_WARNING: usize = 8;
+
+/// At most this many undefined material names get a warning each; the
+/// rest share one more warning.
+pub const MAX_UNDEFINED_WARNINGS: usize = 10;
 
 /// In ear clipping, a corner whose doubled signed area (in the face's
 /// plane) is at most this fraction of the face's extent squared counts as
@@ -119,6 +168,8 @@ pub(crate) fn parse_obj(
     let consumed = Rc::new(Cell::new(0usize));
     let libraries: RefCell<Vec<Library>> = RefCell::new(Vec::new());
     let mtl_diags: RefCell<Vec<Diagnostic>> = RefCell::new(Vec::new());
+    let obj_warnings: RefCell<Vec<Warning>> = RefCell::new(Vec::new());
+    let mtllib_backslashes = RefCell::new(Tally::default());
     let mut reader = CountingReader {
         bytes: text.as_bytes(),
         pos: consumed.clone(),
@@ -137,38 +188,69 @@ pub(crate) fn parse_obj(
             .iter()
             .find(|m| m.line == at)
             .map_or(SourcePos { line: at, col: 1 }, |m| m.pos);
-        let (mtl_file, mtl_text) = match read_mtl(&name) {
-            Ok(x) => x,
-            Err(message) => {
-                mtl_diags
-                    .borrow_mut()
-                    .push(Diagnostic::new(file, pos, message));
-                return Err(tobj::LoadError::OpenFileFailed);
-            }
+        let name = if name.contains('\\') {
+            mtllib_backslashes
+                .borrow_mut()
+                .add(pos, || name.to_string());
+            name.replace('\\', "/")
+        } else {
+            name.to_string()
         };
-        let library = parse_mtl(&mtl_text, &mtl_file, at);
-        mtl_diags.borrow_mut().extend(library.diags.iter().cloned());
-        let materials: Vec<tobj::Material> = library
-            .materials
-            .iter()
-            .map(|m| tobj::Material {
-                name: m.name.clone(),
-                ..Default::default()
-            })
-            .collect();
-        // Names map to indices into the concatenation of every library, as
-        // tobj offsets them, so its material ids are ours.
-        let map = library
-            .materials
-            .iter()
-            .enumerate()
-            .map(|(i, m)| (m.name.clone(), i))
-            .collect();
-        libraries.borrow_mut().push(library);
+        // One file (its name may hold spaces), else several names.
+        let reads = match read_mtl(&name) {
+            Err(_) if name.split_whitespace().nth(1).is_some() => {
+                name.split_whitespace().map(read_mtl).collect()
+            }
+            read => vec![read],
+        };
+        let mut materials: Vec<tobj::Material> = Vec::new();
+        let mut map = HashMap::new();
+        for read in reads {
+            let (mtl_file, mtl_text) = match read {
+                Ok(x) => x,
+                Err(message) => {
+                    obj_warnings.borrow_mut().push(Warning::at(
+                        file,
+                        pos,
+                        format!("{message}; faces using its materials get the default material"),
+                    ));
+                    continue;
+                }
+            };
+            let library = parse_mtl(&mtl_text, &mtl_file, at);
+            mtl_diags.borrow_mut().extend(library.diags.iter().cloned());
+            // Names map to indices into the concatenation of every
+            // library, as tobj offsets them, so its material ids are ours.
+            for m in &library.materials {
+                map.insert(m.name.clone(), materials.len());
+                materials.push(tobj::Material {
+                    name: m.name.clone(),
+                    ..Default::default()
+                });
+            }
+            libraries.borrow_mut().push(library);
+        }
         Ok((materials, map))
     });
     diags.extend(mtl_diags.into_inner());
-    let libraries = libraries.into_inner();
+    let mut libraries = libraries.into_inner();
+    let mut warnings = Vec::new();
+    for lib in &mut libraries {
+        read_textures(lib);
+        warnings.append(&mut lib.warnings);
+    }
+    warnings.extend(obj_warnings.into_inner());
+    let backslashes = mtllib_backslashes.into_inner();
+    if let Some((pos, first)) = backslashes.first {
+        warnings.push(Warning::at(
+            file,
+            pos,
+            format!(
+                "{} `mtllib` path(s) written with `\\` (first `{first}`), read with `/`",
+                backslashes.count
+            ),
+        ));
+    }
     let models = match loaded {
         Ok((models, _)) => models,
         // The scan found the mistake already, with its column.
@@ -208,6 +290,9 @@ pub(crate) fn parse_obj(
             }
         }
     }
+    // Undefined names: the first `usemtl` of each, and how many there are.
+    let mut undefined: Vec<(&str, SourcePos, usize)> = Vec::new();
+    let mut undefined_index: HashMap<&str, usize> = HashMap::new();
     for u in &scan.usemtls {
         match defined.get(u.name.as_str()) {
             Some((loaded_at, _)) if *loaded_at < u.pos.line => {}
@@ -219,12 +304,35 @@ pub(crate) fn parse_obj(
                     u.name
                 ),
             )),
-            None => diags.push(Diagnostic::new(
-                file,
-                u.pos,
-                format!("undefined material `{}`: no `mtllib` defines it", u.name),
-            )),
+            None => match undefined_index.get(u.name.as_str()) {
+                Some(&i) => undefined[i].2 += 1,
+                None => {
+                    undefined_index.insert(&u.name, undefined.len());
+                    undefined.push((&u.name, u.pos, 1));
+                }
+            },
         }
+    }
+    for &(name, pos, count) in undefined.iter().take(MAX_UNDEFINED_WARNINGS) {
+        warnings.push(Warning::at(
+            file,
+            pos,
+            format!(
+                "undefined material `{name}` ({count} `usemtl` line(s), the first here): no \
+                 `mtllib` defines it; its faces get the default material"
+            ),
+        ));
+    }
+    if let Some(&(_, pos, _)) = undefined.get(MAX_UNDEFINED_WARNINGS) {
+        let rest = &undefined[MAX_UNDEFINED_WARNINGS..];
+        warnings.push(Warning::at(
+            file,
+            pos,
+            format!(
+                "{} more undefined materials (the first here): their faces get the default material",
+                rest.len()
+            ),
+        ));
     }
 
     let mut materials: Vec<Material> = records.iter().map(|m| m.to_material()).collect();
@@ -232,6 +340,7 @@ pub(crate) fn parse_obj(
     let mut polygons = Vec::new();
     let mut faces = scan.faces.iter();
     let mut groups = scan.names.groups();
+    let mut degenerate = Tally::default();
     for model in &models {
         let mesh = &model.mesh;
         let material = match mesh.material_id {
@@ -290,9 +399,22 @@ pub(crate) fn parse_obj(
                     scan.names
                         .assign(&mut groups, face.names, first..polygons.len());
                 }
-                Err(message) => diags.push(Diagnostic::new(file, face.pos, message)),
+                Err(FaceError::Degenerate(why)) => degenerate.add(face.pos, || why),
+                Err(FaceError::Bad(message)) => {
+                    diags.push(Diagnostic::new(file, face.pos, message))
+                }
             }
         }
+    }
+    if let Some((pos, why)) = degenerate.first {
+        warnings.push(Warning::at(
+            file,
+            pos,
+            format!(
+                "dropped {} degenerate face(s) (no area, or a vertex repeated); the first here: {why}",
+                degenerate.count
+            ),
+        ));
     }
     if diags.is_empty() && polygons.is_empty() {
         diags.push(Diagnostic::new(file, FILE_START, "OBJ file has no faces"));
@@ -305,43 +427,71 @@ pub(crate) fn parse_obj(
         polygons,
         materials,
         camera_source: CameraSource::AutoFramed,
-        warnings: Vec::new(),
+        warnings,
         groups: GroupScan::finish(groups),
     })
 }
 
 // ------------------------------------------------------------ faces --
 
+/// Why a face gives no polygon.
+enum FaceError {
+    /// No area, a repeated vertex, or smaller than the smallest polygon:
+    /// the face is dropped with a warning. The reason, for the message.
+    Degenerate(String),
+    /// Anything else (it overlaps itself, a coordinate out of range): an
+    /// error.
+    Bad(String),
+}
+
+/// Whether a polygon error means "nothing there" (a face to drop) rather
+/// than a face that cannot be read.
+fn is_degenerate(e: &PolygonError) -> bool {
+    matches!(
+        e,
+        PolygonError::ZeroArea | PolygonError::EqualVertices { .. } | PolygonError::TooSmall { .. }
+    )
+}
+
 /// The polygons of one face: itself when it is a valid polygon, else
 /// (four or more vertices) its ear-clipped triangles. Triangles of no area
-/// (from collinear vertices) are dropped; a face with nothing left is an
-/// error, as is a degenerate triangle.
+/// (from collinear or repeated vertices) are dropped; a face with nothing
+/// left is [`FaceError::Degenerate`].
 fn face_polygons(
     material: MaterialId,
     vertices: Vec<Vec3>,
     origin: SourcePos,
-) -> Result<Vec<Polygon>, String> {
+) -> Result<Vec<Polygon>, FaceError> {
     let whole = match Polygon::new(material, vertices.clone(), origin) {
         Ok(p) => return Ok(vec![p]),
         Err(e) => e,
     };
-    let degenerate = |e: &PolygonError| format!("degenerate face: {e}");
-    if vertices.len() < 4 || matches!(whole, PolygonError::NotFinite { .. }) {
-        return Err(degenerate(&whole));
+    let fail = |e: &PolygonError| {
+        if is_degenerate(e) {
+            FaceError::Degenerate(e.to_string())
+        } else {
+            FaceError::Bad(format!("bad face: {e}"))
+        }
+    };
+    if vertices.len() < 4
+        || !matches!(
+            whole,
+            PolygonError::NotPlanar { .. }
+                | PolygonError::NotConvex { .. }
+                | PolygonError::SelfOverlapping { .. }
+                | PolygonError::ZeroArea
+                | PolygonError::EqualVertices { .. }
+        )
+    {
+        return Err(fail(&whole));
     }
     let triangles = match ear_clip(&vertices) {
         Some(t) => t,
-        None if matches!(
-            whole,
-            PolygonError::ZeroArea | PolygonError::EqualVertices { .. }
-        ) =>
-        {
-            return Err(degenerate(&whole))
-        }
+        None if is_degenerate(&whole) => return Err(fail(&whole)),
         None => {
-            return Err(format!(
+            return Err(FaceError::Bad(format!(
                 "bad face: it overlaps itself and cannot be split into triangles ({whole})"
-            ))
+            )))
         }
     };
     let mut out = Vec::with_capacity(triangles.len());
@@ -352,12 +502,12 @@ fn face_polygons(
             origin,
         ) {
             Ok(p) => out.push(p),
-            Err(PolygonError::ZeroArea | PolygonError::EqualVertices { .. }) => {}
-            Err(e) => return Err(degenerate(&e)),
+            Err(e) if is_degenerate(&e) => {}
+            Err(e) => return Err(fail(&e)),
         }
     }
     if out.is_empty() {
-        Err(degenerate(&whole))
+        Err(fail(&whole))
     } else {
         Ok(out)
     }
@@ -712,6 +862,9 @@ struct Library {
     loaded_at: u32,
     materials: Vec<MtlMaterial>,
     diags: Vec<Diagnostic>,
+    warnings: Vec<Warning>,
+    /// `map_Kd` paths written with `\`: how many, and the first.
+    backslashes: Tally,
 }
 
 /// One `newmtl` block: the values that matter here, with positions.
@@ -719,22 +872,44 @@ struct MtlMaterial {
     name: String,
     file: String,
     pos: SourcePos,
-    kd: Rgb,
+    /// `Kd` as used (clamped below one), `None` when the block has none.
+    kd: Option<Rgb>,
     ke: Rgb,
+    /// The `map_Kd` file (with `/` for `\`) and where it is named.
+    map_kd: Option<(String, SourcePos)>,
+    /// The average linear colour of the `map_Kd` texture, once read.
+    texture: Option<Rgb>,
+    /// Statements asking for more than diffuse reflection, as written
+    /// (`Ks 0.5`, `illum 7`, ...).
+    non_diffuse: Vec<String>,
+    /// `illum` and `Ni` are only known together at the end of the block.
+    illum: Option<i64>,
+    ni: Option<f64>,
 }
 
 impl MtlMaterial {
+    /// The diffuse reflectance used: `Kd` (or [`DEFAULT_REFLECTANCE`]),
+    /// times the average of the `map_Kd` texture when it was read.
+    fn reflectance(&self) -> Rgb {
+        let kd = self.kd.unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE));
+        match self.texture {
+            Some(t) => kd * t,
+            None => kd,
+        }
+    }
+
     /// The scene material: see the module docs for the mapping.
     fn to_material(&self) -> Material {
+        let kd = self.reflectance();
         let (color, k_diffrefl, k_emission) = if self.ke.is_black() {
-            (self.kd, 1.0, 0.0)
-        } else if self.kd.is_black() {
+            (kd, 1.0, 0.0)
+        } else if kd.is_black() {
             (self.ke, 0.0, 1.0)
         } else {
             let lum = |c: Rgb| c.luminance().max(f64::MIN_POSITIVE);
-            let k = lum(self.kd) / lum(self.ke);
+            let k = lum(kd) / lum(self.ke);
             // Below one in every channel, like Kd itself.
-            let k = k.min(self.kd.max_channel() / self.ke.max_channel());
+            let k = k.min(kd.max_channel() / self.ke.max_channel());
             (self.ke, k, 1.0)
         };
         Material {
@@ -744,10 +919,87 @@ impl MtlMaterial {
             k_emission,
         }
     }
+
+    /// Notes what the block's `illum` and `Ni` ask for, once it is read.
+    fn finish(&mut self) {
+        if let Some(illum) = self.illum.filter(|i| (3..=9).contains(i)) {
+            self.non_diffuse.push(format!("illum {illum}"));
+            if let Some(ni) = self.ni.filter(|_| matches!(illum, 4 | 6 | 7)) {
+                self.non_diffuse.push(format!("Ni {}", fmt_num(ni)));
+            }
+        }
+    }
 }
 
-/// Reads an MTL library: `newmtl`, `Kd` and `Ke` (other statements are
-/// ignored). `loaded_at` is the OBJ line that names it.
+/// How often one kind of quirk was seen, and where first.
+#[derive(Default)]
+struct Tally {
+    count: usize,
+    first: Option<(SourcePos, String)>,
+}
+
+impl Tally {
+    /// Counts one more, remembering `what` at `pos` if it is the first.
+    fn add(&mut self, pos: SourcePos, what: impl FnOnce() -> String) {
+        self.count += 1;
+        if self.first.is_none() {
+            self.first = Some((pos, what()));
+        }
+    }
+}
+
+/// `names` as a list for a one-line message: at most
+/// [`MAX_NAMES_IN_WARNING`], then how many more.
+fn name_list(names: &[String]) -> String {
+    let mut s = names
+        .iter()
+        .take(MAX_NAMES_IN_WARNING)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if names.len() > MAX_NAMES_IN_WARNING {
+        s.push_str(&format!(" and {} more", names.len() - MAX_NAMES_IN_WARNING));
+    }
+    s
+}
+
+/// The first number after the keyword, if it is one (MTL statements this
+/// module only warns about are never errors).
+fn number(w: &[(&str, u32)]) -> Option<f64> {
+    w.get(1)
+        .and_then(|(x, _)| x.parse::<f64>().ok())
+        .filter(|x| x.is_finite())
+}
+
+/// The file named by a `map_Kd` line: the rest of the line after the
+/// options (`-s 1 1 1`, `-bm 0.5`, ...), so names with spaces are kept.
+fn map_file<'a>(line: &'a str, w: &[(&'a str, u32)]) -> Option<&'a str> {
+    let mut i = 1;
+    while let Some(&(word, _)) = w.get(i) {
+        let args = match word {
+            "-o" | "-s" | "-t" => 3,
+            "-mm" => 2,
+            "-blendu" | "-blendv" | "-bm" | "-boost" | "-cc" | "-clamp" | "-imfchan"
+            | "-texres" | "-type" => 1,
+            _ => break,
+        };
+        i += 1;
+        // `-o`, `-s` and `-t` take one to three numbers.
+        for _ in 0..args {
+            match w.get(i) {
+                Some((x, _)) if args < 3 || x.parse::<f64>().is_ok() => i += 1,
+                _ => break,
+            }
+        }
+    }
+    let &(_, col) = w.get(i)?;
+    let start = line.char_indices().nth(col as usize - 1)?.0;
+    Some(line[start..].trim())
+}
+
+/// Reads an MTL library: `newmtl`, `Kd`, `Ke` and `map_Kd`, and notes the
+/// statements of non-diffuse materials (see the module docs). `loaded_at`
+/// is the OBJ line that names it.
 fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lib = Library {
@@ -755,61 +1007,230 @@ fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
         loaded_at,
         materials: Vec::new(),
         diags: Vec::new(),
+        warnings: Vec::new(),
+        backslashes: Tally::default(),
     };
-    for (number, line) in lines(text) {
+    for (number_, line) in lines(text) {
         let w = words(line);
         let Some(&(keyword, col)) = w.first() else {
             continue;
         };
-        let at = |col: u32| SourcePos { line: number, col };
-        match keyword {
-            "newmtl" => {
-                // As tobj reads it: everything after the keyword, trimmed.
-                let name = line.trim_start()["newmtl".len()..].trim();
-                if name.is_empty() {
-                    lib.diags.push(Diagnostic::new(
-                        file,
-                        at(col),
-                        "`newmtl` needs a material name",
-                    ));
-                    continue;
-                }
-                lib.materials.push(MtlMaterial {
-                    name: name.to_string(),
-                    file: file.to_string(),
-                    pos: at(col),
-                    kd: Rgb::BLACK,
-                    ke: Rgb::BLACK,
-                });
+        let at = |col: u32| SourcePos { line: number_, col };
+        if keyword == "newmtl" {
+            // As tobj reads it: everything after the keyword, trimmed.
+            let name = line.trim_start()["newmtl".len()..].trim();
+            if name.is_empty() {
+                lib.diags.push(Diagnostic::new(
+                    file,
+                    at(col),
+                    "`newmtl` needs a material name",
+                ));
+                continue;
             }
-            "Kd" | "Ke" => {
-                let Some(m) = lib.materials.last_mut() else {
-                    lib.diags.push(Diagnostic::new(
+            if let Some(m) = lib.materials.last_mut() {
+                m.finish();
+            }
+            lib.materials.push(MtlMaterial {
+                name: name.to_string(),
+                file: file.to_string(),
+                pos: at(col),
+                kd: None,
+                ke: Rgb::BLACK,
+                map_kd: None,
+                texture: None,
+                non_diffuse: Vec::new(),
+                illum: None,
+                ni: None,
+            });
+            continue;
+        }
+        let Some(m) = lib.materials.last_mut() else {
+            if matches!(keyword, "Kd" | "Ke") {
+                lib.diags.push(Diagnostic::new(
+                    file,
+                    at(col),
+                    format!("`{keyword}` before any `newmtl`"),
+                ));
+            }
+            continue;
+        };
+        match keyword {
+            "Kd" | "Ke" => match color(&w) {
+                Err((c, message)) => lib.diags.push(Diagnostic::new(file, at(c), message)),
+                Ok(rgb) if keyword == "Ke" => m.ke = rgb,
+                Ok(rgb) if rgb.max_channel() >= 1.0 => {
+                    // Same hue, brightest channel at the cap.
+                    let clamped = rgb * (MAX_MTL_REFLECTANCE / rgb.max_channel());
+                    let show = |c: Rgb| c.to_array().map(fmt_num).join(" ");
+                    lib.warnings.push(Warning::at(
                         file,
                         at(col),
-                        format!("`{keyword}` before any `newmtl`"),
+                        format!(
+                            "material `{}`: `Kd {}` reflects all light or more; scaled to {} (brightest channel {})",
+                            m.name,
+                            show(rgb),
+                            show(clamped),
+                            fmt_num(MAX_MTL_REFLECTANCE)
+                        ),
                     ));
-                    continue;
-                };
-                match color(&w) {
-                    Err((c, message)) => lib.diags.push(Diagnostic::new(file, at(c), message)),
-                    Ok(rgb) if keyword == "Ke" => m.ke = rgb,
-                    Ok(rgb) => {
-                        if rgb.max_channel() >= 1.0 {
-                            lib.diags.push(Diagnostic::new(
-                                file,
-                                at(col),
-                                reflectance_too_high("`Kd`", rgb),
-                            ));
-                        }
-                        m.kd = rgb;
+                    m.kd = Some(clamped);
+                }
+                Ok(rgb) => m.kd = Some(rgb),
+            },
+            "map_Kd" => {
+                if let Some(name) = map_file(line, &w).filter(|n| !n.is_empty()) {
+                    let path = if name.contains('\\') {
+                        lib.backslashes.add(at(col), || name.to_string());
+                        name.replace('\\', "/")
+                    } else {
+                        name.to_string()
+                    };
+                    m.map_kd = Some((path, at(col)));
+                }
+            }
+            "Ks" => {
+                if let Ok(ks) = color(&w) {
+                    if !ks.is_black() {
+                        m.non_diffuse
+                            .push(format!("Ks {}", fmt_num(ks.max_channel())));
                     }
+                }
+            }
+            "illum" => m.illum = w.get(1).and_then(|(x, _)| x.parse().ok()),
+            "Ni" => m.ni = number(&w),
+            "d" => {
+                if let Some(d) = number(&w).filter(|&d| d < 1.0) {
+                    m.non_diffuse.push(format!("d {}", fmt_num(d)));
+                }
+            }
+            "Tr" => {
+                if let Some(tr) = number(&w).filter(|&t| t > 0.0) {
+                    m.non_diffuse.push(format!("Tr {}", fmt_num(tr)));
+                }
+            }
+            "Pm" => {
+                if let Some(pm) = number(&w).filter(|&p| p > 0.0) {
+                    m.non_diffuse.push(format!("Pm {}", fmt_num(pm)));
+                }
+            }
+            "Pr" => {
+                if let Some(pr) = number(&w).filter(|&p| p < 1.0) {
+                    m.non_diffuse.push(format!("Pr {}", fmt_num(pr)));
                 }
             }
             _ => {}
         }
     }
+    if let Some(m) = lib.materials.last_mut() {
+        m.finish();
+    }
+    let no_kd: Vec<String> = lib
+        .materials
+        .iter()
+        .filter(|m| m.kd.is_none())
+        .map(|m| m.name.clone())
+        .collect();
+    if !no_kd.is_empty() {
+        lib.warnings.push(Warning::file(
+            file,
+            format!(
+                "no `Kd` in {}: reflectance {} (the default)",
+                name_list(&no_kd),
+                fmt_num(DEFAULT_REFLECTANCE)
+            ),
+        ));
+    }
+    let shiny: Vec<String> = lib
+        .materials
+        .iter()
+        .filter(|m| !m.non_diffuse.is_empty())
+        .map(|m| format!("{} ({})", m.name, m.non_diffuse.join(", ")))
+        .collect();
+    if !shiny.is_empty() {
+        lib.warnings.push(Warning::file(
+            file,
+            format!("treated as diffuse: {}", name_list(&shiny)),
+        ));
+    }
     lib
+}
+
+/// Reads each `map_Kd` texture of `lib` (relative to the library's folder)
+/// and records its average colour; one warning for those that cannot be
+/// read (they keep their `Kd`), one for paths written with `\`.
+fn read_textures(lib: &mut Library) {
+    let dir = Path::new(&lib.file)
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let mut failed = Tally::default();
+    for m in &mut lib.materials {
+        let Some((name, pos)) = &m.map_kd else {
+            continue;
+        };
+        let path = dir.join(name);
+        match average_texture(&path) {
+            Ok(rgb) => m.texture = Some(rgb),
+            Err(e) => failed.add(*pos, || {
+                format!("{} (material `{}`): {e}", path.display(), m.name)
+            }),
+        }
+    }
+    if let Some((pos, first)) = failed.first {
+        lib.warnings.push(Warning::at(
+            &lib.file,
+            pos,
+            format!(
+                "cannot read {} `map_Kd` texture(s), first {first}; their materials keep `Kd`",
+                failed.count
+            ),
+        ));
+    }
+    if let Some((pos, first)) = lib.backslashes.first.take() {
+        lib.warnings.push(Warning::at(
+            &lib.file,
+            pos,
+            format!(
+                "{} `map_Kd` path(s) written with `\\` (first `{first}`), read with `/`",
+                lib.backslashes.count
+            ),
+        ));
+    }
+}
+
+/// The average colour of the image at `path`, in linear values (8- and
+/// 16-bit images are sRGB-decoded first; float images are linear
+/// already), alpha ignored. Each channel is in `[0, 1]`.
+pub(crate) fn average_texture(path: &Path) -> Result<Rgb, String> {
+    let image = image::open(path).map_err(|e| e.to_string())?;
+    let linear = matches!(
+        image,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    );
+    let pixels = image.to_rgb32f();
+    let n = u64::from(pixels.width()) * u64::from(pixels.height());
+    if n == 0 {
+        return Err("the image has no pixels".to_string());
+    }
+    let mut sum = [0.0f64; 3];
+    for p in pixels.pixels() {
+        for (s, &c) in sum.iter_mut().zip(&p.0) {
+            let c = f64::from(c).clamp(0.0, 1.0);
+            *s += if linear { c } else { srgb_to_linear(c) };
+        }
+    }
+    let [r, g, b] = sum.map(|s| s / n as f64);
+    Ok(Rgb::new(r, g, b))
+}
+
+/// The sRGB transfer function undone: an encoded value in `[0, 1]` to
+/// linear light in `[0, 1]` (IEC 61966-2-1).
+fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// The colour of a `Kd`/`Ke` line: `r g b`, or one value for grey (as the
@@ -968,21 +1389,40 @@ Kd 0.25
         assert!((s.polygons[0].area - 0.5).abs() < 1e-9);
     }
 
+    /// The warnings of a scene, as printed.
+    fn warning_lines(s: &Scene) -> Vec<String> {
+        s.warnings.iter().map(|w| w.to_string()).collect()
+    }
+
     #[test]
-    fn degenerate_faces_are_errors_with_positions() {
-        let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n  f 1 1 2 2\nf 1 2\n";
-        let e = parse(obj).unwrap_err();
+    fn degenerate_faces_are_dropped_with_one_summary_warning() {
+        // As 3ds Max writes them at UV seams: zero-area slivers and
+        // repeated indices, between real faces; CRLF line ends.
+        let obj = "# 3ds Max Wavefront OBJ Exporter v0.97b\r\n\
+                   v 0 0 0\r\nv 1 0 0\r\nv 2 0 0\r\nv 0 1 0\r\n\
+                   vt 0 0\r\nvn 0 0 1\r\ng Box001\r\ns 1\r\n\
+                   f 1/1/1 2/1/1 3/1/1\r\nf 1 2 4\r\n  f 1 1 2 2\r\nf 2 2 4\r\nf 1 2 3\r\n";
+        let s = parse(obj).unwrap();
+        assert_eq!(s.polygons.len(), 1);
+        assert_eq!(s.polygons[0].origin.line, 11);
         assert_eq!(
-            messages(&e),
+            warning_lines(&s),
             vec![
-                "m.obj:5:1: error: degenerate face: polygon has zero area",
-                "m.obj:7:3: error: degenerate face: vertices 1 and 2 are equal",
-                "m.obj:8:1: error: face has 2 vertices; at least 3 are needed",
+                "m.obj:10:1: warning: dropped 4 degenerate face(s) (no area, or a vertex \
+                 repeated); the first here: polygon has zero area"
             ]
         );
-        // A bow tie cannot be split.
-        let e = parse("v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n").unwrap_err();
-        assert!(messages(&e)[0].starts_with("m.obj:5:1: error: "), "{e}");
+        // Syntax stays an error; a file with nothing left has no faces.
+        let e = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n").unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec!["m.obj:5:1: error: face has 2 vertices; at least 3 are needed"]
+        );
+        let e = parse("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec!["m.obj:1:1: error: OBJ file has no faces"]
+        );
     }
 
     #[test]
@@ -1018,6 +1458,8 @@ Kd 0.25
 
     #[test]
     fn material_problems_name_the_mtl_file() {
+        // `Kd` 1 and an undefined material are warnings now (see the
+        // tests below); these stay errors.
         let mtl =
             "newmtl a\nKd 0.5 1.0 0.2\nnewmtl b\nKe 1 -2 3\nKd 1 2\nnewmtl a\nKd spectral x.spd\n";
         let obj = format!("mtllib lib.mtl\n{SQUARE}usemtl a\nf 1 2 3\nusemtl nope\nf 1 3 4\n");
@@ -1025,22 +1467,19 @@ Kd 0.25
         assert_eq!(
             messages(&e),
             vec![
-                "lib.mtl:2:1: error: reflectance `Kd` is 1 in the green channel; every channel must be below 1",
                 "lib.mtl:4:6: error: `Ke` channel -2 is negative; channels must be >= 0",
                 "lib.mtl:5:1: error: `Kd` takes 3 numbers (r g b) or 1 (grey), found 2",
                 "lib.mtl:6:1: error: material `a` is already defined in lib.mtl at 1:1",
                 "lib.mtl:7:4: error: `Kd spectral` is not supported: give r g b values",
-                "m.obj:8:1: error: undefined material `nope`: no `mtllib` defines it",
             ]
         );
-        // A library that cannot be read, and a material used before its library.
-        let obj = format!("usemtl white\nmtllib other.mtl\nmtllib lib.mtl\n{SQUARE}f 1 2 3\n");
+        // A material used before its library.
+        let obj = format!("usemtl white\nmtllib lib.mtl\n{SQUARE}f 1 2 3\n");
         let e = parse(&obj).unwrap_err();
         assert_eq!(
             messages(&e),
             vec![
-                "m.obj:1:1: error: material `white` is used before the `mtllib` that defines it (line 3)",
-                "m.obj:2:1: error: cannot read material library other.mtl: not found",
+                "m.obj:1:1: error: material `white` is used before the `mtllib` that defines it (line 2)",
             ]
         );
     }
@@ -1105,6 +1544,206 @@ Kd 0.25
         assert!(
             messages(&e)[0].contains("nocam.sc:1:1: error: cannot read file"),
             "{e}"
+        );
+    }
+
+    /// A Blender 2.93 export: header, object, normals, texture
+    /// coordinates, smoothing off, and the material it writes.
+    const BLENDER_OBJ: &str = "# Blender v2.93.0 OBJ File: ''\n# www.blender.org\n\
+        mtllib lib.mtl\no Plane\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n";
+
+    /// A `newmtl` block as Blender writes it, with `extra` lines after `Kd`.
+    fn blender_block(name: &str, kd: &str, extra: &str) -> String {
+        format!(
+            "newmtl {name}\nNs 225.000000\nKa 1.000000 1.000000 1.000000\n{kd}\
+             {extra}Ke 0.000000 0.000000 0.000000\nNi 1.450000\nd 1.000000\nillum 1\n"
+        )
+    }
+
+    #[test]
+    fn kd_at_or_above_one_is_scaled_below_one_with_one_warning_per_material() {
+        let mtl = format!(
+            "# Blender MTL File: 'None'\n# Material Count: 3\n\n{}\n{}\n{}",
+            blender_block("white", "Kd 1.000000 1.000000 1.000000\n", ""),
+            blender_block("orange", "Kd 1.2 0.6 0.3\n", ""),
+            blender_block("grey", "Kd 0.5 0.5 0.5\n", ""),
+        );
+        let obj = format!("{BLENDER_OBJ}usemtl white\ns off\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
+        let s = parse_with(&obj, &mtl).unwrap();
+        assert_eq!(
+            s.materials[0].reflectance(),
+            Rgb::splat(MAX_MTL_REFLECTANCE)
+        );
+        let orange = s.materials[1].reflectance();
+        assert!((orange.r - MAX_MTL_REFLECTANCE).abs() < 1e-12);
+        assert!((orange.g - MAX_MTL_REFLECTANCE / 2.0).abs() < 1e-12);
+        assert!((orange.b - MAX_MTL_REFLECTANCE / 4.0).abs() < 1e-12);
+        assert_eq!(s.materials[2].reflectance(), Rgb::splat(0.5));
+        assert_eq!(
+            warning_lines(&s),
+            vec![
+                "lib.mtl:7:1: warning: material `white`: `Kd 1 1 1` reflects all light or more; scaled to 0.95 0.95 0.95 (brightest channel 0.95)",
+                "lib.mtl:16:1: warning: material `orange`: `Kd 1.2 0.6 0.3` reflects all light or more; scaled to 0.95 0.475 0.237 (brightest channel 0.95)",
+            ]
+        );
+    }
+
+    #[test]
+    fn a_material_without_kd_gets_the_default_reflectance_with_a_warning() {
+        let mtl = "newmtl bare\nNs 10\nnewmtl lamp\nKe 5 5 5\nnewmtl red\nKd 0.6 0.1 0.1\n";
+        let obj = format!("{BLENDER_OBJ}usemtl bare\nf 1 2 3\nusemtl red\nf 1 3 4\n");
+        let s = parse_with(&obj, mtl).unwrap();
+        assert_eq!(
+            s.material_of(crate::scene::PolygonId(0)).reflectance(),
+            Rgb::splat(DEFAULT_REFLECTANCE)
+        );
+        assert_eq!(
+            s.material_of(crate::scene::PolygonId(1)).reflectance(),
+            Rgb::new(0.6, 0.1, 0.1)
+        );
+        assert_eq!(
+            warning_lines(&s),
+            vec!["lib.mtl: warning: no `Kd` in bare, lamp: reflectance 0.8 (the default)"]
+        );
+    }
+
+    #[test]
+    fn specular_glass_and_metal_are_treated_as_diffuse_in_one_warning_per_file() {
+        let mtl = format!(
+            "{}{}{}{}newmtl chrome\nKd 0.5 0.5 0.5\nPm 1.0\nPr 0.1\n",
+            blender_block("matte", "Kd 0.5 0.5 0.5\n", "Ks 0 0 0\n"),
+            blender_block("plastic", "Kd 0.5 0.5 0.5\n", "Ks 0.5 0.5 0.5\n"),
+            "newmtl glass\nKd 0.1 0.1 0.1\nNi 1.5\nd 0.2\nillum 7\n",
+            "newmtl tinted\nKd 0.2 0.2 0.2\nTr 0.4\n",
+        );
+        let obj = format!("{BLENDER_OBJ}usemtl glass\nf 1 2 3\n");
+        let s = parse_with(&obj, &mtl).unwrap();
+        assert_eq!(s.materials[2].reflectance(), Rgb::splat(0.1));
+        assert_eq!(
+            warning_lines(&s),
+            vec![
+                "lib.mtl: warning: treated as diffuse: plastic (Ks 0.5), glass (d 0.2, illum 7, \
+                 Ni 1.5), tinted (Tr 0.4), chrome (Pm 1, Pr 0.1)"
+            ]
+        );
+    }
+
+    #[test]
+    fn unreadable_libraries_and_undefined_materials_warn_and_use_the_default() {
+        // CRLF; two names on one `mtllib` line, one missing; a `\` path.
+        let read = |name: &str| match name {
+            "lib.mtl" => Ok(("lib.mtl".to_string(), MTL.to_string())),
+            "sub/more.mtl" => Ok((
+                "sub/more.mtl".to_string(),
+                "newmtl blue\r\nKd 0.1 0.1 0.7\r\n".to_string(),
+            )),
+            other => Err(format!("cannot read material library {other}: not found")),
+        };
+        let obj = "# Blender v2.93.0 OBJ File: ''\r\nmtllib lib.mtl gone.mtl\r\n\
+                   mtllib sub\\more.mtl\r\no Plane\r\n\
+                   v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\n\
+                   usemtl white\r\nf 1 2 3\r\nusemtl blue\r\nf 1 3 4\r\n\
+                   usemtl nope\r\nf 1 2 4\r\nusemtl nope\r\nf 2 3 4\r\nusemtl gone_red\r\nf 1 2 3\r\n";
+        let s = parse_obj(obj, "m.obj", &read).unwrap();
+        let names: Vec<&str> = (0..5)
+            .map(|i| {
+                s.material_of(crate::scene::PolygonId(i as u32))
+                    .name
+                    .as_str()
+            })
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "white",
+                "blue",
+                DEFAULT_MATERIAL_NAME,
+                DEFAULT_MATERIAL_NAME,
+                DEFAULT_MATERIAL_NAME
+            ]
+        );
+        assert_eq!(
+            s.material_of(crate::scene::PolygonId(1)).reflectance(),
+            Rgb::new(0.1, 0.1, 0.7)
+        );
+        assert_eq!(
+            warning_lines(&s),
+            vec![
+                "lib.mtl: warning: treated as diffuse: white (Ks 0.1)",
+                "m.obj:2:1: warning: cannot read material library gone.mtl: not found; faces using its materials get the default material",
+                "m.obj:3:1: warning: 1 `mtllib` path(s) written with `\\` (first `sub\\more.mtl`), read with `/`",
+                "m.obj:13:1: warning: undefined material `nope` (2 `usemtl` line(s), the first here): no `mtllib` defines it; its faces get the default material",
+                "m.obj:17:1: warning: undefined material `gone_red` (1 `usemtl` line(s), the first here): no `mtllib` defines it; its faces get the default material",
+            ]
+        );
+    }
+
+    #[test]
+    fn many_undefined_materials_give_a_bounded_number_of_warnings() {
+        let mut obj = SQUARE.to_string();
+        for i in 0..MAX_UNDEFINED_WARNINGS + 5 {
+            obj.push_str(&format!("usemtl m{i}\nf 1 2 3\n"));
+        }
+        let s = parse(&obj).unwrap();
+        let w = warning_lines(&s);
+        assert_eq!(w.len(), MAX_UNDEFINED_WARNINGS + 1);
+        assert!(
+            w[MAX_UNDEFINED_WARNINGS].ends_with(
+                "warning: 5 more undefined materials (the first here): their faces get the default material"
+            ),
+            "{w:?}"
+        );
+    }
+
+    #[test]
+    fn map_kd_multiplies_kd_by_the_linear_average_of_the_texture() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("tex")).unwrap();
+        // Half white, half black: linear average 0.5 (sRGB 188 would look
+        // like it, but the average of encoded values would be 127.5/255).
+        let mut img = image::RgbImage::new(2, 2);
+        img.put_pixel(0, 0, image::Rgb([255, 255, 255]));
+        img.put_pixel(1, 0, image::Rgb([255, 255, 255]));
+        img.save(dir.path().join("tex/wall.png")).unwrap();
+        // One sRGB grey of 188 everywhere: linear 0.5029.
+        let grey = image::RgbImage::from_pixel(3, 1, image::Rgb([188, 188, 188]));
+        grey.save(dir.path().join("grey.bmp")).unwrap();
+        std::fs::write(
+            dir.path().join("lib.mtl"),
+            "newmtl wall\nKd 0.8 0.8 0.8\nmap_Kd -s 1 1 1 tex\\wall.png\n\
+             newmtl floor\nKd 0.5 0.5 0.5\nmap_Kd grey.bmp\n\
+             newmtl lost\nKd 0.3 0.3 0.3\nmap_Kd missing.jpg\n\
+             newmtl lost2\nKd 0.3 0.3 0.3\nmap_Kd missing.tga\n",
+        )
+        .unwrap();
+        let obj = dir.path().join("m.obj");
+        std::fs::write(
+            &obj,
+            format!("mtllib lib.mtl\n{SQUARE}usemtl wall\nf 1 2 3 4\n"),
+        )
+        .unwrap();
+        let s = load_obj(&obj, None).unwrap();
+        let rho = |i: usize| s.materials[i].reflectance();
+        assert!((rho(0).g - 0.4).abs() < 1e-6, "{:?}", rho(0));
+        let srgb188 = srgb_to_linear(188.0 / 255.0);
+        assert!((srgb188 - 0.5029).abs() < 1e-4);
+        assert!((rho(1).r - 0.5 * srgb188).abs() < 1e-6, "{:?}", rho(1));
+        assert_eq!(rho(2), Rgb::splat(0.3));
+        let w = warning_lines(&s);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].ends_with(":9:1: warning: cannot read 2 `map_Kd` texture(s), first ")
+                || w[0].contains(":9:1: warning: cannot read 2 `map_Kd` texture(s), first "),
+            "{w:?}"
+        );
+        assert!(w[0].contains("missing.jpg (material `lost`)"), "{w:?}");
+        assert!(w[0].ends_with("; their materials keep `Kd`"), "{w:?}");
+        assert!(
+            w[1].ends_with(
+                ":3:1: warning: 1 `map_Kd` path(s) written with `\\` (first `tex\\wall.png`), read with `/`"
+            ),
+            "{w:?}"
         );
     }
 }
