@@ -748,10 +748,15 @@ fn exported_obj_quirks_load_with_one_line_warnings() {
     let picture = image::open(dir.path().join("room.png")).unwrap();
     assert!(picture.width() > 0 && picture.height() > 0);
     let err = stderr(&out);
-    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("warning:")).collect();
+    // The loader's warnings (the picture may get one of its own: this
+    // model's lamp faces away from the automatic camera).
+    let warnings: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("room.") && l.contains("warning:"))
+        .collect();
     let expected = [
         "room.mtl:7:1: warning: material `white`: `Kd 1 1 1` reflects all light or more; scaled to 0.95 0.95 0.95 (brightest channel 0.95)",
-        "room.mtl: warning: treated as diffuse: glass (Ks 0.5, d 0.3, illum 7, Ni 1.5)",
+        "room.mtl: warning: treated as diffuse: glass (d 0.3, illum 7, Ni 1.5)",
         "room.mtl:38:1: warning: cannot read 1 `map_Kd` texture(s), first textures/brick.png (material `brick`): ",
         "room.mtl:38:1: warning: 1 `map_Kd` path(s) written with `\\` (first `textures\\brick.png`), read with `/`",
         "room.obj:31:1: warning: undefined material `Material.001` (1 `usemtl` line(s), the first here): no `mtllib` defines it; its faces get the default material",

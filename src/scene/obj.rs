@@ -52,8 +52,9 @@
 //! What is ignored: texture coordinates, normals, smoothing groups, lines
 //! (`l`) and points (`p`), `Ka`, `Ns`, other maps,
 //! and what makes a material specular, a mirror, glass or metal: non-black
-//! `Ks`, `illum` 3 to 9, `d` below 1 or `Tr` above 0, `Ni` (with `illum`
-//! 4, 6 or 7), `Pm` above 0 and `Pr` below 1. Such materials are treated
+//! `Ks` above [`DIFFUSE_SHEEN_LIMIT`] (Blender's default 0.5 is not), `illum` 3 to 9, `d`
+//! below 1 or `Tr` above 0, `Ni` (with `illum` 4, 6 or 7), `Pm` above 0
+//! and `Pr` below [`DIFFUSE_SHEEN_LIMIT`]. Such materials are treated
 //! as diffuse, named in one warning per MTL file. Faces before any
 //! `usemtl` get the built-in material [`DEFAULT_MATERIAL_NAME`] with
 //! reflectance [`DEFAULT_REFLECTANCE`] (Blender's default base colour).
@@ -97,6 +98,14 @@ pub const DEFAULT_MATERIAL_NAME: &str = "(no usemtl)";
 /// Reflectance of [`DEFAULT_MATERIAL_NAME`], every channel, dimensionless:
 /// 0.8, the default base colour of a new Blender material.
 pub const DEFAULT_REFLECTANCE: f64 = 0.8;
+
+/// The largest `Ks` channel (and, for `Pr`, the smallest roughness) that
+/// still reads as a diffuse material without a warning, dimensionless:
+/// Blender writes `Ks 0.5 0.5 0.5` and `Pr 0.5` for every material of
+/// default specular and roughness, a dielectric's faint sheen (4 %
+/// reflection head-on), not a shiny one. Above `Ks` 0.5 or below `Pr` 0.5
+/// the material was made glossy on purpose, and the warning names it.
+pub const DIFFUSE_SHEEN_LIMIT: f64 = 0.5;
 
 /// The brightest diffuse reflectance taken from an MTL file, dimensionless.
 /// A `Kd` with a channel at or above one (many exporters write `Kd 1 1 1`
@@ -1090,7 +1099,7 @@ fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
             }
             "Ks" => {
                 if let Ok(ks) = color(&w) {
-                    if !ks.is_black() {
+                    if ks.max_channel() > DIFFUSE_SHEEN_LIMIT {
                         m.non_diffuse
                             .push(format!("Ks {}", fmt_num(ks.max_channel())));
                     }
@@ -1114,7 +1123,7 @@ fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
                 }
             }
             "Pr" => {
-                if let Some(pr) = number(&w).filter(|&p| p < 1.0) {
+                if let Some(pr) = number(&w).filter(|&p| p < DIFFUSE_SHEEN_LIMIT) {
                     m.non_diffuse.push(format!("Pr {}", fmt_num(pr)));
                 }
             }
@@ -1288,7 +1297,7 @@ mod tests {
 # two materials
 newmtl white
 Kd 0.5 0.5 0.5
-Ks 0.1 0.1 0.1
+Ks 0.8 0.8 0.8
 newmtl lamp
 Kd 0 0 0
 Ke 10 8 6
@@ -1611,19 +1620,20 @@ Kd 0.25
     #[test]
     fn specular_glass_and_metal_are_treated_as_diffuse_in_one_warning_per_file() {
         let mtl = format!(
-            "{}{}{}{}newmtl chrome\nKd 0.5 0.5 0.5\nPm 1.0\nPr 0.1\n",
+            "{}{}{}{}{}newmtl chrome\nKd 0.5 0.5 0.5\nPm 1.0\nPr 0.1\n",
             blender_block("matte", "Kd 0.5 0.5 0.5\n", "Ks 0 0 0\n"),
-            blender_block("plastic", "Kd 0.5 0.5 0.5\n", "Ks 0.5 0.5 0.5\n"),
+            blender_block("plastic", "Kd 0.5 0.5 0.5\n", "Ks 0.9 0.9 0.9\n"),
+            blender_block("default", "Kd 0.5 0.5 0.5\n", "Ks 0.5 0.5 0.5\nPr 0.5\n"),
             "newmtl glass\nKd 0.1 0.1 0.1\nNi 1.5\nd 0.2\nillum 7\n",
             "newmtl tinted\nKd 0.2 0.2 0.2\nTr 0.4\n",
         );
         let obj = format!("{BLENDER_OBJ}usemtl glass\nf 1 2 3\n");
         let s = parse_with(&obj, &mtl).unwrap();
-        assert_eq!(s.materials[2].reflectance(), Rgb::splat(0.1));
+        assert_eq!(s.materials[3].reflectance(), Rgb::splat(0.1));
         assert_eq!(
             warning_lines(&s),
             vec![
-                "lib.mtl: warning: treated as diffuse: plastic (Ks 0.5), glass (d 0.2, illum 7, \
+                "lib.mtl: warning: treated as diffuse: plastic (Ks 0.9), glass (d 0.2, illum 7, \
                  Ni 1.5), tinted (Tr 0.4), chrome (Pm 1, Pr 0.1)"
             ]
         );
@@ -1670,7 +1680,7 @@ Kd 0.25
         assert_eq!(
             warning_lines(&s),
             vec![
-                "lib.mtl: warning: treated as diffuse: white (Ks 0.1)",
+                "lib.mtl: warning: treated as diffuse: white (Ks 0.8)",
                 "m.obj:2:1: warning: cannot read material library gone.mtl: not found; faces using its materials get the default material",
                 "m.obj:3:1: warning: 1 `mtllib` path(s) written with `\\` (first `sub\\more.mtl`), read with `/`",
                 "m.obj:13:1: warning: undefined material `nope` (2 `usemtl` line(s), the first here): no `mtllib` defines it; its faces get the default material",
