@@ -1,7 +1,9 @@
 //! Small scenes built in code for unit tests, independent of the parser.
 
 use crate::color::Rgb;
-use crate::scene::{Camera, CameraSource, Material, MaterialId, Polygon, Scene, Shape, SourcePos};
+use crate::scene::{
+    Camera, CameraSource, Material, MaterialId, Polygon, Scene, Shape, SourcePos, Surface,
+};
 use glam::{DVec3, Vec3};
 
 /// Marsaglia's xorshift64: a tiny deterministic pseudo-random stream, so
@@ -48,6 +50,7 @@ pub fn polygon(material: u32, vertices: &[[f32; 3]]) -> Polygon {
         area: n.length() * 0.5,
         shape,
         origin: SourcePos::default(),
+        surface: Surface::default(),
     }
 }
 

@@ -121,6 +121,29 @@ pub struct Polygon {
     pub shape: Shape,
     /// Where the statement that made it starts in its source file.
     pub origin: SourcePos,
+    /// What it is beyond its geometry: sides, smooth surface, sky.
+    pub surface: Surface,
+}
+
+/// Index of a smooth surface: polygons with the same one (an OBJ smoothing
+/// group, faces sharing vertex normals, a glTF primitive with shared
+/// normals) are shaded as one continuous surface where they meet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SmoothId(pub u32);
+
+/// What a polygon is beyond its geometry. The default is the `.sc`
+/// reading: one-sided, faceted, an ordinary surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Surface {
+    /// The loader's reading of the face: true when its back side should
+    /// receive, reflect and emit too (OBJ faces, glTF `doubleSided`).
+    /// Acted on by `Scene::with_sides`, which adds the back copies.
+    pub two_sided: bool,
+    /// Set on a back copy made by `Scene::with_sides`: the polygon whose
+    /// back it is. The two are coplanar and never block each other.
+    pub back_of: Option<PolygonId>,
+    /// The smooth surface it belongs to, if any.
+    pub smooth: Option<SmoothId>,
 }
 
 /// Whether the camera came from the file or was made to frame the scene.

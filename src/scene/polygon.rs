@@ -11,7 +11,7 @@
 //! whatever its unit of length.
 
 use super::error::fmt_num;
-use super::{MaterialId, Polygon, SourcePos};
+use super::{MaterialId, Polygon, SourcePos, Surface};
 use glam::{DVec3, Vec3};
 
 /// How far a vertex may lie from the polygon's plane, as a fraction of the
@@ -191,6 +191,7 @@ impl Polygon {
             area: a.area,
             shape: a.shape,
             origin,
+            surface: Surface::default(),
         })
     }
 

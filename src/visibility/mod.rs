@@ -369,7 +369,7 @@ fn segment_ray(a: Vec3, b: Vec3) -> Option<Ray> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{MaterialId, Polygon, Shape, SourcePos};
+    use crate::scene::{MaterialId, Polygon, Shape, SourcePos, Surface};
     use crate::testutil;
 
     fn square(z: f32, size: f32, offset: (f32, f32)) -> Polygon {
@@ -386,6 +386,7 @@ mod tests {
             area: (size * size) as f64,
             shape: Shape::Parallelogram,
             origin: SourcePos::default(),
+            surface: Surface::default(),
         }
     }
 
