@@ -6,6 +6,7 @@
 use crate::color::Rgb;
 use crate::mesh::{self, refine::RefineOptions};
 use crate::render::Exposure;
+use crate::scene::Sides;
 use crate::solver::SolverOptions;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -111,6 +112,10 @@ pub struct RunConfig {
     /// after loading by [`crate::scene::Scene::set_emission`]; an unknown
     /// name fails the run. Empty by default.
     pub emit: Vec<(String, Rgb)>,
+    /// Which sides of the polygons take part: as the file says (OBJ faces
+    /// both, `.sc` the front), or `--one-sided` / `--two-sided` for all.
+    /// Applied after `--emit` by [`crate::scene::Scene::with_sides`].
+    pub sides: Sides,
 }
 
 impl RunConfig {
@@ -138,6 +143,7 @@ impl RunConfig {
             adaptive: None,
             mesh_lines: false,
             emit: Vec::new(),
+            sides: Sides::AsLoaded,
         }
     }
 }

@@ -84,6 +84,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
+    let mut scene = scene.with_sides(config.sides);
     if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
         scene.warnings.push(warning);
     }

@@ -632,18 +632,22 @@ fn obj_scene_runs_with_camera_export_log_and_plot() {
         assert_eq!(r.len(), columns);
         assert_eq!(r[0], (i + 1) as f64, "step column");
         assert!(
-            r[1] >= 0.0 && r[1] < 18.0 && r[1].fract() == 0.0,
+            // 18 faces, each with its back.
+            r[1] >= 0.0 && r[1] < 36.0 && r[1].fract() == 0.0,
             "shooter index"
         );
         assert!(r[2] >= 1.0, "shooter line");
         assert!(r[3] > 0.0, "shot power");
         assert!(r[4] > 0.0 && r[4] < 1.0, "unshot fraction");
-        assert!(r[5] > 0.0, "rays");
+        // A shooter with nothing in front of it casts no ray: the back of
+        // a two-sided lamp in the ceiling's plane, whose light leaves.
+        assert!(r[5] >= 0.0 && r[5].fract() == 0.0, "rays");
         assert!(r[6] > 0.0, "seconds");
         if i > 0 {
             assert!(r[6] >= rows[i - 1][6], "seconds grow");
         }
     }
+    assert!(rows.iter().map(|r| r[5]).sum::<f64>() > 0.0, "rays");
     // The light shoots first: polygon 1, its face on line 21 of the OBJ.
     assert_eq!((rows[0][1], rows[0][2]), (1.0, 21.0));
     let last = rows.last().unwrap();
@@ -888,7 +892,8 @@ fn a_picture_of_back_faces_warns_once() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "room.mtl", ROOM_MTL);
     write(dir.path(), "box.obj", &room_obj(true));
-    // The eye forced inside a box whose faces point outwards.
+    // The eye forced inside a box whose faces point outwards, read
+    // one-sided (as Blender shows them with backface culling).
     write(
         dir.path(),
         "inside.sc",
@@ -900,6 +905,7 @@ fn a_picture_of_back_faces_warns_once() {
             "box.obj",
             "--camera",
             "inside.sc",
+            "--one-sided",
             "--lenmax",
             "1",
             "--max-steps",

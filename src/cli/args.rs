@@ -158,6 +158,21 @@ pub struct Args {
     #[arg(long, value_name = "NAME=VALUE", value_parser = parse_emit)]
     pub(crate) emit: Vec<(String, Rgb)>,
 
+    /// Every polygon reflects and emits from its front only.
+    ///
+    /// OBJ faces are two-sided by default (each side receives, reflects
+    /// and emits on its own, as Blender shades them); glTF follows each
+    /// material's doubleSided; .sc polygons are one-sided.
+    #[arg(long, conflicts_with = "two_sided")]
+    pub(crate) one_sided: bool,
+
+    /// Every polygon is two-sided.
+    ///
+    /// Each side receives, reflects and emits on its own, with its own
+    /// radiosity (the default for OBJ faces).
+    #[arg(long)]
+    pub(crate) two_sided: bool,
+
     /// Take the camera from this .sc file.
     ///
     /// Its `camera` block is used (for .obj scenes, which have none; it

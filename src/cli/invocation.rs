@@ -13,6 +13,7 @@ use crate::config::{RunConfig, SceneSource};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
 use crate::render::Exposure;
+use crate::scene::Sides;
 use crate::solver::SolverOptions;
 use std::num::NonZeroUsize;
 use std::time::Duration;
@@ -156,6 +157,11 @@ impl TryFrom<Args> for Invocation {
             adaptive: args.adaptive.then_some(refine),
             mesh_lines: args.mesh_lines,
             emit: args.emit,
+            sides: match (args.one_sided, args.two_sided) {
+                (true, _) => Sides::One,
+                (_, true) => Sides::Two,
+                (false, false) => Sides::AsLoaded,
+            },
         };
         let mode = if args.no_window
             || config.output.is_some()

@@ -142,6 +142,14 @@ pub struct PolygonMesh {
     /// [`refine`]); 0 for the regular subdivision of [`build`], whose
     /// vertices are evenly spaced.
     pub levels: u32,
+    /// Its draw layer among overlapping coplanar polygons that face its
+    /// way ([`crate::scene::draw_layers`]): where they overlap, the
+    /// picture shows the highest layer. 0 for most polygons.
+    pub layer: u8,
+    /// True when another polygon draws its back side (its back copy, or a
+    /// face of the file that is its reverse, [`crate::scene::Surface::back`]):
+    /// the picture then draws this one from the front only.
+    pub has_back: bool,
 }
 
 impl PolygonMesh {
@@ -429,6 +437,7 @@ pub fn build_with_limit(
         element_polygon: Vec::with_capacity(elements as usize),
         polygons: Vec::with_capacity(scene.polygons.len()),
     };
+    let layers = crate::scene::draw_layers(scene, &crate::scene::plane_classes(scene));
     for (index, (polygon, plan)) in scene.polygons.iter().zip(&plans).enumerate() {
         let id = PolygonId(index as u32);
         let v_start = mesh.positions.len() as u32;
@@ -455,6 +464,8 @@ pub fn build_with_limit(
             min_edge,
             inset: options.inset * min_edge,
             levels: 0,
+            layer: layers[index],
+            has_back: polygon.surface.back.is_some(),
         });
     }
     Ok(mesh)

@@ -30,7 +30,7 @@ pub mod tonemap;
 pub use camera::{View, ViewError};
 pub use coverage::{PictureCoverage, DARK_PICTURE_FRACTION};
 pub use overlay::{draw_mesh_edges, MESH_COLOR};
-pub use raster::{Frame, Rasterizer, RenderError};
+pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
 pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};
 
 /// Renders one frame of a solution (`radiosity` per vertex of `mesh`) with

@@ -12,7 +12,10 @@
 //! nearest surface wins the depth test.
 //!
 //! Only the front of a polygon reflects or emits light: triangles seen from
-//! the back are drawn black but still hide what is behind them.
+//! the back are drawn black but still hide what is behind them, unless
+//! another polygon is that back side (a two-sided face's back copy), which
+//! then draws it. Overlapping coplanar polygons are stacked by their draw
+//! layer ([`LAYER_DEPTH_BIAS`]).
 //!
 //! The picture is filled in bands of rows in parallel. Every band draws all
 //! triangles in mesh order, and no pixel belongs to two bands, so the result
@@ -24,6 +27,12 @@ use crate::mesh::{Mesh, VertexId};
 use glam::DVec3;
 use rayon::prelude::*;
 use thiserror::Error;
+
+/// Relative depth by which each draw layer is pulled towards the eye:
+/// far above the rounding of depths interpolated from `f32` vertices
+/// (1e-7 relative), far below any gap a model means (a stack of
+/// [`crate::scene::MAX_DRAW_LAYER`] layers moves 0.014 % of the depth).
+pub const LAYER_DEPTH_BIAS: f64 = 2e-5;
 
 /// Bits of sub-pixel precision of the snapped screen coordinates.
 ///
@@ -226,11 +235,19 @@ impl Rasterizer {
                     .normal
                     .dot(view.eye() - mesh.positions[tri[0].index()])
                     > 0.0;
+                // Its back side is another polygon, drawn on its own.
+                if !front && polygon.has_back {
+                    continue;
+                }
+                let first = self.triangles.len();
                 setup.push(
                     [corner(tri[0]), corner(tri[1]), corner(tri[2])],
                     front,
                     &mut self.triangles,
                 );
+                for t in &mut self.triangles[first..] {
+                    t.layer = polygon.layer;
+                }
             }
         }
 
@@ -392,6 +409,8 @@ struct ScreenTriangle {
     bias: [i64; 3],
     /// Whether the eye sees the front of the triangle's polygon.
     front: bool,
+    /// Its polygon's draw layer ([`crate::mesh::PolygonMesh::layer`]).
+    layer: u8,
     /// Inclusive pixel bounds: columns `x0..=x1`, rows `y0..=y1`.
     x0: usize,
     x1: usize,
@@ -531,6 +550,7 @@ impl<'v> Setup<'v> {
                 i64::from(!is_top_left(&v[0], &v[1])),
             ],
             front,
+            layer: 0,
             // Non-negative and inside the picture after the clamps above.
             x0: x0 as usize,
             x1: x1 as usize,
@@ -573,13 +593,17 @@ impl Band<'_> {
                 }
                 let (l0, l1, l2) = (w0 as f64 / area, w1 as f64 / area, w2 as f64 / area);
                 let inv_z = l0 * a.inv_z + l1 * b.inv_z + l2 * c.inv_z;
+                // A higher layer is pulled nearer by a hair, so of two
+                // overlapping coplanar polygons it wins wherever rounding
+                // would have split them.
+                let key = inv_z * (1.0 + f64::from(t.layer) * LAYER_DEPTH_BIAS);
                 let i = row + x;
                 // Strictly nearer: on equal depth the first triangle drawn
                 // keeps the pixel, which is the same in every band.
-                if inv_z.is_nan() || inv_z <= self.depth[i] {
+                if key.is_nan() || key <= self.depth[i] {
                     continue;
                 }
-                self.depth[i] = inv_z;
+                self.depth[i] = key;
                 self.covered[i] = true;
                 self.front[i] = t.front;
                 let channel = |k: usize| {
@@ -664,6 +688,8 @@ mod tests {
                 min_edge: 1.0,
                 inset: 0.0,
                 levels: 0,
+                layer: 0,
+                has_back: false,
             });
             self
         }

@@ -689,7 +689,7 @@ mod tests {
     fn obj_objects_and_groups_are_recorded_per_polygon() {
         let obj = "\
 v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
-f 1 2 3\n\
+f 2 3 4\n\
 o Room\n\
 f 1 2 3 4\n\
 g walls fixtures\n\
@@ -698,7 +698,8 @@ f 1 2 3 5\n\
 o Camera\n\
 o Lamp\n\
 g fixtures\n\
-f 1 2 3\n\
+v 0.5 0.5 2\n\
+f 1 2 -1\n\
 o Room\n\
 g\n\
 f 1 3 4\n";

@@ -6,6 +6,7 @@
 //! everything the format promises (planar, convex, non-degenerate polygons;
 //! reflectance below one), so later stages may rely on it.
 
+mod coplanar;
 mod emit;
 mod error;
 mod framing;
@@ -13,7 +14,11 @@ pub mod hall;
 pub mod obj;
 mod polygon;
 mod sc;
+mod sides;
 
+pub use coplanar::{
+    draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE, PLANE_OFFSET_TOLERANCE,
+};
 pub use emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
 };
@@ -29,6 +34,7 @@ pub use polygon::{
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
 pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
+pub use sides::Sides;
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.
@@ -137,11 +143,16 @@ pub struct SmoothId(pub u32);
 pub struct Surface {
     /// The loader's reading of the face: true when its back side should
     /// receive, reflect and emit too (OBJ faces, glTF `doubleSided`).
-    /// Acted on by `Scene::with_sides`, which adds the back copies.
+    /// Acted on by [`Scene::with_sides`], which adds the back copies.
     pub two_sided: bool,
-    /// Set on a back copy made by `Scene::with_sides`: the polygon whose
+    /// Set on a back copy made by [`Scene::with_sides`]: the polygon whose
     /// back it is. The two are coplanar and never block each other.
     pub back_of: Option<PolygonId>,
+    /// The polygon that is this one's back side, once [`Scene::with_sides`]
+    /// has run: its back copy, or a face of the file that is this one
+    /// reversed. A polygon with a back is never drawn from behind: its
+    /// back draws that side.
+    pub back: Option<PolygonId>,
     /// The smooth surface it belongs to, if any.
     pub smooth: Option<SmoothId>,
 }

@@ -46,6 +46,12 @@
 //!   A face of four or more vertices keeps the triangles of it that have
 //!   an area, silently.
 //!
+//! Every face is **two-sided** ([`super::Surface::two_sided`]), as Blender
+//! shades it: each side receives, reflects and emits on its own once
+//! [`Scene::with_sides`] has added the back copies (`--one-sided` keeps
+//! the fronts only). A face that repeats an earlier one exactly is
+//! dropped with one warning ([`Scene::drop_duplicates`]).
+//!
 //! Object (`o`) and group (`g`) names are recorded in [`Scene::groups`],
 //! for `--emit` and the warning when nothing emits.
 //!
@@ -431,14 +437,22 @@ pub(crate) fn parse_obj(
     if !diags.is_empty() {
         return Err(LoadError::from_diagnostics(diags));
     }
-    Ok(Scene {
+    // Blender shades both sides of a face: so does an OBJ face here.
+    for p in &mut polygons {
+        p.surface.two_sided = true;
+    }
+    let mut scene = Scene {
         camera: super::frame_camera(&polygons),
         polygons,
         materials,
         camera_source: CameraSource::AutoFramed,
         warnings,
         groups: GroupScan::finish(groups),
-    })
+    };
+    if let Some(warning) = scene.drop_duplicates(file) {
+        scene.warnings.push(warning);
+    }
+    Ok(scene)
 }
 
 // ------------------------------------------------------------ faces --
@@ -1654,7 +1668,7 @@ Kd 0.25
                    mtllib sub\\more.mtl\r\no Plane\r\n\
                    v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\n\
                    usemtl white\r\nf 1 2 3\r\nusemtl blue\r\nf 1 3 4\r\n\
-                   usemtl nope\r\nf 1 2 4\r\nusemtl nope\r\nf 2 3 4\r\nusemtl gone_red\r\nf 1 2 3\r\n";
+                   usemtl nope\r\nf 1 2 4\r\nusemtl nope\r\nf 2 3 4\r\nusemtl gone_red\r\nf 1 4 2\r\n";
         let s = parse_obj(obj, "m.obj", &read).unwrap();
         let names: Vec<&str> = (0..5)
             .map(|i| {
@@ -1693,7 +1707,8 @@ Kd 0.25
     fn many_undefined_materials_give_a_bounded_number_of_warnings() {
         let mut obj = SQUARE.to_string();
         for i in 0..MAX_UNDEFINED_WARNINGS + 5 {
-            obj.push_str(&format!("usemtl m{i}\nf 1 2 3\n"));
+            // A face of its own each time: repeated faces are dropped.
+            obj.push_str(&format!("v 0 0 {}\nusemtl m{i}\nf 1 2 -1\n", i + 1));
         }
         let s = parse(&obj).unwrap();
         let w = warning_lines(&s);

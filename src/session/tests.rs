@@ -244,3 +244,65 @@ fn shown_radiosity_with_and_without_the_ambient_term() {
     assert!(a.iter().zip(&b).all(|(x, y)| y.r >= x.r));
     assert!(a.iter().zip(&b).any(|(x, y)| y.r > x.r));
 }
+
+/// Two-sided walls of a closed box (each wall and its back copy emitting
+/// `e` and reflecting `rho`): the inside is the uniform enclosure,
+/// `B = e / (1 − rho)`, and the outside sides see nothing, so they keep
+/// `B = e` exactly. The back copies are coplanar with their fronts and
+/// sit across every corner from the other walls' copies: neither blocks
+/// the other, and no light crosses a wall.
+#[test]
+fn two_sided_box_is_the_enclosure_inside_and_bare_emission_outside() {
+    use crate::scene::Sides;
+    use crate::testutil::{closed_box, grey, scene};
+    let (e, rho) = (1.0, 0.6);
+    let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]).with_sides(Sides::Two);
+    assert_eq!(s.polygons.len(), 12);
+    let m = build(&s, 0.1);
+    let vis = Visibility::new(&s);
+    let mut session = Session::new(&s, &m, &vis, options(None));
+    run_to_end(&mut session);
+    let b = session.radiosity();
+    let worst = |range: std::ops::Range<usize>, exact: f64| {
+        m.polygons[range]
+            .iter()
+            .flat_map(|p| p.vertices.clone())
+            .map(|v| (b[v as usize].r - exact).abs() / exact)
+            .fold(0.0, f64::max)
+    };
+    let inside = worst(0..6, e / (1.0 - rho));
+    assert!(inside < 0.01, "worst inside vertex error {inside}");
+    let outside = worst(6..12, e);
+    assert!(outside < 1e-12, "worst outside vertex error {outside}");
+}
+
+/// A single-plane wall lit from one side: its lit side is bright and its
+/// back, which sees only the dark side of the world, stays black, with no
+/// light through the wall; one-sided, the back is not there at all.
+#[test]
+fn a_thin_two_sided_wall_is_dark_on_its_unlit_side() {
+    use crate::scene::Sides;
+    use crate::testutil::{grey, polygon, scene};
+    // A lamp at x = 0 facing +x, a wall at x = 1 facing it (−x).
+    let lamp = polygon(1, &[[0., 0., 0.], [0., 1., 0.], [0., 1., 1.], [0., 0., 1.]]);
+    let wall = polygon(0, &[[1., 0., 0.], [1., 0., 1.], [1., 1., 1.], [1., 1., 0.]]);
+    let mut s = scene(
+        vec![lamp, wall],
+        vec![grey("wall", 0.0, 0.5), grey("lamp", 1.0, 0.0)],
+    );
+    s.polygons[1].surface.two_sided = true;
+    let s = s.with_sides(Sides::AsLoaded);
+    assert_eq!(s.polygons.len(), 3, "the wall and its back");
+    let m = build(&s, 0.1);
+    let vis = Visibility::new(&s);
+    let mut session = Session::new(&s, &m, &vis, options(None));
+    run_to_end(&mut session);
+    let b = session.radiosity();
+    let mean = |p: usize| {
+        let r = m.polygons[p].vertices.clone();
+        r.clone().map(|v| b[v as usize].r).sum::<f64>() / r.len() as f64
+    };
+    // Facing squares one unit apart: F ≈ 0.2, so the lit side ≈ 0.1.
+    assert!(mean(1) > 0.05, "lit side {}", mean(1));
+    assert_eq!(mean(2), 0.0, "the back of the wall gets no light");
+}

@@ -13,7 +13,7 @@
 
 pub mod shaft;
 
-use crate::scene::{PolygonId, Scene};
+use crate::scene::{self, PolygonId, Scene};
 use glam::{DVec3, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
@@ -108,6 +108,9 @@ pub struct Visibility {
     bvh: Option<CwBvh>,
     regions: Option<Bvh2>,
     blockers: Vec<Blocker>,
+    /// Per polygon, its plane's number ([`scene::plane_classes`]): a
+    /// polygon never blocks a segment from or to a polygon in its plane.
+    planes: Vec<u32>,
     shaft_tolerance: f64,
     plane_side_tolerance: f64,
 }
@@ -168,6 +171,7 @@ impl Visibility {
             bvh,
             regions,
             blockers,
+            planes: scene::plane_classes(scene),
             shaft_tolerance: SHAFT_TOLERANCE * f64::from(scene.extent()),
             plane_side_tolerance: PLANE_SIDE_TOLERANCE * f64::from(scene.extent()),
         }
@@ -208,8 +212,7 @@ impl Visibility {
                 .unwrap_or(&[])
             {
                 let blocker = &self.blockers[p as usize];
-                if p != from.0
-                    && p != to.0
+                if !self.in_plane_of(p, (from, to))
                     && shaft.may_overlap_points(blocker.vertices.iter().copied())
                     && self.straddles(blocker, a.vertices.iter().chain(&b.vertices).copied())
                 {
@@ -314,12 +317,23 @@ impl Visibility {
         })
     }
 
+    /// True when polygon `p` lies in the plane of one of `ends` (or is
+    /// one of them): a segment from or to a point of that plane can meet
+    /// it only at its end, so it never blocks.
+    #[inline]
+    fn in_plane_of(&self, p: u32, ends: (PolygonId, PolygonId)) -> bool {
+        let plane = |q: PolygonId| self.planes.get(q.index()).copied().unwrap_or(q.0);
+        let own = self.planes.get(p as usize).copied().unwrap_or(p);
+        p == ends.0 .0 || p == ends.1 .0 || own == plane(ends.0) || own == plane(ends.1)
+    }
+
     /// Number of polygons.
     pub fn polygon_count(&self) -> usize {
         self.blockers.len()
     }
 
-    /// True when some polygon other than `ends.0` and `ends.1` crosses the
+    /// True when some polygon other than `ends.0` and `ends.1`, and not in
+    /// the plane of either, crosses the
     /// open segment from `a` to `b` (ignoring hits within
     /// [`SEGMENT_END_EPSILON`] of either end).
     pub fn occluded(&self, a: Vec3, b: Vec3, ends: (PolygonId, PolygonId)) -> bool {
@@ -331,7 +345,7 @@ impl Visibility {
         };
         !bvh.ray_traverse_miss(ray, |ray, id| {
             let p = bvh.primitive_indices[id];
-            if p == ends.0 .0 || p == ends.1 .0 {
+            if self.in_plane_of(p, ends) {
                 f32::INFINITY
             } else {
                 self.blockers[p as usize].intersect(ray)
@@ -346,8 +360,7 @@ impl Visibility {
             return false;
         };
         self.blockers.iter().enumerate().any(|(p, blocker)| {
-            let p = p as u32;
-            p != ends.0 .0 && p != ends.1 .0 && blocker.intersect(&ray).is_finite()
+            !self.in_plane_of(p as u32, ends) && blocker.intersect(&ray).is_finite()
         })
     }
 }
