@@ -13,6 +13,7 @@ pub mod hall;
 pub mod obj;
 mod polygon;
 mod sc;
+mod split;
 
 pub use emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
@@ -29,6 +30,7 @@ pub use polygon::{
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
 pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
+pub use split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.
