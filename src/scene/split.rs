@@ -60,7 +60,9 @@
 //!
 //! **Cost.** Candidate pairs come from a BVH over the polygons' bounding
 //! boxes (`obvhs`), and each polygon's cuts are found and made on its own,
-//! in parallel: about 0.1 s for 100,000 polygons on two cores.
+//! in parallel: 118,300 polygons (a floor of tiles with a box on each,
+//! half of them sunk) take under half a CPU-second, building the scene
+//! included (the test `a_hundred_thousand_polygons_split_as_counted`).
 
 use super::{Polygon, PolygonId, Scene};
 use glam::{DVec3, Vec3A};
