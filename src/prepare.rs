@@ -1,7 +1,8 @@
 //! Preparing a scene for solving: load it (with a camera override), make
 //! what `--emit` names emit ([`Scene::set_emission`]), say on stderr what
 //! the loader changed or ignored and whether nothing emits
-//! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), check
+//! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), split polygons
+//! where others pass through them ([`Scene::split_intersections`]), check
 //! the mesh size against the element limit before allocating anything,
 //! mesh it and build the visibility BVH. What the batch run, the window
 //! and the examples all start from.
@@ -9,7 +10,7 @@
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
-use crate::scene::{self, LoadError, Scene, UnknownName};
+use crate::scene::{self, LoadError, Scene, SplitStats, UnknownName};
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::path::Path;
@@ -62,6 +63,8 @@ pub struct Prepared {
     pub lenmax: f32,
     /// Seconds spent so far (load, mesh, bvh).
     pub seconds: PhaseSeconds,
+    /// What splitting along intersections did to the loaded scene.
+    pub split: SplitStats,
 }
 
 impl Prepared {
@@ -84,10 +87,14 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
-    let mut scene = scene.with_sides(config.sides);
     if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
         scene.warnings.push(warning);
     }
+    // Not a quirk of the file, so no warning: geometry passing through
+    // geometry is how models are built. Before the back copies, so that
+    // each piece gets its own.
+    let split = scene.split_intersections();
+    let scene = scene.with_sides(config.sides);
     seconds.load = t.elapsed().as_secs_f64();
     // Said before the solve, whatever `--quiet` says: a warning explains a
     // picture that is not what the user expected.
@@ -114,6 +121,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
         visibility,
         lenmax: mesh_options.lenmax,
         seconds,
+        split,
     })
 }
 

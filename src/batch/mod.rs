@@ -143,8 +143,14 @@ pub struct RunStats {
     /// (and not written) when there were none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
-    /// Scene polygons.
+    /// Scene polygons (after splitting along intersections).
     pub polygons: usize,
+    /// Polygons cut along the lines where others pass through them, and
+    /// the pieces they became
+    /// ([`Scene::split_intersections`](crate::scene::Scene::split_intersections));
+    /// written only when something was cut.
+    #[serde(skip_serializing_if = "crate::scene::SplitStats::is_empty")]
+    pub split: crate::scene::SplitStats,
     /// Mesh elements.
     pub elements: usize,
     /// Mesh element vertices.
@@ -303,6 +309,7 @@ pub fn run_prepared(
             .chain(dark)
             .collect(),
         polygons: prepared.scene.polygons.len(),
+        split: prepared.split,
         elements: mesh.elements.len(),
         vertices: mesh.vertex_count(),
         lenmax: prepared.lenmax,

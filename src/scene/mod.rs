@@ -15,6 +15,7 @@ pub mod obj;
 mod polygon;
 mod sc;
 mod sides;
+mod split;
 
 pub use coplanar::{
     draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE, PLANE_OFFSET_TOLERANCE,
@@ -35,6 +36,7 @@ pub use polygon::{
 };
 pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
 pub use sides::Sides;
+pub use split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.
