@@ -391,7 +391,9 @@ fn collect_primitive(
 
 /// The `.glb` file (see the module docs) for the scene, the mesh built from
 /// it, the radiosity per vertex and the exposure of the display colours;
-/// `name` as for [`write_mesh`].
+/// `name` as for [`write_mesh`]. The inputs must agree as [`write_mesh`]
+/// checks (one radiosity per vertex, one mesh polygon per scene polygon,
+/// fewer than 2³² vertices); this function does not check again.
 pub fn glb_bytes(
     scene: &Scene,
     mesh: &Mesh,
