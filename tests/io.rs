@@ -207,8 +207,9 @@ fn cornell_obj_loads_to_the_polygons_and_materials_of_cornell_sc() {
     assert_eq!(obj.camera_source, scene::CameraSource::AutoFramed);
 }
 
-/// A small solved Cornell box: its mesh and radiosity after a few steps.
-fn solved_cornell() -> (Mesh, Vec<Rgb>) {
+/// A small solved Cornell box: the scene, its mesh and radiosity after a
+/// few steps.
+fn solved_cornell() -> (Scene, Mesh, Vec<Rgb>) {
     let scene = scene::load(&scene("cornell.sc")).unwrap();
     let mesh = mesh::build(
         &scene,
@@ -232,7 +233,8 @@ fn solved_cornell() -> (Mesh, Vec<Rgb>) {
         solver.step();
     }
     assert_eq!(solver.steps(), 6);
-    (mesh.clone(), solver.radiosity().to_vec())
+    let radiosity = solver.radiosity().to_vec();
+    (scene, mesh, radiosity)
 }
 
 fn f32s(bytes: &[u8]) -> Vec<f32> {
@@ -312,74 +314,91 @@ fn validate_glb(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {
         assert_eq!(offset % 4, 0, "accessor aligned to its component size");
         bin[offset..offset + len].to_vec()
     };
-    let primitive = &doc["meshes"][0]["primitives"][0];
-    assert_eq!(primitive["mode"], 4);
-    let attributes = primitive["attributes"].as_object().unwrap();
-    let vertex_count = accessors[attributes["POSITION"].as_u64().unwrap() as usize]["count"]
-        .as_u64()
-        .unwrap();
-    for (name, index) in attributes {
-        let a = &accessors[index.as_u64().unwrap() as usize];
-        assert_eq!(a["count"].as_u64().unwrap(), vertex_count, "{name} count");
-        assert_eq!(a["type"], "VEC3", "{name}");
-        assert_eq!(a["componentType"], 5126, "{name}");
-        let view = &views[a["bufferView"].as_u64().unwrap() as usize];
-        assert_eq!(view["target"], 34962, "{name} view is a vertex buffer");
-        let values = f32s(&data(a));
-        assert!(values.iter().all(|v| v.is_finite()), "{name} finite");
-        if name == "COLOR_0" {
-            assert!(
-                values.iter().all(|v| (0.0..=1.0).contains(v)),
-                "COLOR_0 in [0, 1]"
-            );
-        }
-        if name == "NORMAL" {
-            for n in values.chunks(3) {
-                let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-                assert!((len - 1.0).abs() < 5e-4, "NORMAL is unit length");
+    // Every node names a mesh, every scene lists nodes, every primitive
+    // has a material.
+    let meshes = doc["meshes"].as_array().unwrap();
+    let materials = doc["materials"].as_array().unwrap();
+    let nodes = doc["nodes"].as_array().unwrap();
+    for node in nodes {
+        assert!(node["mesh"].as_u64().unwrap() < meshes.len() as u64);
+        assert!(node["name"].as_str().is_some_and(|n| !n.is_empty()));
+    }
+    for n in doc["scenes"][0]["nodes"].as_array().unwrap() {
+        assert!(n.as_u64().unwrap() < nodes.len() as u64);
+    }
+    for primitive in meshes
+        .iter()
+        .flat_map(|m| m["primitives"].as_array().unwrap())
+    {
+        assert!(primitive["material"].as_u64().unwrap() < materials.len() as u64);
+        assert_eq!(primitive["mode"], 4);
+        let attributes = primitive["attributes"].as_object().unwrap();
+        let vertex_count = accessors[attributes["POSITION"].as_u64().unwrap() as usize]["count"]
+            .as_u64()
+            .unwrap();
+        for (name, index) in attributes {
+            let a = &accessors[index.as_u64().unwrap() as usize];
+            assert_eq!(a["count"].as_u64().unwrap(), vertex_count, "{name} count");
+            assert_eq!(a["type"], "VEC3", "{name}");
+            assert_eq!(a["componentType"], 5126, "{name}");
+            let view = &views[a["bufferView"].as_u64().unwrap() as usize];
+            assert_eq!(view["target"], 34962, "{name} view is a vertex buffer");
+            let values = f32s(&data(a));
+            assert!(values.iter().all(|v| v.is_finite()), "{name} finite");
+            if name == "COLOR_0" {
+                assert!(
+                    values.iter().all(|v| (0.0..=1.0).contains(v)),
+                    "COLOR_0 in [0, 1]"
+                );
             }
-        }
-        if name == "POSITION" {
-            let mut lo = [f32::INFINITY; 3];
-            let mut hi = [f32::NEG_INFINITY; 3];
-            for p in values.chunks(3) {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
+            if name == "NORMAL" {
+                for n in values.chunks(3) {
+                    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                    assert!((len - 1.0).abs() < 5e-4, "NORMAL is unit length");
                 }
             }
-            let read = |key: &str| -> Vec<f32> {
-                a[key]
-                    .as_array()
-                    .unwrap_or_else(|| panic!("POSITION has {key}"))
-                    .iter()
-                    .map(|x| x.as_f64().unwrap() as f32)
-                    .collect()
-            };
-            assert_eq!(read("min"), lo.to_vec(), "POSITION min equals the data");
-            assert_eq!(read("max"), hi.to_vec(), "POSITION max equals the data");
+            if name == "POSITION" {
+                let mut lo = [f32::INFINITY; 3];
+                let mut hi = [f32::NEG_INFINITY; 3];
+                for p in values.chunks(3) {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
+                    }
+                }
+                let read = |key: &str| -> Vec<f32> {
+                    a[key]
+                        .as_array()
+                        .unwrap_or_else(|| panic!("POSITION has {key}"))
+                        .iter()
+                        .map(|x| x.as_f64().unwrap() as f32)
+                        .collect()
+                };
+                assert_eq!(read("min"), lo.to_vec(), "POSITION min equals the data");
+                assert_eq!(read("max"), hi.to_vec(), "POSITION max equals the data");
+            }
         }
+        let indices = &accessors[primitive["indices"].as_u64().unwrap() as usize];
+        assert_eq!(indices["componentType"], 5125);
+        assert_eq!(indices["type"], "SCALAR");
+        assert_eq!(indices["count"].as_u64().unwrap() % 3, 0);
+        let view = &views[indices["bufferView"].as_u64().unwrap() as usize];
+        assert_eq!(view["target"], 34963, "index view is an element buffer");
+        let idx = data(indices);
+        assert!(idx
+            .chunks_exact(4)
+            .all(|c| (u32::from_le_bytes(c.try_into().unwrap()) as u64) < vertex_count));
     }
-    let indices = &accessors[primitive["indices"].as_u64().unwrap() as usize];
-    assert_eq!(indices["componentType"], 5125);
-    assert_eq!(indices["type"], "SCALAR");
-    assert_eq!(indices["count"].as_u64().unwrap() % 3, 0);
-    let view = &views[indices["bufferView"].as_u64().unwrap() as usize];
-    assert_eq!(view["target"], 34963, "index view is an element buffer");
-    let idx = data(indices);
-    assert!(idx
-        .chunks_exact(4)
-        .all(|c| (u32::from_le_bytes(c.try_into().unwrap()) as u64) < vertex_count));
     (doc, bin)
 }
 
 #[test]
 fn glb_reads_back_bit_for_bit() {
-    let (mesh, radiosity) = solved_cornell();
+    let (scene, mesh, radiosity) = solved_cornell();
     let exposure = 0.37;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cornell.glb");
-    write_mesh(&path, &mesh, &radiosity, exposure).unwrap();
+    write_mesh(&path, &scene, &mesh, &radiosity, exposure, "cornell").unwrap();
     let bytes = std::fs::read(&path).unwrap();
     validate_glb(&bytes);
 
@@ -387,60 +406,383 @@ fn glb_reads_back_bit_for_bit() {
     let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
     let blob = gltf.blob.as_deref().unwrap();
     let doc = &gltf.document;
-    assert_eq!(doc.meshes().count(), 1);
     assert_eq!(doc.scenes().count(), 1);
-    assert!(doc.extensions_used().any(|e| e == "KHR_materials_unlit"));
-    let primitive = doc.meshes().next().unwrap().primitives().next().unwrap();
-    assert!(primitive.material().unlit());
-    assert_eq!(primitive.mode(), gltf::mesh::Mode::Triangles);
-    let reader = primitive.reader(|_| Some(blob));
+    assert_eq!(doc.default_scene().unwrap().name(), Some("cornell"));
 
-    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
-    let expected: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
-    assert_eq!(bits(&positions), bits(&expected));
+    // A `.sc` scene names only materials: one node per material, in the
+    // order the polygons first use them, each one primitive.
+    let mut names: Vec<&str> = Vec::new();
+    for p in &scene.polygons {
+        let name = scene.materials[p.material.index()].name.as_str();
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    let nodes: Vec<_> = doc.default_scene().unwrap().nodes().collect();
+    assert_eq!(
+        nodes.iter().map(|n| n.name().unwrap()).collect::<Vec<_>>(),
+        names
+    );
 
-    let colors: Vec<[f32; 3]> = reader.read_colors(0).unwrap().into_rgb_f32().collect();
-    let expected: Vec<[f32; 3]> = radiosity
-        .iter()
-        .map(|r| r.to_f32().map(|v| (v * exposure).clamp(0.0, 1.0)))
-        .collect();
-    assert_eq!(bits(&colors), bits(&expected));
-
-    let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
-    let expected: Vec<[f32; 3]> = mesh
-        .vertex_polygon
-        .iter()
-        .map(|p| mesh.polygons[p.index()].normal.to_array())
-        .collect();
-    assert_eq!(bits(&normals), bits(&expected));
-
-    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
-    let expected: Vec<u32> = mesh
-        .elements
-        .iter()
-        .flat_map(|e| e.triangles())
-        .flatten()
-        .map(|v| v.0)
-        .collect();
-    assert_eq!(indices, expected);
-
-    // The custom attribute, read through its accessor and view.
-    let accessor = primitive
-        .get(&gltf::Semantic::Extras(
-            RADIOSITY_ATTRIBUTE.trim_start_matches('_').to_string(),
-        ))
-        .unwrap();
-    assert_eq!(accessor.data_type(), gltf::accessor::DataType::F32);
-    assert_eq!(accessor.dimensions(), gltf::accessor::Dimensions::Vec3);
-    let view = accessor.view().unwrap();
-    let start = view.offset() + accessor.offset();
-    let values = f32s(&blob[start..start + accessor.count() * 12]);
-    let expected: Vec<f32> = radiosity.iter().flat_map(|r| r.to_f32()).collect();
-    assert_eq!(bits1(&values), bits1(&expected));
+    // Every element triangle of the solver's mesh, by its corners'
+    // position bits: normal, display colour, radiosity and material of
+    // each corner, to be found once in the file.
+    type Corner = ([u32; 3], [u32; 3], [u32; 3]);
+    type Triangles<'a> = Vec<(Vec<Corner>, &'a str)>;
+    let mut expected: std::collections::HashMap<[[u32; 3]; 3], Triangles> =
+        std::collections::HashMap::new();
+    for (e, p) in mesh.elements.iter().zip(&mesh.element_polygon) {
+        let material = scene.materials[scene.polygons[p.index()].material.index()]
+            .name
+            .as_str();
+        for t in e.triangles() {
+            let key = t.map(|v| mesh.positions[v.index()].to_array().map(f32::to_bits));
+            let corners = t
+                .iter()
+                .map(|v| {
+                    let r = radiosity[v.index()].to_f32();
+                    (
+                        mesh.polygons[p.index()].normal.to_array().map(f32::to_bits),
+                        r.map(|c| (c * exposure).clamp(0.0, 1.0).to_bits()),
+                        r.map(f32::to_bits),
+                    )
+                })
+                .collect();
+            expected.entry(key).or_default().push((corners, material));
+        }
+    }
+    let total: usize = expected.values().map(Vec::len).sum();
+    let mut found = 0;
+    let radiosity_semantic =
+        gltf::Semantic::Extras(RADIOSITY_ATTRIBUTE.trim_start_matches('_').to_string());
+    for node in &nodes {
+        let primitives: Vec<_> = node.mesh().unwrap().primitives().collect();
+        assert_eq!(primitives.len(), 1, "{:?}", node.name());
+        let primitive = &primitives[0];
+        let material = primitive.material();
+        assert_eq!(
+            material.name(),
+            node.name(),
+            "material named as in the scene"
+        );
+        assert!(!material.unlit());
+        let m = scene
+            .materials
+            .iter()
+            .find(|m| Some(m.name.as_str()) == material.name())
+            .unwrap();
+        let rho = m.reflectance();
+        let base = material.pbr_metallic_roughness().base_color_factor();
+        assert_eq!(
+            base,
+            [rho.r as f32, rho.g as f32, rho.b as f32, 1.0],
+            "baseColorFactor is the reflectance"
+        );
+        assert_eq!(primitive.mode(), gltf::mesh::Mode::Triangles);
+        let reader = primitive.reader(|_| Some(blob));
+        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+        let colors: Vec<[f32; 3]> = reader.read_colors(0).unwrap().into_rgb_f32().collect();
+        let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
+        // The custom attribute, read through its accessor and view.
+        let accessor = primitive.get(&radiosity_semantic).unwrap();
+        assert_eq!(accessor.data_type(), gltf::accessor::DataType::F32);
+        assert_eq!(accessor.dimensions(), gltf::accessor::Dimensions::Vec3);
+        let view = accessor.view().unwrap();
+        let start = view.offset() + accessor.offset();
+        let raw = f32s(&blob[start..start + accessor.count() * 12]);
+        let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+        for t in indices.chunks(3) {
+            let key = [0, 1, 2].map(|k| positions[t[k] as usize].map(f32::to_bits));
+            let corners: Vec<Corner> = t
+                .iter()
+                .map(|&i| {
+                    let i = i as usize;
+                    (
+                        normals[i].map(f32::to_bits),
+                        colors[i].map(f32::to_bits),
+                        [raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]].map(f32::to_bits),
+                    )
+                })
+                .collect();
+            let list = expected.get_mut(&key).expect("a triangle of the mesh");
+            let at = list
+                .iter()
+                .position(|(c, name)| *c == corners && Some(*name) == material.name())
+                .expect("same values and material as in the mesh");
+            list.swap_remove(at);
+            found += 1;
+        }
+    }
+    assert_eq!(found, total, "every triangle once");
 }
 
-fn bits(v: &[[f32; 3]]) -> Vec<[u32; 3]> {
-    v.iter().map(|a| a.map(f32::to_bits)).collect()
+/// Two objects as Blender 3.x writes them: a cube whose top face has a
+/// material of its own, and a lamp panel under the ceiling; shared
+/// vertices, `vn`, `s off`.
+const TWO_OBJECTS_OBJ: &str = "\
+# Blender 3.6.5
+# www.blender.org
+mtllib two.mtl
+o Cube
+v 1.000000 1.000000 -1.000000
+v 1.000000 -1.000000 -1.000000
+v 1.000000 1.000000 1.000000
+v 1.000000 -1.000000 1.000000
+v -1.000000 1.000000 -1.000000
+v -1.000000 -1.000000 -1.000000
+v -1.000000 1.000000 1.000000
+v -1.000000 -1.000000 1.000000
+vn -0.0000 1.0000 -0.0000
+vn -0.0000 -0.0000 1.0000
+vn -1.0000 -0.0000 -0.0000
+vn -0.0000 -1.0000 -0.0000
+vn 1.0000 -0.0000 -0.0000
+vn -0.0000 -0.0000 -1.0000
+s off
+usemtl Top
+f 1//1 5//1 7//1 3//1
+usemtl Material
+f 4//2 3//2 7//2 8//2
+f 8//3 7//3 5//3 6//3
+f 6//4 2//4 4//4 8//4
+f 2//5 1//5 3//5 4//5
+f 6//6 5//6 1//6 2//6
+o Lamp
+v -0.500000 3.000000 0.500000
+v 0.500000 3.000000 0.500000
+v -0.500000 3.000000 -0.500000
+v 0.500000 3.000000 -0.500000
+vn -0.0000 -1.0000 -0.0000
+s off
+usemtl LampShade
+f 9//7 11//7 12//7 10//7
+";
+
+const TWO_OBJECTS_MTL: &str = "\
+# Blender 3.6.5 MTL File: 'None'
+# www.blender.org
+
+newmtl LampShade
+Ns 250.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.800000 0.800000 0.800000
+Ks 0.500000 0.500000 0.500000
+Ke 0.000000 0.000000 0.000000
+Ni 1.450000
+d 1.000000
+illum 2
+
+newmtl Material
+Ns 250.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.600000 0.300000 0.200000
+Ks 0.500000 0.500000 0.500000
+Ke 0.000000 0.000000 0.000000
+Ni 1.450000
+d 1.000000
+illum 2
+
+newmtl Top
+Ns 250.000000
+Ka 1.000000 1.000000 1.000000
+Kd 0.100000 0.500000 0.100000
+Ks 0.500000 0.500000 0.500000
+Ke 0.000000 0.000000 0.000000
+Ni 1.450000
+d 1.000000
+illum 2
+";
+
+/// (node name, [(material name, triangles)]) of a `.glb`, read with the
+/// `gltf` crate, in node and primitive order.
+fn glb_structure(bytes: &[u8]) -> Vec<(String, Vec<(String, usize)>)> {
+    let gltf = gltf::Gltf::from_slice(bytes).unwrap();
+    let scene = gltf.document.default_scene().unwrap();
+    scene
+        .nodes()
+        .map(|node| {
+            let prims = node
+                .mesh()
+                .unwrap()
+                .primitives()
+                .map(|p| {
+                    let count = p.indices().unwrap().count();
+                    assert_eq!(count % 3, 0);
+                    (p.material().name().unwrap().to_string(), count / 3)
+                })
+                .collect();
+            (node.name().unwrap().to_string(), prims)
+        })
+        .collect()
+}
+
+#[test]
+fn glb_keeps_the_objects_and_materials_of_an_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "two.obj", TWO_OBJECTS_OBJ);
+    write(dir.path(), "two.mtl", TWO_OBJECTS_MTL);
+    let mut scene = scene::load(&dir.path().join("two.obj")).unwrap();
+    scene
+        .set_emission("Lamp", Rgb::new(10.0, 10.0, 10.0))
+        .unwrap();
+    let mesh = mesh::build(
+        &scene,
+        &MeshOptions {
+            lenmax: 0.3,
+            inset: 0.05,
+        },
+    )
+    .unwrap();
+    let radiosity: Vec<Rgb> = (0..mesh.vertex_count())
+        .map(|i| Rgb::new(0.01 * (i % 97) as f64, 0.5, 2.0))
+        .collect();
+    let path = dir.path().join("baked.glb");
+    write_mesh(&path, &scene, &mesh, &radiosity, 0.8, "two").unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    validate_glb(&bytes);
+
+    // The triangles of each (object, material), counted from the mesh's
+    // elements: a back copy counts with its front.
+    let object_of = |p: usize| -> &str {
+        let p = scene.polygons[p].surface.back_of.map_or(p, |f| f.index());
+        let id = radiosity::scene::PolygonId(p as u32);
+        scene
+            .groups
+            .iter()
+            .find(|g| g.kind == scene::GroupKind::Object && g.polygons.contains(&id))
+            .map(|g| g.name.as_str())
+            .unwrap()
+    };
+    let mut expected: std::collections::BTreeMap<(&str, &str), usize> = Default::default();
+    for (e, p) in mesh.elements.iter().zip(&mesh.element_polygon) {
+        let material = scene.materials[scene.polygons[p.index()].material.index()]
+            .name
+            .as_str();
+        *expected
+            .entry((object_of(p.index()), material))
+            .or_default() += e.triangles().count();
+    }
+    let got = glb_structure(&bytes);
+    let names: Vec<&str> = got.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["Cube", "Lamp"], "one node per object, named");
+    let materials: Vec<Vec<&str>> = got
+        .iter()
+        .map(|(_, prims)| prims.iter().map(|(m, _)| m.as_str()).collect())
+        .collect();
+    // Primitives in the order of the scene's materials (the MTL's order).
+    assert_eq!(materials, [vec!["Material", "Top"], vec!["LampShade"]]);
+    let mut counted: std::collections::BTreeMap<(&str, &str), usize> = Default::default();
+    for (node, prims) in &got {
+        for (material, triangles) in prims {
+            counted.insert((node.as_str(), material.as_str()), *triangles);
+        }
+    }
+    assert_eq!(counted, expected);
+    // A 2 × 2 face at lenmax 0.3 is 7 × 7 quads, 98 triangles; the lamp
+    // 4 × 4 quads, 32 triangles: on each side of a two-sided face.
+    let sides = if scene.polygons.iter().any(|p| p.surface.back_of.is_some()) {
+        2
+    } else {
+        1
+    };
+    assert_eq!(counted[&("Cube", "Top")], 98 * sides);
+    assert_eq!(counted[&("Cube", "Material")], 5 * 98 * sides);
+    assert_eq!(counted[&("Lamp", "LampShade")], 32 * sides);
+
+    // The materials: reflectance as base colour, the lamp's emission
+    // (10 × exposure 0.8 = 8) as emissive colour 1 × strength 8.
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+    for m in gltf.document.materials() {
+        let name = m.name().unwrap();
+        let rho = scene
+            .materials
+            .iter()
+            .find(|s| s.name == name)
+            .unwrap()
+            .reflectance();
+        assert_eq!(
+            m.pbr_metallic_roughness().base_color_factor(),
+            [rho.r as f32, rho.g as f32, rho.b as f32, 1.0],
+            "{name}"
+        );
+        let emissive = m.emissive_factor();
+        if name == "LampShade" {
+            assert_eq!(emissive, [1.0, 1.0, 1.0]);
+        } else {
+            assert_eq!(emissive, [0.0, 0.0, 0.0], "{name}");
+        }
+    }
+    let (doc, _) = validate_glb(&bytes);
+    let lamp = doc["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "LampShade")
+        .unwrap();
+    assert_eq!(
+        lamp["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"],
+        8.0
+    );
+    assert!(doc["extensionsUsed"]
+        .as_array()
+        .unwrap()
+        .contains(&serde_json::json!("KHR_materials_emissive_strength")));
+}
+
+#[test]
+fn exported_obj_round_trips_through_the_program() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "model.obj",
+        &TWO_OBJECTS_OBJ.replace("two.mtl", "model.mtl"),
+    );
+    write(dir.path(), "model.mtl", TWO_OBJECTS_MTL);
+    let out = run_in(
+        dir.path(),
+        &[
+            "model.obj",
+            "--emit",
+            "Lamp=10",
+            "--max-steps",
+            "20",
+            "--size",
+            "64x64",
+            "--exposure",
+            "1",
+            "--export",
+            "baked.glb",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(dir.path().join("baked.glb")).unwrap();
+    validate_glb(&bytes);
+    let got = glb_structure(&bytes);
+    let names: Vec<&str> = got.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["Cube", "Lamp"]);
+    assert_eq!(got[0].1.len(), 2, "the cube's two materials");
+    assert_eq!(got[1].1[0].0, "LampShade");
+    // The cube is lit by the lamp above it (its top, reflectance 0.5 in
+    // green, 2 units under a unit lamp of 10, gets about 0.4 in green), and
+    // the lamp shows its own light, clipped to 1.
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+    let blob = gltf.blob.as_deref().unwrap();
+    for node in gltf.document.nodes() {
+        let mesh = node.mesh().unwrap();
+        let brightest = mesh
+            .primitives()
+            .flat_map(|p| {
+                p.reader(|_| Some(blob))
+                    .read_colors(0)
+                    .unwrap()
+                    .into_rgb_f32()
+                    .collect::<Vec<_>>()
+            })
+            .map(|c| c[0] + c[1] + c[2])
+            .fold(0.0f32, f32::max);
+        assert!(brightest > 0.1, "{:?} is lit: {brightest}", node.name());
+    }
 }
 
 fn bits1(v: &[f32]) -> Vec<u32> {
@@ -519,11 +861,11 @@ fn read_ply(bytes: &[u8]) -> Ply {
 
 #[test]
 fn ply_reads_back_bit_for_bit() {
-    let (mesh, radiosity) = solved_cornell();
+    let (scene, mesh, radiosity) = solved_cornell();
     let exposure = 0.37;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cornell.ply");
-    write_mesh(&path, &mesh, &radiosity, exposure).unwrap();
+    write_mesh(&path, &scene, &mesh, &radiosity, exposure, "cornell").unwrap();
     let ply = read_ply(&std::fs::read(&path).unwrap());
     let names: Vec<String> = ply
         .vertex_properties

@@ -280,7 +280,15 @@ pub fn run_prepared(
             .map_err(RunError::Write)?;
     }
     if let Some(path) = &config.export {
-        output::write_mesh(path, mesh, &solved.radiosity, exposure).map_err(RunError::Write)?;
+        output::write_mesh(
+            path,
+            &prepared.scene,
+            mesh,
+            &solved.radiosity,
+            exposure,
+            &config.scene.stem(),
+        )
+        .map_err(RunError::Write)?;
     }
     if let Some(path) = &config.log {
         convergence::write_log_file(path, &solved.records).map_err(RunError::Write)?;

@@ -183,10 +183,11 @@ pub struct Args {
 
     /// Write the solved element mesh (.glb or .ply).
     ///
-    /// .glb is glTF 2.0 binary (display colours as COLOR_0, linear
-    /// radiosity as _RADIOSITY); .ply is binary little-endian (float
-    /// radiosity and 8-bit colour per vertex). Runs in batch mode, as -o
-    /// does.
+    /// .glb is glTF 2.0 binary (one node per OBJ object, or per material
+    /// for .sc, materials named as in the scene; display colours as
+    /// COLOR_0, linear radiosity as _RADIOSITY); .ply is binary
+    /// little-endian (float radiosity and 8-bit colour per vertex). Runs
+    /// in batch mode, as -o does.
     #[arg(long, value_name = "FILE")]
     pub(crate) export: Option<PathBuf>,
 

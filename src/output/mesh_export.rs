@@ -6,8 +6,8 @@
 //! scene units, as in the scene file: no change of axes or scale) with its
 //! solved **radiosity** as 32-bit floats in the scene's radiosity units
 //! (exactly the solver's values rounded to `f32`), and a **display colour**
-//! tone-mapped with the exposure the picture used, so the model looks like
-//! the picture:
+//! tone-mapped with the exposure the picture used, so that shown alone the
+//! model's colours look like the picture:
 //!
 //! | | `.glb` | `.ply` |
 //! |---|---|---|
@@ -17,11 +17,45 @@
 //! | radiosity | `_RADIOSITY`, float VEC3 | `radiosity_r radiosity_g radiosity_b` float |
 //! | faces | triangles (quads split along their `0–2` diagonal, as drawn), `UNSIGNED_INT` indices | elements as they are: triangles and quads, `list uchar uint vertex_indices` |
 //!
-//! Faces are counter-clockwise seen from the front, as in the scene; the
-//! glTF material is unlit (`KHR_materials_unlit`) and single-sided, so a
-//! viewer shows the baked light as it is and one can look into a room from
-//! outside through its back faces. Vertices are not shared between
-//! polygons, as in the solver: the radiosity is discontinuous there.
+//! Faces are counter-clockwise seen from the front, as in the scene.
+//! Vertices are not shared between polygons, as in the solver: the
+//! radiosity is discontinuous there.
+//!
+//! **The model's structure (glTF).** The `.glb` keeps what the scene file
+//! named, so a model re-imported into Blender comes back as the objects
+//! it was modelled as, with their names and materials ([`export_nodes`]):
+//!
+//! - one node (with a mesh of the same name) per OBJ object (`o`); when
+//!   the file has groups (`g`) but no objects, one per group (a face in
+//!   several groups goes to the first of them that lists it); faces in no
+//!   object (or group) go to one node named after the scene file
+//!   ([`DEFAULT_NODE_NAME`] when there is no name);
+//! - a scene that names nothing but materials (`.sc`, an OBJ without `o`
+//!   or `g`) gets one node per material, named after it, in the order
+//!   the polygons first use them: lamps, walls and furniture stay
+//!   selectable apart;
+//! - the back copy of a two-sided face (`surface.back_of`) goes with its
+//!   front;
+//! - each node's mesh has one primitive per material, in the scene's
+//!   material order; each primitive has its own vertices.
+//!
+//! Each glTF material is named as the scene's material and describes it
+//! as a surface, for a renderer: `baseColorFactor` is the reflectance
+//! (linear), `emissiveFactor` the emission × the picture's exposure (the
+//! scale of `COLOR_0`), divided by its largest channel with
+//! `KHR_materials_emissive_strength` holding that channel when it is
+//! above 1; metallic 0, roughness 1, single-sided (each side of a
+//! two-sided face is its own polygon). The exact reflectance and emission
+//! in scene units are in the material's `extras` (Blender shows them as
+//! custom properties). The baked light is in `COLOR_0`: glTF multiplies
+//! it into the base colour, so a viewer that follows the rule shows
+//! reflectance × baked light under its own lighting; to see the baked
+//! light as the picture shows it, display the colour attribute alone
+//! (the user guide says how in Blender).
+//!
+//! PLY has no nodes or named materials: the `.ply` stays one list of
+//! vertices and faces in scene polygon order (a reader that wants the
+//! objects takes them from the `.glb`).
 //!
 //! The glTF file follows the layout rules the Khronos validator checks: the
 //! JSON chunk is padded with spaces and the binary chunk with zeros to
@@ -33,7 +67,9 @@ use super::{write_atomically, OutputError};
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::render::srgb8;
+use crate::scene::{Group, GroupKind, Material, MaterialId, PolygonId, Scene};
 use serde_json::json;
+use std::collections::BTreeMap;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -99,13 +135,19 @@ impl MeshFormat {
 
 /// Writes the mesh with its radiosity (one value per vertex, scene
 /// radiosity units) to `path` in the format its extension names,
-/// atomically. `exposure` (dimensionless, `> 0`) makes the display colours,
-/// as for 8-bit pictures.
+/// atomically. `scene` is the scene the mesh was built from (one mesh
+/// polygon per scene polygon): its objects, groups and materials give the
+/// glTF nodes and materials (see the module docs). `name` (the scene
+/// file's stem) names the glTF scene and the node of polygons in no
+/// object. `exposure` (dimensionless, `> 0`) makes the display colours, as
+/// for 8-bit pictures.
 pub fn write_mesh(
     path: &Path,
+    scene: &Scene,
     mesh: &Mesh,
     radiosity: &[Rgb],
     exposure: f32,
+    name: &str,
 ) -> Result<(), OutputError> {
     let format = MeshFormat::from_path(path)?;
     let invalid = |why: &str| OutputError::Io {
@@ -123,11 +165,124 @@ pub fn write_mesh(
     }
     match format {
         MeshFormat::Glb => {
-            let bytes = glb_bytes(mesh, radiosity, exposure);
+            if mesh.polygons.len() != scene.polygons.len() {
+                return Err(invalid("the mesh was not built from this scene"));
+            }
+            let bytes = glb_bytes(scene, mesh, radiosity, exposure, name);
             write_atomically(path, |w| w.write_all(&bytes))
         }
         MeshFormat::Ply => write_atomically(path, |w| write_ply(w, mesh, radiosity, exposure)),
     }
+}
+
+/// The name of the node holding the polygons in no object (or group) when
+/// the export is given no name.
+pub const DEFAULT_NODE_NAME: &str = "default";
+
+/// One glTF node of an export: a name and its polygons, by material.
+///
+/// Invariants: `primitives` is not empty, ascending by material, each
+/// material once; each polygon list is ascending and not empty.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ExportNode {
+    /// The node's (and its mesh's) name.
+    pub name: String,
+    /// One glTF primitive per material: the material and the polygons
+    /// drawn with it.
+    pub primitives: Vec<(MaterialId, Vec<PolygonId>)>,
+}
+
+/// How the scene's polygons are split into glTF nodes (see the module
+/// docs): every polygon lands in exactly one node; a back copy
+/// (`surface.back_of`) lands in its front's. `name` names the node of
+/// polygons in no object or group ([`DEFAULT_NODE_NAME`] when empty).
+pub fn export_nodes(scene: &Scene, name: &str) -> Vec<ExportNode> {
+    let n = scene.polygons.len();
+    let mut names: Vec<String> = Vec::new();
+    let mut owner: Vec<Option<usize>> = vec![None; n];
+    let is_back = |p: usize| scene.polygons[p].surface.back_of.is_some();
+    let objects: Vec<&Group> = scene
+        .groups
+        .iter()
+        .filter(|g| g.kind == GroupKind::Object)
+        .collect();
+    let sets: Vec<&Group> = if objects.is_empty() {
+        scene.groups.iter().collect()
+    } else {
+        objects
+    };
+    if sets.is_empty() {
+        // No names but the materials' (`.sc`): one node per material.
+        let mut node_of_material = vec![None; scene.materials.len()];
+        for (p, polygon) in scene.polygons.iter().enumerate() {
+            if is_back(p) {
+                continue;
+            }
+            let m = polygon.material.index();
+            let node = *node_of_material[m].get_or_insert_with(|| {
+                names.push(scene.materials[m].name.clone());
+                names.len() - 1
+            });
+            owner[p] = Some(node);
+        }
+    } else {
+        for set in sets {
+            let node = names.len();
+            let mut used = false;
+            for &p in &set.polygons {
+                let p = p.index();
+                if p < n && !is_back(p) && owner[p].is_none() {
+                    owner[p] = Some(node);
+                    used = true;
+                }
+            }
+            if used {
+                names.push(set.name.clone());
+            }
+        }
+    }
+    // Back copies follow their front; what is left goes to one node.
+    let mut rest = None;
+    for p in 0..n {
+        if owner[p].is_some() {
+            continue;
+        }
+        let front = scene.polygons[p]
+            .surface
+            .back_of
+            .map(|f| f.index())
+            .filter(|&f| f < n && !is_back(f));
+        owner[p] = match front.and_then(|f| owner[f]) {
+            Some(node) => Some(node),
+            None => Some(*rest.get_or_insert_with(|| {
+                names.push(if name.is_empty() {
+                    DEFAULT_NODE_NAME.to_string()
+                } else {
+                    name.to_string()
+                });
+                names.len() - 1
+            })),
+        };
+    }
+    let mut per_node: Vec<BTreeMap<MaterialId, Vec<PolygonId>>> =
+        vec![BTreeMap::new(); names.len()];
+    for (p, node) in owner.iter().enumerate() {
+        if let Some(node) = node {
+            per_node[*node]
+                .entry(scene.polygons[p].material)
+                .or_default()
+                .push(PolygonId(p as u32));
+        }
+    }
+    names
+        .into_iter()
+        .zip(per_node)
+        .filter(|(_, prims)| !prims.is_empty())
+        .map(|(name, prims)| ExportNode {
+            name,
+            primitives: prims.into_iter().collect(),
+        })
+        .collect()
 }
 
 /// The display colour of a radiosity for glTF: linear, exposed, clipped.
@@ -149,81 +304,246 @@ fn put_f32s(buf: &mut Vec<u8>, values: impl IntoIterator<Item = f32>) {
     }
 }
 
-/// The `.glb` file (see the module docs) for the mesh, the radiosity per
-/// vertex and the exposure of the display colours.
-pub fn glb_bytes(mesh: &Mesh, radiosity: &[Rgb], exposure: f32) -> Vec<u8> {
-    let n = mesh.vertex_count();
-    let triangles: Vec<[u32; 3]> = mesh
-        .elements
-        .iter()
-        .flat_map(|e| e.triangles())
-        .map(|t| t.map(|v| v.0))
-        .collect();
-
-    let mut bin = Vec::with_capacity(n * 48 + triangles.len() * 12);
-    // (offset, length) of each view in `bin`; every length is a multiple
-    // of 4, so every view starts aligned.
-    let mut views = Vec::new();
-    let mut view = |bin: &mut Vec<u8>, fill: &dyn Fn(&mut Vec<u8>)| {
-        let start = bin.len();
-        fill(bin);
-        views.push((start, bin.len() - start));
-    };
-    view(&mut bin, &|b| {
-        put_f32s(b, mesh.positions.iter().flat_map(|p| p.to_array()))
-    });
-    view(&mut bin, &|b| {
-        put_f32s(
-            b,
-            mesh.vertex_polygon
-                .iter()
-                .flat_map(|p| mesh.polygons[p.index()].normal.to_array()),
-        )
-    });
-    view(&mut bin, &|b| {
-        put_f32s(
-            b,
-            radiosity.iter().flat_map(|&r| linear_display(r, exposure)),
-        )
-    });
-    view(&mut bin, &|b| {
-        put_f32s(b, radiosity.iter().flat_map(|r| r.to_f32()))
-    });
-    view(&mut bin, &|b| {
-        for i in triangles.iter().flatten() {
-            b.extend_from_slice(&i.to_le_bytes());
-        }
-    });
-
-    let (lo, hi) = mesh.positions.iter().fold(
-        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-        |(lo, hi), p| {
-            let p = p.to_array();
-            (
-                [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
-                [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
-            )
+/// The glTF material of a scene material: named as it, its reflectance as
+/// `baseColorFactor`, its emission × `exposure` as `emissiveFactor` (with
+/// `KHR_materials_emissive_strength` above 1), the exact values in
+/// `extras`. Returns the JSON and whether the strength extension is used.
+fn material_json(m: &Material, exposure: f32) -> (serde_json::Value, bool) {
+    let rho = m.reflectance();
+    let e = m.emission();
+    let scaled = (e * f64::from(exposure)).to_f32();
+    let top = scaled.iter().copied().fold(0.0f32, f32::max);
+    let channels = |c: Rgb| [c.r, c.g, c.b];
+    let mut json = json!({
+        "name": m.name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [rho.r, rho.g, rho.b, 1.0],
+            "metallicFactor": 0.0,
+            "roughnessFactor": 1.0,
         },
-    );
+        "extras": {
+            "reflectance": channels(rho),
+            "emission": channels(e),
+        },
+    });
+    let strong = top.is_finite() && top > 1.0;
+    if top.is_finite() && top > 0.0 {
+        let factor = if strong {
+            scaled.map(|v| v / top)
+        } else {
+            scaled
+        };
+        json["emissiveFactor"] = json!(factor.map(|v| f64::from(v.clamp(0.0, 1.0))));
+        if strong {
+            json["extensions"] = json!({
+                "KHR_materials_emissive_strength": {"emissiveStrength": f64::from(top)}
+            });
+        }
+    }
+    (json, strong)
+}
+
+/// One primitive's vertices and triangles, in its own numbering.
+struct PrimitiveData {
+    /// Mesh vertex of each local vertex, in order of first use.
+    vertices: Vec<u32>,
+    /// The polygon whose normal each local vertex takes.
+    normal_of: Vec<PolygonId>,
+    /// Local indices, three per triangle.
+    indices: Vec<u32>,
+}
+
+/// Collects the elements of `polygons` with their vertices renumbered from
+/// 0 in order of first use. `local` (one entry per mesh vertex) and
+/// `stamp` are scratch space shared between calls; `id` must differ on
+/// every call.
+fn collect_primitive(
+    mesh: &Mesh,
+    polygons: &[PolygonId],
+    id: u32,
+    local: &mut [u32],
+    stamp: &mut [u32],
+) -> PrimitiveData {
+    let mut data = PrimitiveData {
+        vertices: Vec::new(),
+        normal_of: Vec::new(),
+        indices: Vec::new(),
+    };
+    for &p in polygons {
+        let pm = &mesh.polygons[p.index()];
+        for e in &mesh.elements[pm.elements.start as usize..pm.elements.end as usize] {
+            for tri in e.triangles() {
+                for v in tri {
+                    let v = v.index();
+                    if stamp[v] != id {
+                        stamp[v] = id;
+                        local[v] = data.vertices.len() as u32;
+                        data.vertices.push(v as u32);
+                        data.normal_of.push(p);
+                    }
+                    data.indices.push(local[v]);
+                }
+            }
+        }
+    }
+    data
+}
+
+/// The `.glb` file (see the module docs) for the scene, the mesh built from
+/// it, the radiosity per vertex and the exposure of the display colours;
+/// `name` as for [`write_mesh`]. The inputs must agree as [`write_mesh`]
+/// checks (one radiosity per vertex, one mesh polygon per scene polygon,
+/// fewer than 2³² vertices); this function does not check again.
+pub fn glb_bytes(
+    scene: &Scene,
+    mesh: &Mesh,
+    radiosity: &[Rgb],
+    exposure: f32,
+    name: &str,
+) -> Vec<u8> {
+    let nodes = export_nodes(scene, name);
+    let mut bin = Vec::with_capacity(mesh.vertex_count() * 48 + mesh.elements.len() * 24);
+    let mut views: Vec<serde_json::Value> = Vec::new();
+    let mut accessors: Vec<serde_json::Value> = Vec::new();
+    // Appends one tightly packed view and its accessor; returns the
+    // accessor's index. Every length is a multiple of 4, so every view
+    // starts aligned.
+    let mut push = |bin: &mut Vec<u8>,
+                    bytes: &dyn Fn(&mut Vec<u8>),
+                    mut accessor: serde_json::Value,
+                    target: u32| {
+        let start = bin.len();
+        bytes(bin);
+        accessor["bufferView"] = json!(views.len());
+        views.push(json!({
+            "buffer": 0,
+            "byteOffset": start,
+            "byteLength": bin.len() - start,
+            "target": target,
+        }));
+        accessors.push(accessor);
+        accessors.len() - 1
+    };
     // Written as the f64 equal to each f32, so a reader compares exactly.
     let exact = |v: [f32; 3]| v.map(f64::from);
-    let buffer_views: Vec<_> = views
-        .iter()
-        .enumerate()
-        .map(|(i, &(offset, length))| {
-            json!({
-                "buffer": 0,
-                "byteOffset": offset,
-                "byteLength": length,
-                "target": if i == 4 { ELEMENT_ARRAY_BUFFER } else { ARRAY_BUFFER },
-            })
-        })
-        .collect();
-    let vec3 = |view: usize| json!({"bufferView": view, "componentType": FLOAT, "count": n, "type": "VEC3"});
-    let mut position = vec3(0);
-    position["min"] = json!(exact(lo));
-    position["max"] = json!(exact(hi));
-    let doc = json!({
+
+    let mut gltf_material = vec![None; scene.materials.len()];
+    let mut materials = Vec::new();
+    let mut strength_used = false;
+    let mut local = vec![0u32; mesh.vertex_count()];
+    let mut stamp = vec![u32::MAX; mesh.vertex_count()];
+    let mut next_id = 0u32;
+    let mut meshes = Vec::with_capacity(nodes.len());
+    for node in &nodes {
+        let mut primitives = Vec::with_capacity(node.primitives.len());
+        for (material, polygons) in &node.primitives {
+            let data = collect_primitive(mesh, polygons, next_id, &mut local, &mut stamp);
+            next_id += 1;
+            let count = data.vertices.len();
+            let vec3 = json!({"componentType": FLOAT, "count": count, "type": "VEC3"});
+            let (lo, hi) = data.vertices.iter().fold(
+                ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+                |(lo, hi), &v| {
+                    let p = mesh.positions[v as usize].to_array();
+                    (
+                        [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
+                        [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
+                    )
+                },
+            );
+            let mut position = vec3.clone();
+            position["min"] = json!(exact(lo));
+            position["max"] = json!(exact(hi));
+            let position = push(
+                &mut bin,
+                &|b| {
+                    put_f32s(
+                        b,
+                        data.vertices
+                            .iter()
+                            .flat_map(|&v| mesh.positions[v as usize].to_array()),
+                    )
+                },
+                position,
+                ARRAY_BUFFER,
+            );
+            let normal = push(
+                &mut bin,
+                &|b| {
+                    put_f32s(
+                        b,
+                        data.normal_of
+                            .iter()
+                            .flat_map(|p| mesh.polygons[p.index()].normal.to_array()),
+                    )
+                },
+                vec3.clone(),
+                ARRAY_BUFFER,
+            );
+            let color = push(
+                &mut bin,
+                &|b| {
+                    put_f32s(
+                        b,
+                        data.vertices
+                            .iter()
+                            .flat_map(|&v| linear_display(radiosity[v as usize], exposure)),
+                    )
+                },
+                vec3.clone(),
+                ARRAY_BUFFER,
+            );
+            let raw = push(
+                &mut bin,
+                &|b| {
+                    put_f32s(
+                        b,
+                        data.vertices
+                            .iter()
+                            .flat_map(|&v| radiosity[v as usize].to_f32()),
+                    )
+                },
+                vec3,
+                ARRAY_BUFFER,
+            );
+            let indices = push(
+                &mut bin,
+                &|b| {
+                    for i in &data.indices {
+                        b.extend_from_slice(&i.to_le_bytes());
+                    }
+                },
+                json!({
+                    "componentType": UNSIGNED_INT,
+                    "count": data.indices.len(),
+                    "type": "SCALAR",
+                }),
+                ELEMENT_ARRAY_BUFFER,
+            );
+            let m = material.index();
+            let index = *gltf_material[m].get_or_insert_with(|| {
+                let (json, strong) = material_json(&scene.materials[m], exposure);
+                strength_used |= strong;
+                materials.push(json);
+                materials.len() - 1
+            });
+            primitives.push(json!({
+                "attributes": {
+                    "POSITION": position,
+                    "NORMAL": normal,
+                    "COLOR_0": color,
+                    RADIOSITY_ATTRIBUTE: raw,
+                },
+                "indices": indices,
+                "material": index,
+                "mode": TRIANGLES,
+            }));
+        }
+        meshes.push(json!({"name": node.name, "primitives": primitives}));
+    }
+
+    let scene_name = if name.is_empty() { "radiosity" } else { name };
+    let mut doc = json!({
         "asset": {
             "version": "2.0",
             "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
@@ -233,48 +553,22 @@ pub fn glb_bytes(mesh: &Mesh, radiosity: &[Rgb], exposure: f32) -> Vec<u8> {
                 "color_exposure": f64::from(exposure),
             },
         },
-        "extensionsUsed": ["KHR_materials_unlit"],
         "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "name": "radiosity"}],
-        "meshes": [{
-            "name": "radiosity",
-            "primitives": [{
-                "attributes": {
-                    "POSITION": 0,
-                    "NORMAL": 1,
-                    "COLOR_0": 2,
-                    RADIOSITY_ATTRIBUTE: 3,
-                },
-                "indices": 4,
-                "material": 0,
-                "mode": TRIANGLES,
-            }],
-        }],
-        "materials": [{
-            "name": "baked radiosity (unlit vertex colours)",
-            "pbrMetallicRoughness": {
-                "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
-                "metallicFactor": 0.0,
-                "roughnessFactor": 1.0,
-            },
-            "extensions": {"KHR_materials_unlit": {}},
-        }],
+        "scenes": [{"name": scene_name, "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| json!({"name": n.name, "mesh": i}))
+            .collect::<Vec<_>>(),
+        "meshes": meshes,
+        "materials": materials,
         "buffers": [{"byteLength": bin.len()}],
-        "bufferViews": buffer_views,
-        "accessors": [
-            position,
-            vec3(1),
-            vec3(2),
-            vec3(3),
-            {
-                "bufferView": 4,
-                "componentType": UNSIGNED_INT,
-                "count": triangles.len() * 3,
-                "type": "SCALAR",
-            },
-        ],
+        "bufferViews": views,
+        "accessors": accessors,
     });
+    if strength_used {
+        doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
+    }
     // A `Value` always serialises.
     let mut json_chunk = serde_json::to_vec(&doc).unwrap_or_default();
     while !json_chunk.len().is_multiple_of(4) {
@@ -353,9 +647,9 @@ pub fn write_ply(
 mod tests {
     use super::*;
     use crate::mesh::{self, MeshOptions};
-    use crate::scene::parse_str;
+    use crate::scene::{parse_str, Group, GroupKind, PolygonId};
 
-    fn small() -> (Mesh, Vec<Rgb>) {
+    fn small() -> (Scene, Mesh, Vec<Rgb>) {
         let scene = parse_str(
             "material m color 0.5 0.5 0.5 k_diffrefl 1 k_emission 1 end\n\
              polygon m vertex 0 0 0 vertex 1 0 0 vertex 1 1 0 vertex 0 1 0 end\n\
@@ -374,7 +668,7 @@ mod tests {
         let rad = (0..mesh.vertex_count())
             .map(|i| Rgb::new(i as f64 * 0.1, 0.3, 2.0))
             .collect();
-        (mesh, rad)
+        (scene, mesh, rad)
     }
 
     fn u32_at(b: &[u8], at: usize) -> u32 {
@@ -383,8 +677,8 @@ mod tests {
 
     #[test]
     fn glb_chunks_are_aligned_and_sized() {
-        let (mesh, rad) = small();
-        let b = glb_bytes(&mesh, &rad, 0.5);
+        let (scene, mesh, rad) = small();
+        let b = glb_bytes(&scene, &mesh, &rad, 0.5, "t");
         assert_eq!(u32_at(&b, 0), GLB_MAGIC);
         assert_eq!(u32_at(&b, 4), 2);
         assert_eq!(u32_at(&b, 8) as usize, b.len());
@@ -410,9 +704,177 @@ mod tests {
         assert_eq!(blue, 1.0);
     }
 
+    /// Four unit squares side by side along x, materials a, b, a, b.
+    fn four() -> Scene {
+        let mut sc = String::from(
+            "material a color 0.5 0.5 0.5 k_diffrefl 1 k_emission 0 end\n\
+             material b color 0.2 0.4 0.6 k_diffrefl 1 k_emission 3 end\n",
+        );
+        for (i, m) in ["a", "b", "a", "b"].iter().enumerate() {
+            let x = i as f32 * 2.0;
+            sc.push_str(&format!(
+                "polygon {m} vertex {x} 0 0 vertex {} 0 0 vertex {} 1 0 vertex {x} 1 0 end\n",
+                x + 1.0,
+                x + 1.0
+            ));
+        }
+        parse_str(&sc, "t.sc").unwrap()
+    }
+
+    fn group(name: &str, kind: GroupKind, polygons: &[u32]) -> Group {
+        Group {
+            name: name.into(),
+            kind,
+            polygons: polygons.iter().map(|&p| PolygonId(p)).collect(),
+        }
+    }
+
+    /// (name, [(material, [polygon])]) of each node, for comparisons.
+    type Shape = Vec<(String, Vec<(u32, Vec<u32>)>)>;
+
+    fn shape(nodes: &[ExportNode]) -> Shape {
+        nodes
+            .iter()
+            .map(|n| {
+                let prims = n
+                    .primitives
+                    .iter()
+                    .map(|(m, ps)| (m.0, ps.iter().map(|p| p.0).collect()))
+                    .collect();
+                (n.name.clone(), prims)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn scenes_without_names_get_one_node_per_material() {
+        let nodes = export_nodes(&four(), "t");
+        assert_eq!(
+            shape(&nodes),
+            [
+                ("a".to_string(), vec![(0, vec![0, 2])]),
+                ("b".to_string(), vec![(1, vec![1, 3])]),
+            ]
+        );
+    }
+
+    #[test]
+    fn objects_make_nodes_and_the_rest_goes_to_the_file_node() {
+        let mut scene = four();
+        scene.groups = vec![
+            group("walls", GroupKind::Group, &[0, 1, 2, 3]),
+            group("Cube", GroupKind::Object, &[1, 2]),
+            group("Lamp", GroupKind::Object, &[3]),
+        ];
+        // Objects win over groups; polygon 0 is in no object.
+        assert_eq!(
+            shape(&export_nodes(&scene, "room")),
+            [
+                ("Cube".to_string(), vec![(0, vec![2]), (1, vec![1])]),
+                ("Lamp".to_string(), vec![(1, vec![3])]),
+                ("room".to_string(), vec![(0, vec![0])]),
+            ]
+        );
+        assert_eq!(export_nodes(&scene, "")[2].name, DEFAULT_NODE_NAME);
+    }
+
+    #[test]
+    fn groups_make_nodes_when_there_are_no_objects() {
+        let mut scene = four();
+        // Polygon 1 is in both groups: the first one takes it; a group
+        // left with nothing of its own makes no node.
+        scene.groups = vec![
+            group("left", GroupKind::Group, &[0, 1]),
+            group("right", GroupKind::Group, &[1, 2, 3]),
+            group("again", GroupKind::Group, &[0]),
+        ];
+        assert_eq!(
+            shape(&export_nodes(&scene, "t")),
+            [
+                ("left".to_string(), vec![(0, vec![0]), (1, vec![1])]),
+                ("right".to_string(), vec![(0, vec![2]), (1, vec![3])]),
+            ]
+        );
+    }
+
+    #[test]
+    fn back_copies_join_their_fronts_node() {
+        let mut scene = four();
+        for front in [1u32, 3] {
+            let mut back = scene.polygons[front as usize].clone();
+            back.vertices.reverse();
+            back.normal = -back.normal;
+            back.surface.back_of = Some(PolygonId(front));
+            scene.polygons.push(back);
+        }
+        // Polygon 4 is the back of 1 and 5 the back of 3; the group lists
+        // the back of 3 too, which does not move it.
+        scene.groups = vec![
+            group("Cube", GroupKind::Object, &[0, 1]),
+            group("Lamp", GroupKind::Object, &[2, 3]),
+            group("Stray", GroupKind::Object, &[5]),
+        ];
+        assert_eq!(
+            shape(&export_nodes(&scene, "t")),
+            [
+                ("Cube".to_string(), vec![(0, vec![0]), (1, vec![1, 4])]),
+                ("Lamp".to_string(), vec![(0, vec![2]), (1, vec![3, 5])]),
+            ]
+        );
+        // .sc-like scene: the back copies follow their front's material node.
+        scene.groups.clear();
+        assert_eq!(
+            shape(&export_nodes(&scene, "t")),
+            [
+                ("a".to_string(), vec![(0, vec![0, 2])]),
+                ("b".to_string(), vec![(1, vec![1, 3, 4, 5])]),
+            ]
+        );
+    }
+
+    #[test]
+    fn materials_carry_reflectance_and_scaled_emission() {
+        let scene = four();
+        let (a, strong) = material_json(&scene.materials[0], 0.5);
+        assert!(!strong);
+        assert_eq!(a["name"], "a");
+        assert_eq!(
+            a["pbrMetallicRoughness"]["baseColorFactor"],
+            json!([0.5, 0.5, 0.5, 1.0])
+        );
+        assert!(a.get("emissiveFactor").is_none(), "a does not emit");
+        // b emits 3 × (0.2, 0.4, 0.6) = (0.6, 1.2, 1.8); × 0.5 exposure =
+        // (0.3, 0.6, 0.9): within [0, 1], no strength needed.
+        let (b, strong) = material_json(&scene.materials[1], 0.5);
+        assert!(!strong);
+        let f: Vec<f64> = b["emissiveFactor"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        for (got, want) in f.iter().zip([0.3, 0.6, 0.9]) {
+            assert!((got - want).abs() < 1e-6, "{f:?}");
+        }
+        // × 2: (1.2, 2.4, 3.6) = 3.6 × (1/3, 2/3, 1).
+        let (b, strong) = material_json(&scene.materials[1], 2.0);
+        assert!(strong);
+        let s = b["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"]
+            .as_f64()
+            .unwrap();
+        assert!((s - 3.6).abs() < 1e-5, "{s}");
+        let f = b["emissiveFactor"].as_array().unwrap();
+        assert!((f[0].as_f64().unwrap() - 1.0 / 3.0).abs() < 1e-6);
+        assert_eq!(f[2].as_f64().unwrap(), 1.0);
+        // The exact values, unscaled, in the extras.
+        let e = scene.materials[1].emission();
+        assert_eq!(b["extras"]["emission"], json!([e.r, e.g, e.b]));
+        assert_eq!(b["extras"]["emission"][1].as_f64().unwrap(), 3.0 * 0.4);
+    }
+
     #[test]
     fn ply_header_counts_and_record_sizes_add_up() {
-        let (mesh, rad) = small();
+        let (_, mesh, rad) = small();
         let mut out = Vec::new();
         write_ply(&mut out, &mesh, &rad, 1.0).unwrap();
         let end = out.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
@@ -439,9 +901,17 @@ mod tests {
         );
         let e = MeshFormat::from_path(Path::new("a.obj")).unwrap_err();
         assert!(e.to_string().contains("unknown extension .obj"), "{e}");
-        let (mesh, rad) = small();
+        let (scene, mesh, rad) = small();
         let dir = tempfile::tempdir().unwrap();
-        let e = write_mesh(&dir.path().join("x.glb"), &mesh, &rad[1..], 1.0).unwrap_err();
+        let e = write_mesh(
+            &dir.path().join("x.glb"),
+            &scene,
+            &mesh,
+            &rad[1..],
+            1.0,
+            "x",
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("one value per mesh vertex"), "{e}");
     }
 }
