@@ -600,6 +600,9 @@ impl<'a> Reader<'a> {
                 "animations and skins are ignored: the model is read in its rest pose",
             ));
         }
+        if let Some(c) = camera.as_mut() {
+            aim_at_the_model(c, &polygons);
+        }
         let camera_source = if camera.is_some() {
             CameraSource::File
         } else {
@@ -1111,6 +1114,24 @@ fn make_camera(camera: &::gltf::Camera<'_>, world: &DMat4) -> Result<Camera, Str
     };
     c.check().map_err(|e| format!("cannot be used: {e}"))?;
     Ok(c)
+}
+
+/// Moves a file camera's look-at point along its view to the depth of
+/// the model's centre, so that the window orbits the model; the view
+/// itself does not change. Left alone when the centre is behind the eye.
+fn aim_at_the_model(camera: &mut Camera, polygons: &[Polygon]) {
+    let (lo, hi) = super::polygon_bounds(polygons);
+    let centre = (0.5 * (lo + hi)).as_dvec3();
+    let eye = camera.eye.as_dvec3();
+    let forward = (camera.lookat - camera.eye).as_dvec3().normalize_or_zero();
+    let depth = (centre - eye).dot(forward);
+    if depth.is_finite() && depth > 0.0 {
+        let mut moved = *camera;
+        moved.lookat = (eye + forward * depth).as_vec3();
+        if moved.check().is_ok() {
+            *camera = moved;
+        }
+    }
 }
 
 /// The bytes a glTF URI names: a `data:` URI's base64 payload, or a file
