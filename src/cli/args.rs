@@ -30,8 +30,7 @@ pub const EXIT_CODES: &str =
 #[derive(clap::Parser, Clone, Debug, PartialEq)]
 #[command(name = "radiosity", version, about, after_help = EXIT_CODES)]
 pub struct Args {
-    /// Scene file: .sc, .obj (Wavefront OBJ with its MTL materials), or
-    /// .gltf/.glb (glTF 2.0).
+    /// Scene file: .sc, .obj (with its MTL materials), .gltf or .glb (glTF 2).
     ///
     /// Without it, the bundled scenes/rtable.sc.
     pub(crate) scene: Option<PathBuf>,
