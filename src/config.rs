@@ -33,7 +33,8 @@ pub const BUNDLED_SCENE_NAME: &str = "scenes/rtable.sc";
 pub enum SceneSource {
     /// The bundled `rtable.sc`.
     Bundled,
-    /// A scene file: `.obj` (Wavefront OBJ with MTL materials) or `.sc`.
+    /// A scene file: `.obj` (Wavefront OBJ with MTL materials), `.gltf`
+    /// or `.glb` (glTF 2.0), or `.sc`.
     File(PathBuf),
 }
 

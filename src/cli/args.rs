@@ -21,7 +21,7 @@ pub const EXIT_CODES: &str =
 /// Progressive-refinement radiosity renderer (ray-traced form factors after
 /// Wallace, Elmquist and Haines 1989).
 ///
-/// Reads a .sc or .obj scene, meshes every polygon into elements, shoots
+/// Reads a .sc, .obj or glTF scene, meshes every polygon into elements, shoots
 /// light from the polygon with the most unshot power until the unshot power
 /// falls below the threshold, and writes a Gouraud-shaded picture.
 // The field docs are plain help text, where `<scene-name>` is a
@@ -30,7 +30,7 @@ pub const EXIT_CODES: &str =
 #[derive(clap::Parser, Clone, Debug, PartialEq)]
 #[command(name = "radiosity", version, about, after_help = EXIT_CODES)]
 pub struct Args {
-    /// Scene file: .sc, or .obj (Wavefront OBJ with its MTL materials).
+    /// Scene file: .sc, .obj (with its MTL materials), .gltf or .glb (glTF 2).
     ///
     /// Without it, the bundled scenes/rtable.sc.
     pub(crate) scene: Option<PathBuf>,

@@ -47,13 +47,16 @@ pub const LAMP_WORDS: &[&str] = &["led", "leds", "sun"];
 /// are counted.
 pub const MAX_LISTED_NAMES: usize = 12;
 
-/// What kind of name an OBJ file gave a [`Group`].
+/// What kind of name a scene file gave a [`Group`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum GroupKind {
-    /// An object, `o NAME`.
+    /// An object: OBJ `o NAME`, or a glTF node with a mesh (what Blender
+    /// calls an object and exports as a node).
     Object,
-    /// A group, `g NAME …`.
+    /// An OBJ group, `g NAME …`.
     Group,
+    /// A glTF mesh, by its name: every node that draws it.
+    Mesh,
 }
 
 impl GroupKind {
@@ -62,11 +65,13 @@ impl GroupKind {
         match self {
             GroupKind::Object => "object",
             GroupKind::Group => "group",
+            GroupKind::Mesh => "mesh",
         }
     }
 }
 
-/// A named set of polygons from the scene file: an OBJ object or group.
+/// A named set of polygons from the scene file: an OBJ object or group,
+/// a glTF node or mesh.
 ///
 /// Invariants: `name` is not empty; `polygons` is strictly ascending and
 /// every id is below the scene's polygon count. The same `(kind, name)`
@@ -94,19 +99,26 @@ pub struct UnknownName {
     pub objects: Vec<String>,
     /// Every group name, in file order.
     pub groups: Vec<String>,
+    /// Every mesh name (glTF), in file order.
+    pub meshes: Vec<String>,
 }
 
 impl fmt::Display for UnknownName {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let kinds = if self.objects.is_empty() && self.groups.is_empty() {
-            "material"
-        } else {
-            "material, object or group"
+        let kinds = match (
+            self.objects.is_empty() && self.groups.is_empty(),
+            self.meshes.is_empty(),
+        ) {
+            (true, true) => "material",
+            (false, true) => "material, object or group",
+            (_, false) if self.groups.is_empty() => "material, object or mesh",
+            (_, false) => "material, object, mesh or group",
         };
         write!(f, "no {kinds} is named `{}`; the scene has ", self.name)?;
         let lists = [
             ("material", "materials", &self.materials),
             ("object", "objects", &self.objects),
+            ("mesh", "meshes", &self.meshes),
             ("group", "groups", &self.groups),
         ];
         let mut first = true;
@@ -302,6 +314,7 @@ impl Scene {
             materials: self.materials.iter().map(|m| m.name.clone()).collect(),
             objects: of(GroupKind::Object),
             groups: of(GroupKind::Group),
+            meshes: of(GroupKind::Mesh),
         }
     }
 
@@ -316,7 +329,7 @@ impl Scene {
             }
         }
         let mut out: Vec<(&'static str, &str)> = Vec::new();
-        let groups = [GroupKind::Object, GroupKind::Group]
+        let groups = [GroupKind::Object, GroupKind::Group, GroupKind::Mesh]
             .into_iter()
             .flat_map(|k| {
                 self.groups

@@ -54,13 +54,19 @@ pub(crate) fn reflectance_too_high(what: &str, rho: Rgb) -> String {
 }
 
 /// One problem found while loading, with its position.
+///
+/// A text format (`.sc`, `.obj`, `.mtl`, a `.gltf` file's JSON syntax)
+/// places it by line and column. A problem in a binary file, or one a glTF
+/// loader places by its JSON path (`meshes[3].primitives[0]`) or byte
+/// offset in the message itself, has line and column 0 (see
+/// [`Diagnostic::whole`]) and is printed `FILE: error: MESSAGE`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
     /// The file as the user named it.
     pub file: String,
-    /// Line, from 1.
+    /// Line, from 1; 0 when the message says where (see above).
     pub line: u32,
-    /// Column in characters, from 1.
+    /// Column in characters, from 1; 0 when `line` is 0.
     pub col: u32,
     /// What is wrong: one line, no trailing period, no position.
     pub message: String,
@@ -77,6 +83,17 @@ impl Diagnostic {
         }
     }
 
+    /// A diagnostic with no line and column: `message` says where (a JSON
+    /// path, a byte offset) or concerns the whole file.
+    pub fn whole(file: &str, message: impl Into<String>) -> Self {
+        Diagnostic {
+            file: file.to_owned(),
+            line: 0,
+            col: 0,
+            message: message.into(),
+        }
+    }
+
     /// Where it points, as a [`SourcePos`].
     pub fn pos(&self) -> SourcePos {
         SourcePos {
@@ -88,6 +105,9 @@ impl Diagnostic {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line == 0 {
+            return write!(f, "{}: error: {}", self.file, self.message);
+        }
         write!(
             f,
             "{}:{}:{}: error: {}",
@@ -230,6 +250,15 @@ mod tests {
         assert_eq!(
             diag(3, 7, "unknown keyword `foo`").to_string(),
             "a.sc:3:7: error: unknown keyword `foo`"
+        );
+    }
+
+    #[test]
+    fn a_diagnostic_without_a_line_prints_the_file_alone() {
+        let d = Diagnostic::whole("m.glb", "meshes[3].primitives[0]: no POSITION");
+        assert_eq!(
+            d.to_string(),
+            "m.glb: error: meshes[3].primitives[0]: no POSITION"
         );
     }
 

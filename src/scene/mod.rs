@@ -10,6 +10,7 @@ mod coplanar;
 mod emit;
 mod error;
 mod framing;
+pub mod gltf;
 pub mod hall;
 pub mod obj;
 mod polygon;
@@ -100,7 +101,8 @@ impl Material {
 }
 
 /// Where something was written in a source file (both 1-based; columns
-/// count Unicode characters).
+/// count Unicode characters). Both are 0 for what comes from a format
+/// without lines (a glTF polygon).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SourcePos {
     /// Line, from 1.
@@ -235,15 +237,19 @@ pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
     }
 }
 
-/// Reads and parses a scene file: Wavefront OBJ (with its MTL libraries)
-/// when the extension is `.obj` in any case, else `.sc`. Errors carry the
-/// file name, line and column.
+/// Reads and parses a scene file, by its extension in any case:
+/// Wavefront OBJ (with its MTL libraries) for `.obj`, glTF 2.0 for
+/// `.gltf` and `.glb`, else `.sc`. Errors carry the file name and the
+/// line and column (for glTF, the JSON path).
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let is_obj = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if is_obj {
+    let is = |ext: &str| {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    };
+    if is("obj") {
         obj::load_obj(path, None)
+    } else if is("gltf") || is("glb") {
+        self::gltf::load_gltf(path, None)
     } else {
         sc::load_file(path)
     }

@@ -161,16 +161,14 @@ pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> 
 
 /// Turns a `mtllib` name into the library's name for messages and its
 /// text, or says why it cannot.
-pub(crate) type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
+pub type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
 
-/// Parses OBJ text named `file`. `read_mtl` turns a `mtllib` name into
-/// the library's name for messages and its text, or says why it cannot.
-/// The camera frames the model.
-pub(crate) fn parse_obj(
-    text: &str,
-    file: &str,
-    read_mtl: &ReadMtl<'_>,
-) -> Result<Scene, LoadError> {
+/// Parses OBJ text named `file`: [`load_obj`] without reading the OBJ
+/// and its libraries from files. `read_mtl` turns a `mtllib` name into
+/// the library's name for messages and its text, or says why it cannot;
+/// `map_Kd` textures are still read from the file system, relative to the
+/// folder of the library's name. The camera frames the model.
+pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let scan = scan_obj(text, file);
     let mut diags = scan.diags.clone();
@@ -469,7 +467,7 @@ enum FaceError {
 
 /// Whether a polygon error means "nothing there" (a face to drop) rather
 /// than a face that cannot be read.
-fn is_degenerate(e: &PolygonError) -> bool {
+pub(super) fn is_degenerate(e: &PolygonError) -> bool {
     matches!(
         e,
         PolygonError::ZeroArea | PolygonError::EqualVertices { .. } | PolygonError::TooSmall { .. }
@@ -954,16 +952,25 @@ impl MtlMaterial {
     }
 }
 
-/// How often one kind of quirk was seen, and where first.
-#[derive(Default)]
-struct Tally {
-    count: usize,
-    first: Option<(SourcePos, String)>,
+/// How often one kind of quirk was seen, and where first (`P` is a
+/// [`SourcePos`] for text formats, a JSON path for glTF).
+pub(super) struct Tally<P = SourcePos> {
+    pub(super) count: usize,
+    pub(super) first: Option<(P, String)>,
 }
 
-impl Tally {
+impl<P> Default for Tally<P> {
+    fn default() -> Self {
+        Tally {
+            count: 0,
+            first: None,
+        }
+    }
+}
+
+impl<P> Tally<P> {
     /// Counts one more, remembering `what` at `pos` if it is the first.
-    fn add(&mut self, pos: SourcePos, what: impl FnOnce() -> String) {
+    pub(super) fn add(&mut self, pos: P, what: impl FnOnce() -> String) {
         self.count += 1;
         if self.first.is_none() {
             self.first = Some((pos, what()));
@@ -973,7 +980,7 @@ impl Tally {
 
 /// `names` as a list for a one-line message: at most
 /// [`MAX_NAMES_IN_WARNING`], then how many more.
-fn name_list(names: &[String]) -> String {
+pub(super) fn name_list(names: &[String]) -> String {
     let mut s = names
         .iter()
         .take(MAX_NAMES_IN_WARNING)
@@ -1226,6 +1233,11 @@ fn read_textures(lib: &mut Library) {
 /// already), alpha ignored. Each channel is in `[0, 1]`.
 pub(crate) fn average_texture(path: &Path) -> Result<Rgb, String> {
     let image = image::open(path).map_err(|e| e.to_string())?;
+    average_image(&image)
+}
+
+/// The average colour of `image`, as [`average_texture`] says.
+pub(super) fn average_image(image: &image::DynamicImage) -> Result<Rgb, String> {
     let linear = matches!(
         image,
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)

@@ -96,15 +96,23 @@ impl Scene {
         } else {
             "faces repeat"
         };
-        Some(Warning::at(
-            file,
-            later,
-            format!(
-                "{count} {faces} an earlier face exactly (first: line {} repeats line {}); \
-                 one of each was kept, as repeated faces would shadow each other",
-                later.line, earlier.line
-            ),
-        ))
+        let why = "one of each was kept, as repeated faces would shadow each other";
+        // Formats without lines (glTF) give their polygons no position.
+        Some(if later.line == 0 {
+            Warning::file(
+                file,
+                format!("{count} {faces} an earlier face exactly; {why}"),
+            )
+        } else {
+            Warning::at(
+                file,
+                later,
+                format!(
+                    "{count} {faces} an earlier face exactly (first: line {} repeats line {}); {why}",
+                    later.line, earlier.line
+                ),
+            )
+        })
     }
 
     /// Keeps the polygons whose `keep` entry is true, in order, and
