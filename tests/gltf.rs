@@ -130,10 +130,10 @@ fn materials_give_reflectance_emission_and_sides() {
         d.material(json!({"name": "White", "pbrMetallicRoughness": {"metallicFactor": 0.0}}));
     let chrome = d.material(json!({"name": "Chrome"}));
     let mut prims = Vec::new();
-    for m in [paint, lamp, white, chrome] {
-        prims.push(d.square(Some(m), false));
+    for (k, m) in [paint, lamp, white, chrome].into_iter().enumerate() {
+        prims.push(d.square_at(Some(m), false, 2.0 * k as f32));
     }
-    prims.push(d.square(None, false));
+    prims.push(d.square_at(None, false, 8.0));
     let mesh = d.mesh("Things", prims);
     let n = d.node(json!({"name": "Things", "mesh": mesh}));
     d.scene(&[n]);

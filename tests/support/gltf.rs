@@ -121,7 +121,16 @@ impl Doc {
     /// triangles, with `NORMAL` when `normals`; a primitive of material
     /// `material` (if any).
     pub fn square(&mut self, material: Option<usize>, normals: bool) -> Value {
-        let position = self.floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.], "VEC3");
+        self.square_at(material, normals, 0.0)
+    }
+
+    /// [`Doc::square`] moved by `dx` along x, for primitives that must not
+    /// repeat each other (exact repeats are dropped on import).
+    pub fn square_at(&mut self, material: Option<usize>, normals: bool, dx: f32) -> Value {
+        let position = self.floats(
+            &[dx, 0., 0., dx + 1., 0., 0., dx + 1., 1., 0., dx, 1., 0.],
+            "VEC3",
+        );
         let indices = self.indices(&[0, 1, 2, 0, 2, 3]);
         let mut p = json!({"attributes": {"POSITION": position}, "indices": indices});
         if normals {

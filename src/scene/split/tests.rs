@@ -76,6 +76,7 @@ fn a_sunk_wall_is_cut_at_the_floor() {
         two_sided: true,
         back_of: None,
         smooth: Some(SmoothId(3)),
+        ..Surface::default()
     };
     let mut s = scene(
         vec![floor(0.0, 2.0, 0.0, 2.0, 0.0), w.clone()],
