@@ -111,6 +111,11 @@ pub struct RunConfig {
     /// after loading by [`crate::scene::Scene::set_emission`]; an unknown
     /// name fails the run. Empty by default.
     pub emit: Vec<(String, Rgb)>,
+    /// `--sky VALUE`: a uniform diffuse sky of this radiosity (scene units,
+    /// every channel finite, `>= 0` and at most
+    /// [`crate::scene::MAX_EMISSION`]) all around the scene, added after
+    /// `--emit` by [`crate::scene::Scene::add_sky`]; `None` by default.
+    pub sky: Option<Rgb>,
 }
 
 impl RunConfig {
@@ -138,6 +143,7 @@ impl RunConfig {
             adaptive: None,
             mesh_lines: false,
             emit: Vec::new(),
+            sky: None,
         }
     }
 }

@@ -5,7 +5,7 @@
 //! Each option's doc comment is its help: the first paragraph is the one
 //! line `-h` shows, the whole comment is what `--help` shows.
 
-use super::values::{parse_emit, parse_shooter_samples, parse_size};
+use super::values::{parse_emit, parse_shooter_samples, parse_size, parse_sky};
 use crate::color::Rgb;
 use crate::config;
 use crate::mesh::refine;
@@ -157,6 +157,16 @@ pub struct Args {
     /// unknown NAME is an error listing the names there are.
     #[arg(long, value_name = "NAME=VALUE", value_parser = parse_emit)]
     pub(crate) emit: Vec<(String, Rgb)>,
+
+    /// Light the scene from all around with a uniform sky.
+    ///
+    /// V or R,G,B: a diffuse sky of this radiosity, in the scene's units,
+    /// surrounds the scene (as Blender's world colour) and lights it
+    /// through every opening; closed rooms stay dark inside. An unoccluded
+    /// floor of reflectance rho under a sky V comes out rho * V. The sky is
+    /// not drawn and not exported: the picture's background stays black.
+    #[arg(long, value_name = "VALUE", value_parser = parse_sky)]
+    pub(crate) sky: Option<Rgb>,
 
     /// Take the camera from this .sc file.
     ///

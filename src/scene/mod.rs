@@ -13,6 +13,7 @@ pub mod hall;
 pub mod obj;
 mod polygon;
 mod sc;
+mod sky;
 
 pub use emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
@@ -29,6 +30,7 @@ pub use polygon::{
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
 pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
+pub use sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.
@@ -144,6 +146,11 @@ pub struct Surface {
     pub back_of: Option<PolygonId>,
     /// The smooth surface it belongs to, if any.
     pub smooth: Option<SmoothId>,
+    /// A facet of the sky enclosure added by `--sky` ([`Scene::add_sky`]):
+    /// it emits and shoots like any emitter but reflects nothing, is meshed
+    /// as one element, and is left out of the scene's bounds, the picture,
+    /// the exports and adaptive refinement.
+    pub sky: bool,
 }
 
 /// Whether the camera came from the file or was made to frame the scene.
@@ -184,8 +191,10 @@ impl Scene {
         &self.materials[self.polygons[p.index()].material.index()]
     }
 
-    /// Axis-aligned bounds `(min, max)` of all vertices, in scene units.
-    /// For an empty scene both are zero.
+    /// Axis-aligned bounds `(min, max)` of the vertices of every polygon
+    /// but the sky's ([`Surface::sky`]), in scene units: the sky encloses
+    /// the scene and must not change its size, framing or default
+    /// tolerances. For an empty scene both are zero.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         polygon_bounds(&self.polygons)
     }
@@ -212,10 +221,13 @@ impl Scene {
     }
 }
 
-/// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, in
-/// scene units; both zero when there are none.
+/// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, sky
+/// facets left out, in scene units; both zero when there are none.
 pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
-    let mut it = polygons.iter().flat_map(|p| p.vertices.iter().copied());
+    let mut it = polygons
+        .iter()
+        .filter(|p| !p.surface.sky)
+        .flat_map(|p| p.vertices.iter().copied());
     match it.next() {
         None => (Vec3::ZERO, Vec3::ZERO),
         Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),
