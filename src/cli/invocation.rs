@@ -337,7 +337,7 @@ mod tests {
             &["--size", "0x10"],
             &["--emit", "Lamp=-1"],
             &["--emit", "Lamp=a,b"],
-            &["--sky", "-1"],
+            &["--sky=-1"],
             &["--sky", "1,2"],
         ] {
             let e = parse(args).unwrap_err();

@@ -315,3 +315,27 @@ fn the_sky_is_one_element_a_facet_and_is_left_out_of_the_drawn_mesh() {
     assert_eq!(kept, (0..bare.vertex_count() as u32).collect::<Vec<_>>());
     assert!(bare.without_sky(&radiosity).is_none());
 }
+
+#[test]
+fn the_checkpoint_fingerprint_covers_the_sky() {
+    let base = scene(vec![floor(2.0)], vec![grey("floor", 0.0, 0.5)]);
+    let fingerprint = |sky: Option<Rgb>| {
+        let mut s = base.clone();
+        if let Some(sky) = sky {
+            s.add_sky(sky).unwrap();
+        }
+        let options = MeshOptions {
+            lenmax: 0.5,
+            inset: mesh::DEFAULT_INSET,
+        };
+        let m = mesh::build(&s, &options).unwrap();
+        checkpoint::fingerprint(&s, &m, &SolverOptions::default())
+    };
+    let (none, one, two) = (
+        fingerprint(None),
+        fingerprint(Some(Rgb::splat(1.0))),
+        fingerprint(Some(Rgb::splat(2.0))),
+    );
+    assert!(none != one && one != two && none != two);
+    assert_eq!(one, fingerprint(Some(Rgb::splat(1.0))));
+}
