@@ -117,6 +117,11 @@ pub struct RunConfig {
     /// both, `.sc` the front), or `--one-sided` / `--two-sided` for all.
     /// Applied after `--emit` by [`crate::scene::Scene::with_sides`].
     pub sides: Sides,
+    /// `--sky VALUE`: a uniform diffuse sky of this radiosity (scene units,
+    /// every channel finite, `>= 0` and at most
+    /// [`crate::scene::MAX_EMISSION`]) all around the scene, added after
+    /// `--emit` by [`crate::scene::Scene::add_sky`]; `None` by default.
+    pub sky: Option<Rgb>,
 }
 
 impl RunConfig {
@@ -145,6 +150,7 @@ impl RunConfig {
             mesh_lines: false,
             emit: Vec::new(),
             sides: Sides::AsLoaded,
+            sky: None,
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Preparing a scene for solving: load it (with a camera override), make
-//! what `--emit` names emit ([`Scene::set_emission`]), say on stderr what
+//! what `--emit` names emit ([`Scene::set_emission`]), put the `--sky`
+//! around it ([`Scene::add_sky`]), say on stderr what
 //! the loader changed or ignored and whether nothing emits
 //! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), split polygons
 //! where others pass through them ([`Scene::split_intersections`]), check
@@ -10,7 +11,7 @@
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
-use crate::scene::{self, LoadError, Scene, SplitStats, UnknownName};
+use crate::scene::{self, LoadError, PolygonError, Scene, SplitStats, UnknownName};
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::path::Path;
@@ -31,6 +32,10 @@ pub enum PrepareError {
     /// scene; the message lists the names there are.
     #[error("--emit: {0}")]
     UnknownName(#[from] UnknownName),
+    /// The sky's enclosure would lie beyond the largest coordinate a
+    /// polygon may have (a scene within a tenth of that limit).
+    #[error("--sky: the scene is too large to put a sky around it: {0}")]
+    Sky(PolygonError),
 }
 
 /// Seconds spent in each phase of a run.
@@ -87,14 +92,19 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
-    if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
-        scene.warnings.push(warning);
-    }
     // Not a quirk of the file, so no warning: geometry passing through
     // geometry is how models are built. Before the back copies, so that
     // each piece gets its own.
     let split = scene.split_intersections();
-    let scene = scene.with_sides(config.sides);
+    let mut scene = scene.with_sides(config.sides);
+    // Last, after everything that adds or changes polygons, so that the
+    // enclosure is built around the finished scene.
+    if let Some(sky) = config.sky {
+        scene.add_sky(sky).map_err(PrepareError::Sky)?;
+    }
+    if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
+        scene.warnings.push(warning);
+    }
     seconds.load = t.elapsed().as_secs_f64();
     // Said before the solve, whatever `--quiet` says: a warning explains a
     // picture that is not what the user expected.

@@ -37,7 +37,7 @@ pub enum CheckpointError {
     /// The checkpoint was written for another scene, mesh or solver options.
     #[error(
         "checkpoint {} was saved for a different scene, mesh or form-factor options \
-         (give the same scene, --emit, --lenmax, --inset, --form-factor, --shooter-samples and \
+         (give the same scene, --emit, --sky, --lenmax, --inset, --form-factor, --shooter-samples and \
          --no-near-field as the run that saved it)",
         path.display()
     )]

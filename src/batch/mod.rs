@@ -143,7 +143,8 @@ pub struct RunStats {
     /// (and not written) when there were none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
-    /// Scene polygons (after splitting along intersections).
+    /// Scene polygons (after splitting along intersections; the sky's
+    /// facets not counted).
     pub polygons: usize,
     /// Polygons cut along the lines where others pass through them, and
     /// the pieces they became
@@ -151,10 +152,14 @@ pub struct RunStats {
     /// written only when something was cut.
     #[serde(skip_serializing_if = "crate::scene::SplitStats::is_empty")]
     pub split: crate::scene::SplitStats,
-    /// Mesh elements.
+    /// Mesh elements (the sky's not counted).
     pub elements: usize,
-    /// Mesh element vertices.
+    /// Mesh element vertices (the sky's not counted).
     pub vertices: usize,
+    /// The `--sky` radiosity `[r, g, b]` in the scene's units, when the
+    /// scene was lit by a sky (not written otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sky: Option<[f64; 3]>,
     /// The lenmax used, in scene units.
     pub lenmax: f32,
     /// Shooting steps taken.
@@ -280,11 +285,17 @@ pub fn run_prepared(
             .map_err(RunError::Write)?;
     }
     if let Some(path) = &config.export {
+        // The sky lights the model; it is no part of it.
+        let without_sky = mesh.without_sky(&solved.radiosity);
+        let (mesh, radiosity) = match &without_sky {
+            Some((m, r)) => (m, &r[..]),
+            None => (mesh, &solved.radiosity[..]),
+        };
         output::write_mesh(
             path,
             &prepared.scene,
             mesh,
-            &solved.radiosity,
+            radiosity,
             exposure,
             &config.scene.stem(),
         )
@@ -316,10 +327,16 @@ pub fn run_prepared(
             .map(|w| w.to_string())
             .chain(dark)
             .collect(),
-        polygons: prepared.scene.polygons.len(),
+        polygons: prepared
+            .scene
+            .polygons
+            .iter()
+            .filter(|p| !p.surface.sky)
+            .count(),
         split: prepared.split,
-        elements: mesh.elements.len(),
-        vertices: mesh.vertex_count(),
+        elements: drawn(mesh).0,
+        vertices: drawn(mesh).1,
+        sky: prepared.scene.sky().map(|s| s.to_array()),
         lenmax: prepared.lenmax,
         steps: totals.steps,
         rays: totals.rays,
@@ -499,13 +516,31 @@ pub fn summary(stats: &RunStats) -> String {
         // No steps, no unshot power: there was nothing to solve.
         return format!("{}: nothing emits, nothing solved → {written}", stats.scene);
     }
+    let sky = match stats.sky {
+        Some([r, g, b]) if r == g && g == b => format!(" under a sky of {r}"),
+        Some([r, g, b]) => format!(" under a sky of {r},{g},{b}"),
+        None => String::new(),
+    };
     format!(
-        "{}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {written}",
+        "{}{sky}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {written}",
         stats.scene,
         stats.seconds.solve,
         stats.rays as f64 / 1e6,
         stats.unshot_fraction * 100.0,
         if stats.converged { "" } else { " (step limit)" },
+    )
+}
+
+/// The elements and vertices of `mesh` that are drawn: every one but the
+/// sky's.
+fn drawn(mesh: &crate::mesh::Mesh) -> (usize, usize) {
+    let sky = mesh.polygons.iter().filter(|pm| pm.sky);
+    let (elements, vertices) = sky.fold((0, 0), |(e, v), pm| {
+        (e + pm.elements.len(), v + pm.vertex_count() as usize)
+    });
+    (
+        mesh.elements.len() - elements,
+        mesh.vertex_count() - vertices,
     )
 }
 

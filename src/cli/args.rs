@@ -5,7 +5,7 @@
 //! Each option's doc comment is its help: the first paragraph is the one
 //! line `-h` shows, the whole comment is what `--help` shows.
 
-use super::values::{parse_emit, parse_shooter_samples, parse_size};
+use super::values::{parse_emit, parse_shooter_samples, parse_size, parse_sky};
 use crate::color::Rgb;
 use crate::config;
 use crate::mesh::refine;
@@ -172,6 +172,15 @@ pub struct Args {
     /// radiosity (the default for OBJ faces).
     #[arg(long)]
     pub(crate) two_sided: bool,
+    /// Light the scene from all around with a uniform sky.
+    ///
+    /// V or R,G,B: a diffuse sky of this radiosity, in the scene's units,
+    /// surrounds the scene (as Blender's world colour) and lights it
+    /// through every opening; closed rooms stay dark inside. An unoccluded
+    /// floor of reflectance rho under a sky V comes out rho * V. The sky is
+    /// not drawn and not exported: the picture's background stays black.
+    #[arg(long, value_name = "VALUE", value_parser = parse_sky)]
+    pub(crate) sky: Option<Rgb>,
 
     /// Take the camera from this .sc file.
     ///

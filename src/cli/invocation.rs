@@ -162,6 +162,7 @@ impl TryFrom<Args> for Invocation {
                 (_, true) => Sides::Two,
                 (false, false) => Sides::AsLoaded,
             },
+            sky: args.sky,
         };
         let mode = if args.no_window
             || config.output.is_some()
@@ -259,6 +260,8 @@ mod tests {
             "Lamp=10",
             "--emit",
             "shade=1,2,3",
+            "--sky",
+            "0.5,0.6,0.7",
             "-q",
         ]);
         assert_eq!(c.scene, SceneSource::File(PathBuf::from("room.sc")));
@@ -293,8 +296,10 @@ mod tests {
                 ("shade".to_string(), crate::color::Rgb::new(1.0, 2.0, 3.0)),
             ]
         );
+        assert_eq!(c.sky, Some(crate::color::Rgb::new(0.5, 0.6, 0.7)));
         assert!(!c.progress);
         assert_eq!(config(&["--ambient"]).ambient, Some(true));
+        assert_eq!(config(&[]).sky, None);
     }
 
     #[test]
@@ -338,6 +343,8 @@ mod tests {
             &["--size", "0x10"],
             &["--emit", "Lamp=-1"],
             &["--emit", "Lamp=a,b"],
+            &["--sky=-1"],
+            &["--sky", "1,2"],
         ] {
             let e = parse(args).unwrap_err();
             assert_eq!(

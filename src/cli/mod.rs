@@ -1,6 +1,6 @@
 //! The command line: clap's definitions ([`Args`]), the parsers for
 //! structured values ([`parse_size`], [`parse_shooter_samples`],
-//! [`parse_emit`]) and the
+//! [`parse_emit`], [`parse_sky`]) and the
 //! conversion of the raw arguments into the one validated [`Invocation`]
 //! the rest of the program sees (never `argv`).
 //!
@@ -24,4 +24,4 @@ mod values;
 
 pub use args::{Args, EXIT_CODES};
 pub use invocation::{Invocation, Mode, UsageError};
-pub use values::{parse_emit, parse_shooter_samples, parse_size, ValueError};
+pub use values::{parse_emit, parse_shooter_samples, parse_size, parse_sky, ValueError};

@@ -27,6 +27,14 @@ pub enum ValueError {
         max = MAX_EMISSION
     )]
     Emit(String),
+    /// `--sky` is not a radiosity `V` or `R,G,B`, each channel a number
+    /// from 0 to [`MAX_EMISSION`].
+    #[error(
+        "--sky must look like 1 or 0.8,0.9,1.2 (a radiosity per channel, \
+         from 0 to {max:e}), got `{0}`",
+        max = MAX_EMISSION
+    )]
+    Sky(String),
 }
 
 /// Parses `--size`: `WxH` (or `WXH`), width and height in pixels, both
@@ -65,19 +73,32 @@ pub fn parse_emit(text: &str) -> Result<(String, Rgb), ValueError> {
     if name.is_empty() {
         return Err(bad());
     }
+    let rgb = parse_radiosity(value).ok_or_else(bad)?;
+    Ok((name.to_string(), rgb))
+}
+
+/// Parses `--sky`: a radiosity in the scene's units, `V` (grey) or
+/// `R,G,B`, every channel finite, `>= 0` and at most [`MAX_EMISSION`],
+/// as the value of `--emit`.
+pub fn parse_sky(text: &str) -> Result<Rgb, ValueError> {
+    parse_radiosity(text).ok_or_else(|| ValueError::Sky(text.to_string()))
+}
+
+/// A radiosity `V` or `R,G,B` (spaces around channels allowed), every
+/// channel finite, `>= 0` and at most [`MAX_EMISSION`]; `None` otherwise.
+fn parse_radiosity(value: &str) -> Option<Rgb> {
     let channels = value
         .split(',')
         .map(|c| match c.trim().parse::<f64>() {
-            Ok(x) if x.is_finite() && (0.0..=MAX_EMISSION).contains(&x) => Ok(x),
-            _ => Err(bad()),
+            Ok(x) if x.is_finite() && (0.0..=MAX_EMISSION).contains(&x) => Some(x),
+            _ => None,
         })
-        .collect::<Result<Vec<f64>, ValueError>>()?;
-    let rgb = match channels[..] {
-        [v] => Rgb::splat(v),
-        [r, g, b] => Rgb::new(r, g, b),
-        _ => return Err(bad()),
-    };
-    Ok((name.to_string(), rgb))
+        .collect::<Option<Vec<f64>>>()?;
+    match channels[..] {
+        [v] => Some(Rgb::splat(v)),
+        [r, g, b] => Some(Rgb::new(r, g, b)),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
@@ -142,6 +163,21 @@ mod tests {
             parse_emit("Lamp=-1").unwrap_err().to_string(),
             "--emit must look like NAME=10 or NAME=10,8,6 (a radiosity per channel, \
              from 0 to 1e20), got `Lamp=-1`"
+        );
+    }
+
+    #[test]
+    fn sky_is_a_grey_or_coloured_radiosity() {
+        assert_eq!(parse_sky("1"), Ok(Rgb::splat(1.0)));
+        assert_eq!(parse_sky("0.8, 0.9,1.2"), Ok(Rgb::new(0.8, 0.9, 1.2)));
+        assert_eq!(parse_sky("0"), Ok(Rgb::BLACK));
+        for bad in ["", "-1", "a", "1,2", "1,2,3,4", "nan", "inf", "1e21", "x=1"] {
+            assert_eq!(parse_sky(bad), Err(ValueError::Sky(bad.into())), "{bad}");
+        }
+        assert_eq!(
+            parse_sky("-1").unwrap_err().to_string(),
+            "--sky must look like 1 or 0.8,0.9,1.2 (a radiosity per channel, \
+             from 0 to 1e20), got `-1`"
         );
     }
 

@@ -150,6 +150,10 @@ pub struct PolygonMesh {
     /// face of the file that is its reverse, [`crate::scene::Surface::back`]):
     /// the picture then draws this one from the front only.
     pub has_back: bool,
+    /// A sky facet ([`crate::scene::Surface::sky`]): one element whatever
+    /// the lenmax, never refined, drawn or exported (see
+    /// [`Mesh::without_sky`]).
+    pub sky: bool,
 }
 
 impl PolygonMesh {
@@ -466,6 +470,7 @@ pub fn build_with_limit(
             levels: 0,
             layer: layers[index],
             has_back: polygon.surface.back.is_some(),
+            sky: polygon.surface.sky,
         });
     }
     Ok(mesh)
@@ -497,6 +502,13 @@ fn divisions(length: f32, lenmax: f32) -> u32 {
 
 impl Plan {
     fn new(polygon: &Polygon, lenmax: f32) -> Plan {
+        // A sky facet's radiosity is its emission, the same everywhere:
+        // one element carries it, whatever the scene's lenmax.
+        let lenmax = if polygon.surface.sky {
+            f32::INFINITY
+        } else {
+            lenmax
+        };
         let v = &polygon.vertices;
         match polygon.shape {
             Shape::Parallelogram | Shape::Quad => {
@@ -878,6 +890,55 @@ impl Mesh {
             areas.iter_mut().for_each(|a| *a /= total);
         }
         areas
+    }
+
+    /// The mesh as drawn and exported: without the vertices and elements of
+    /// sky facets ([`PolygonMesh::sky`]), with `values` (one per vertex of
+    /// this mesh: a radiosity, say) kept for the vertices that stay. Every
+    /// polygon keeps its index, so [`Mesh::vertex_polygon`] and
+    /// [`Mesh::element_polygon`] still name scene polygons; a sky facet's
+    /// ranges are empty. `None` when there is no sky (use this mesh).
+    pub fn without_sky<T: Clone>(&self, values: &[T]) -> Option<(Mesh, Vec<T>)> {
+        if !self.polygons.iter().any(|pm| pm.sky) {
+            return None;
+        }
+        let mut new_index = vec![u32::MAX; self.vertex_count()];
+        let mut out = Mesh {
+            positions: Vec::new(),
+            sample_positions: Vec::new(),
+            vertex_polygon: Vec::new(),
+            elements: Vec::new(),
+            element_polygon: Vec::new(),
+            polygons: Vec::with_capacity(self.polygons.len()),
+        };
+        let mut kept = Vec::new();
+        for pm in &self.polygons {
+            let (v_start, e_start) = (out.positions.len() as u32, out.elements.len() as u32);
+            if !pm.sky {
+                for l in pm.vertices.clone() {
+                    let l = l as usize;
+                    new_index[l] = out.positions.len() as u32;
+                    out.positions.push(self.positions[l]);
+                    out.sample_positions.push(self.sample_positions[l]);
+                    out.vertex_polygon.push(self.vertex_polygon[l]);
+                    kept.extend(values.get(l).cloned());
+                }
+                for e in pm.elements.clone() {
+                    let mut element = self.elements[e as usize];
+                    // A triangle's repeated fourth corner is renumbered too.
+                    for c in &mut element.corners {
+                        *c = VertexId(new_index[c.index()]);
+                    }
+                    out.elements.push(element);
+                    out.element_polygon.push(self.element_polygon[e as usize]);
+                }
+            }
+            let mut polygon = pm.clone();
+            polygon.vertices = v_start..out.positions.len() as u32;
+            polygon.elements = e_start..out.elements.len() as u32;
+            out.polygons.push(polygon);
+        }
+        Some((out, kept))
     }
 
     /// Checks the structural invariants; returns the first broken one.

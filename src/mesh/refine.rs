@@ -304,7 +304,7 @@ impl Refiner {
         let marked: Vec<usize> = (0..self.leaves.len())
             .filter(|&k| {
                 let leaf = self.leaves[k];
-                if leaf.level >= max_level {
+                if leaf.level >= max_level || self.is_sky(&leaf) {
                     return false;
                 }
                 self.ring(&leaf, &mut ring);
@@ -351,10 +351,13 @@ impl Refiner {
         Some((mesh, report))
     }
 
-    /// Area-weighted mean of a per-pool-vertex field over the leaves.
+    /// Area-weighted mean of a per-pool-vertex field over the leaves, sky
+    /// facets left out.
     fn mean(&self, values: &[f64]) -> f64 {
         let (mut sum, mut area) = (0.0, 0.0);
-        for leaf in &self.leaves {
+        // The sky's huge bright facets would raise the floor above the
+        // scene's own dark parts.
+        for leaf in self.leaves.iter().filter(|leaf| !self.is_sky(leaf)) {
             let a = self.leaf_area(leaf);
             let mean = leaf
                 .corners()
@@ -370,6 +373,13 @@ impl Refiner {
         } else {
             0.0
         }
+    }
+
+    /// True for a leaf of a sky facet, which is never split.
+    fn is_sky(&self, leaf: &Leaf) -> bool {
+        self.polygons
+            .get(leaf.polygon.index())
+            .is_some_and(|pm| pm.sky)
     }
 
     fn leaf_area(&self, leaf: &Leaf) -> f64 {

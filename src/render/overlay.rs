@@ -21,7 +21,8 @@ pub const MESH_COLOR: [u8; 3] = [40, 220, 255];
 /// picture's depth is interpolated per triangle, so equality needs slack.
 pub const LINE_DEPTH_BIAS: f64 = 1e-3;
 
-/// Draws every element edge of `mesh` seen through `view` onto `image` in
+/// Draws every element edge of `mesh` (sky facets left out, as the
+/// picture leaves them out) seen through `view` onto `image` in
 /// `color`, hidden where a nearer surface covers it. `inv_depth` is the
 /// rasterizer's depth buffer for the same view ([`super::Rasterizer::inv_depth`]),
 /// one `1/z` per pixel; if its size does not match the image, nothing is drawn.
@@ -36,7 +37,10 @@ pub fn draw_mesh_edges(
     if inv_depth.len() != w * h || w == 0 || h == 0 {
         return;
     }
-    for element in &mesh.elements {
+    for (element, polygon) in mesh.elements.iter().zip(&mesh.element_polygon) {
+        if mesh.polygons.get(polygon.index()).is_none_or(|pm| pm.sky) {
+            continue;
+        }
         let corners = element.corners();
         for k in 0..corners.len() {
             let (a, b) = (corners[k].index(), corners[(k + 1) % corners.len()].index());

@@ -203,7 +203,9 @@ impl Rasterizer {
     /// units), and returns the picture, sized as the view.
     ///
     /// Front faces show the Gouraud-interpolated radiosity, back faces are
-    /// black, uncovered pixels are black and not `covered`.
+    /// black, uncovered pixels are black and not `covered`. Sky facets
+    /// ([`crate::mesh::PolygonMesh::sky`]) are not drawn: where the sky is
+    /// seen, the picture shows background.
     pub fn render(
         &mut self,
         mesh: &Mesh,
@@ -223,6 +225,10 @@ impl Rasterizer {
         for (e, element) in mesh.elements.iter().enumerate() {
             // Checked by `check_mesh`: every index below is in range.
             let polygon = &mesh.polygons[mesh.element_polygon[e].index()];
+            // The sky lights the scene; it is not part of the picture.
+            if polygon.sky {
+                continue;
+            }
             for tri in element.triangles() {
                 let corner = |v: VertexId| ClipVertex {
                     p: view.to_camera(mesh.positions[v.index()]).as_dvec3(),
@@ -690,6 +696,7 @@ mod tests {
                 levels: 0,
                 layer: 0,
                 has_back: false,
+                sky: false,
             });
             self
         }

@@ -355,7 +355,8 @@ impl Scene {
     /// The warning for a scene in which nothing emits (see
     /// [`Scene::emits`]), about `file` as the user named it: one line
     /// saying the picture will be black, naming what looks like a lamp,
-    /// and the option that gives it light. `None` when something emits.
+    /// and the options that give it light (`--emit`, `--sky`). `None` when
+    /// something emits, a sky ([`Scene::add_sky`]) included.
     pub fn nothing_emits_warning(&self, file: &str) -> Option<Warning> {
         if self.emits() {
             return None;
@@ -397,7 +398,10 @@ impl Scene {
         };
         Some(Warning::file(
             file,
-            format!("nothing emits light, so the picture will be black; {fix}"),
+            format!(
+                "nothing emits light, so the picture will be black; {fix}; \
+                 or light it from all around with --sky VALUE (a sky of that radiosity)"
+            ),
         ))
     }
 }
@@ -676,7 +680,8 @@ mod tests {
             w.to_string(),
             "room.obj: warning: nothing emits light, so the picture will be black; \
              object `Lamp` looks like a lamp: make it emit with --emit NAME=VALUE \
-             (radiosity in the scene's units, V or R,G,B), for instance --emit 'Lamp=10'"
+             (radiosity in the scene's units, V or R,G,B), for instance --emit 'Lamp=10'; \
+             or light it from all around with --sky VALUE (a sky of that radiosity)"
         );
         let mut two = room();
         two.materials[1].name = "Glow".to_string();
@@ -688,12 +693,20 @@ mod tests {
         let mut lit = room();
         lit.set_emission("Lamp", Rgb::splat(1.0)).unwrap();
         assert_eq!(lit.nothing_emits_warning("room.obj"), None);
+        // A sky lights it too.
+        let mut sky = room();
+        sky.add_sky(Rgb::splat(1.0)).unwrap();
+        assert_eq!(sky.nothing_emits_warning("room.obj"), None);
         // No hint: the option alone.
         let dark = testutil::scene(vec![square(0, 0.0)], vec![material("m", 0.5, 0.0)]);
         assert_eq!(dark.camera_source, CameraSource::File);
         let message = dark.nothing_emits_warning("a.sc").unwrap().to_string();
         assert!(
-            message.ends_with("black; make a material emit with --emit NAME=VALUE (radiosity in the scene's units, V or R,G,B)"),
+            message.ends_with(
+                "black; make a material emit with --emit NAME=VALUE (radiosity in the \
+                 scene's units, V or R,G,B); or light it from all around with --sky VALUE \
+                 (a sky of that radiosity)"
+            ),
             "{message}"
         );
     }

@@ -153,7 +153,8 @@ fn directions() -> Vec<DVec3> {
 /// (brute force: the scene sits below the BVH in the crate).
 fn nearest_hit(polygons: &[Polygon], origin: DVec3, dir: DVec3, edge_tol: f64) -> Option<Hit> {
     let mut best: Option<Hit> = None;
-    for p in polygons {
+    // The sky encloses everything: it is no wall of a room.
+    for p in polygons.iter().filter(|p| !p.surface.sky) {
         let n = p.normal.as_dvec3();
         let cosine = n.dot(dir);
         if cosine.abs() < RAY_PARALLEL_COSINE {

@@ -16,6 +16,7 @@ pub mod obj;
 mod polygon;
 mod sc;
 mod sides;
+mod sky;
 mod split;
 
 pub use coplanar::{
@@ -37,6 +38,7 @@ pub use polygon::{
 };
 pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
 pub use sides::Sides;
+pub use sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
 pub use split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
@@ -159,6 +161,11 @@ pub struct Surface {
     pub back: Option<PolygonId>,
     /// The smooth surface it belongs to, if any.
     pub smooth: Option<SmoothId>,
+    /// A facet of the sky enclosure added by `--sky` ([`Scene::add_sky`]):
+    /// it emits and shoots like any emitter but reflects nothing, is meshed
+    /// as one element, and is left out of the scene's bounds, the picture,
+    /// the exports and adaptive refinement.
+    pub sky: bool,
 }
 
 /// Whether the camera came from the file or was made to frame the scene.
@@ -199,8 +206,10 @@ impl Scene {
         &self.materials[self.polygons[p.index()].material.index()]
     }
 
-    /// Axis-aligned bounds `(min, max)` of all vertices, in scene units.
-    /// For an empty scene both are zero.
+    /// Axis-aligned bounds `(min, max)` of the vertices of every polygon
+    /// but the sky's ([`Surface::sky`]), in scene units: the sky encloses
+    /// the scene and must not change its size, framing or default
+    /// tolerances. For an empty scene both are zero.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         polygon_bounds(&self.polygons)
     }
@@ -227,10 +236,13 @@ impl Scene {
     }
 }
 
-/// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, in
-/// scene units; both zero when there are none.
+/// Axis-aligned bounds `(min, max)` of the vertices of `polygons`, sky
+/// facets left out, in scene units; both zero when there are none.
 pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
-    let mut it = polygons.iter().flat_map(|p| p.vertices.iter().copied());
+    let mut it = polygons
+        .iter()
+        .filter(|p| !p.surface.sky)
+        .flat_map(|p| p.vertices.iter().copied());
     match it.next() {
         None => (Vec3::ZERO, Vec3::ZERO),
         Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),

@@ -32,7 +32,8 @@
 //! (its header is 52 bytes); it is still read, with an empty record.
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
-//! materials, the mesh's vertices and sample points, and the form-factor
+//! materials (those `--emit` changed, and the facets and radiosity of a
+//! `--sky`), the mesh's vertices and sample points, and the form-factor
 //! options. It leaves out the stopping rule (threshold, step limit), so a
 //! resumed run may go further than the interrupted one would have. A
 //! driver refuses a checkpoint whose fingerprint differs from its solve's;
@@ -159,6 +160,8 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     h.word(scene.polygons.len() as u64);
     for p in &scene.polygons {
         h.word(p.material.0 as u64);
+        // A sky facet (`--sky`) is meshed and sampled as no other polygon.
+        h.word(p.surface.sky as u64);
         h.word(p.vertices.len() as u64);
         for v in &p.vertices {
             for c in v.to_array() {
@@ -196,6 +199,7 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         ShooterSamples::AtMost(n) => n as u64,
     });
     h.word(options.near_field as u64);
+    h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
     h.word(match options.unshot {
         super::UnshotScheme::Polygon => 1,
         super::UnshotScheme::Vertex => 2,

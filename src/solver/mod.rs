@@ -14,6 +14,12 @@
 //! Δb_i  = 0
 //! ```
 //!
+//! A sky (`--sky`, [`crate::scene::Scene::add_sky`]) is an enclosure of
+//! emitting facets that reflect nothing: each shoots like any emitter, from
+//! its own grid of [`formfactor::SKY_FACET_SAMPLES`] points, and its unshot
+//! power counts as the light it can bring to the scene, not its own (see
+//! [`Progressive::unshot_power`]).
+//!
 //! Emission and reflection are from the front only. Receivers are
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
@@ -141,7 +147,8 @@ pub struct StepReport {
     pub step: u64,
     /// The polygon that shot.
     pub shooter: PolygonId,
-    /// The power it shot: `A_i · mean(Δb_i)`, in radiosity × area units.
+    /// The power it shot: `A_i · mean(Δb_i)`, in radiosity × area units
+    /// (for a sky facet, weighted as [`Progressive::unshot_power`] says).
     pub shot_power: f64,
     /// Unshot power left after the step, as a fraction of the initial.
     pub unshot_fraction: f64,
@@ -238,6 +245,9 @@ pub struct Progressive<'a> {
     emission: Vec<Rgb>,
     /// Per polygon: front reflectance `rho`.
     reflectance: Vec<Rgb>,
+    /// Per polygon: the factor its unshot power counts with (see
+    /// [`sky_power_weights`]): 1, less for sky facets.
+    power_weight: Vec<f64>,
     /// Per polygon: shooter samples.
     samples: Vec<Vec<ShooterSample>>,
     /// Per vertex: radiosity `b`.
@@ -298,18 +308,25 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|p| scene.materials[p.material.index()].reflectance())
             .collect();
+        let sets: Vec<SampleSet> = scene
+            .polygons
+            .iter()
+            .map(|p| SampleSet::for_polygon(set, p))
+            .collect();
         let samples: Vec<Vec<ShooterSample>> = scene
             .polygons
             .iter()
             .zip(&mesh.polygons)
-            .map(|(p, pm)| shooter_samples(p, pm, mesh, set))
+            .zip(&sets)
+            .map(|((p, pm), &set)| shooter_samples(p, pm, mesh, set))
             .collect();
         let radiosity = mesh
             .vertex_polygon
             .iter()
             .map(|p| emission[p.index()])
             .collect();
-        let unshot = UnshotField::new(options.unshot, mesh, &emission, &samples, set);
+        let unshot = UnshotField::new(options.unshot, mesh, &emission, &samples, &sets);
+        let power_weight = sky_power_weights(mesh);
         let mut tiles = Vec::new();
         let mut tile_of = vec![0u32; mesh.vertex_count()];
         for pm in &mesh.polygons {
@@ -329,6 +346,7 @@ impl<'a> Progressive<'a> {
             options,
             emission,
             reflectance,
+            power_weight,
             samples,
             radiosity,
             unshot,
@@ -397,6 +415,13 @@ impl<'a> Progressive<'a> {
     pub fn ambient(&self) -> Rgb {
         let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
         for (j, (rho, pm)) in self.reflectance.iter().zip(&self.mesh.polygons).enumerate() {
+            // The sky is no part of the scene its light is spread over;
+            // what it has not shot yet is the light's source, counted as
+            // the power it would bring (see `sky_power_weights`).
+            if pm.sky {
+                unshot += self.unshot.mean(&self.mesh, j) * pm.area * self.power_weight[j];
+                continue;
+            }
             area += pm.area;
             unshot += self.unshot.mean(&self.mesh, j) * pm.area;
             reflected += *rho * pm.area;
@@ -429,16 +454,22 @@ impl<'a> Progressive<'a> {
     }
 
     /// Total unshot power `Σ A_i · mean(Δb_i)` (per-vertex scheme: the
-    /// sum over vertices of `mean(Δb_l) · vertex area`).
+    /// sum over vertices of `mean(Δb_l) · vertex area`), in radiosity ×
+    /// area units. A sky's facets count together as at most `S · A_scene`
+    /// (its radiosity times the area of every other polygon), the most it
+    /// can bring to the scene, not its own far larger power (see
+    /// [`sky_power_weights`]).
     pub fn unshot_power(&self) -> f64 {
         (0..self.mesh.polygons.len())
             .map(|j| self.polygon_unshot_power(j))
             .sum()
     }
 
-    /// Unshot power of polygon `j`, in radiosity × area units.
+    /// Unshot power of polygon `j`, in radiosity × area units, as it
+    /// counts for choosing the shooter and for the threshold: a sky
+    /// facet's weighted by [`sky_power_weights`].
     fn polygon_unshot_power(&self, j: usize) -> f64 {
-        self.unshot.power(&self.mesh, j)
+        self.unshot.power(&self.mesh, j) * self.power_weight[j]
     }
 
     /// Unshot power at the start (the emitted power).
@@ -888,5 +919,41 @@ impl<'a> Progressive<'a> {
     }
 }
 
+/// Per polygon of `mesh`, the factor its unshot power counts with: 1 for
+/// the scene's polygons; for the facets of a sky, the scene's area (every
+/// non-sky polygon's) over the sky's, so that the whole sky counts as
+/// `S · A_scene`.
+///
+/// A sky's own power, `S` times the area of an enclosure far outside the
+/// scene, is mostly light that never reaches it, and it depends on the
+/// enclosure's arbitrary radius. Counted whole it would make the first
+/// bounce in the scene look negligible against the initial power, and the
+/// threshold would stop the solve before any light was reflected. What a
+/// sky can bring to the scene is at most `S · A_scene` (each polygon's form
+/// factor to the sky is at most 1), which is also what an emitter of the
+/// scene's size would hold: the threshold then means what it means for
+/// any scene.
+fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
+    let (mut scene_area, mut sky_area) = (0.0, 0.0);
+    for pm in &mesh.polygons {
+        if pm.sky {
+            sky_area += pm.area;
+        } else {
+            scene_area += pm.area;
+        }
+    }
+    let sky_weight = if sky_area > 0.0 {
+        scene_area / sky_area
+    } else {
+        1.0
+    };
+    mesh.polygons
+        .iter()
+        .map(|pm| if pm.sky { sky_weight } else { 1.0 })
+        .collect()
+}
+
+#[cfg(test)]
+mod sky_tests;
 #[cfg(test)]
 mod tests;

@@ -67,13 +67,13 @@ enum SampleSource {
 impl UnshotField {
     /// The field at the start of a solve: every polygon's (or vertex's)
     /// `Δb = e`, its polygon's emission. `samples` are every polygon's
-    /// shooter samples, chosen as `set` says.
+    /// shooter samples, chosen as `sets` (one per polygon) say.
     pub(crate) fn new(
         scheme: UnshotScheme,
         mesh: &Mesh,
         emission: &[Rgb],
         samples: &[Vec<ShooterSample>],
-        set: SampleSet,
+        sets: &[SampleSet],
     ) -> Self {
         match scheme {
             UnshotScheme::Polygon => UnshotField {
@@ -97,7 +97,8 @@ impl UnshotField {
                     sources: samples
                         .iter()
                         .zip(&mesh.polygons)
-                        .map(|(s, pm)| sample_sources(mesh, pm, s, set))
+                        .zip(sets)
+                        .map(|((s, pm), &set)| sample_sources(mesh, pm, s, set))
                         .collect(),
                 },
             },
@@ -303,7 +304,7 @@ fn sample_sources(
     match set {
         SampleSet::Centre => return vec![SampleSource::PolygonMean; samples.len()],
         SampleSet::Vertices => return pm.vertices.clone().map(SampleSource::Vertex).collect(),
-        SampleSet::AtMost(_) => {}
+        SampleSet::AtMost(_) | SampleSet::Sky(_) => {}
     }
     samples
         .iter()

@@ -1,0 +1,341 @@
+//! The sky (`--sky`) against closed forms: inside a uniform enclosure the
+//! radiance is the same from every direction, so a point receives the
+//! sky's radiosity `S` times its form factor to whatever part of the sky it
+//! sees, which Lambert's formula gives exactly for the polygonal openings
+//! below ([`formfactor::point_to_polygon`]).
+
+use super::formfactor::point_to_polygon;
+use super::*;
+use crate::color::Rgb;
+use crate::mesh::{self, MeshOptions};
+use crate::scene::Polygon;
+use crate::testutil::{closed_box, grey, polygon, scene};
+use glam::Vec3;
+
+/// Solves `s` under `sky` on a mesh of `lenmax` with the default options;
+/// returns the mesh, the radiosity and the steps taken.
+fn solve_under_sky(mut s: Scene, sky: Rgb, lenmax: f32) -> (Scene, Mesh, Vec<Rgb>, u64) {
+    s.add_sky(sky).unwrap();
+    let mesh = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax,
+            inset: mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(&s);
+    let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
+    while !solver.is_done() {
+        if solver.step().is_none() {
+            break;
+        }
+    }
+    solver.validate().unwrap();
+    let (radiosity, steps) = (solver.radiosity().to_vec(), solver.steps());
+    (s, mesh, radiosity, steps)
+}
+
+/// A `w × w` floor at height 0 facing up (`+y`), material 0.
+fn floor(w: f32) -> Polygon {
+    polygon(0, &[[0., 0., 0.], [0., 0., w], [w, 0., w], [w, 0., 0.]])
+}
+
+/// The vertices of polygon `p`: (sample position, radiosity).
+fn vertices_of<'a>(
+    mesh: &'a Mesh,
+    radiosity: &'a [Rgb],
+    p: usize,
+) -> impl Iterator<Item = (Vec3, Rgb)> + 'a {
+    mesh.polygons[p]
+        .vertices
+        .clone()
+        .map(move |l| (mesh.sample_positions[l as usize], radiosity[l as usize]))
+}
+
+#[test]
+fn an_open_floor_under_a_sky_gets_its_reflectance_times_the_sky() {
+    let sky = Rgb::new(1.0, 2.0, 4.0);
+    let s = scene(
+        vec![floor(4.0)],
+        vec![crate::scene::Material {
+            name: "stone".into(),
+            color: Rgb::new(0.8, 0.5, 0.25),
+            k_diffrefl: 1.0,
+            k_emission: 0.0,
+        }],
+    );
+    let (s, mesh, radiosity, _) = solve_under_sky(s, sky, 0.25);
+    let expected = Rgb::new(0.8, 1.0, 1.0);
+    let mut worst = 0.0f64;
+    for (_, b) in vertices_of(&mesh, &radiosity, 0) {
+        for (got, want) in b.to_array().into_iter().zip(expected.to_array()) {
+            worst = worst.max((got / want - 1.0).abs());
+        }
+    }
+    // The full hemisphere of sky, from 640 discrete directions.
+    assert!(worst < 0.01, "worst relative error {worst}");
+    // The sky's own vertices keep their emission; only the floor reflects.
+    assert_eq!(s.sky(), Some(sky));
+    for p in 1..s.polygons.len() {
+        assert!(vertices_of(&mesh, &radiosity, p).all(|(_, b)| b == sky));
+    }
+}
+
+#[test]
+fn a_closed_box_under_a_sky_stays_black_inside() {
+    // A grey box on a ground that the sky lights; the box's walls face
+    // inward, so every ray to them from the sky crosses another wall.
+    let mut polygons = closed_box(2.0, [0; 6]);
+    polygons.push(polygon(
+        1,
+        &[
+            [-4., -0.5, -4.],
+            [-4., -0.5, 6.],
+            [6., -0.5, 6.],
+            [6., -0.5, -4.],
+        ],
+    ));
+    let s = scene(
+        polygons,
+        vec![grey("wall", 0.0, 0.7), grey("ground", 0.0, 0.5)],
+    );
+    let (_, mesh, radiosity, _) = solve_under_sky(s, Rgb::splat(3.0), 0.1);
+    for wall in 0..6 {
+        for (x, b) in vertices_of(&mesh, &radiosity, wall) {
+            assert_eq!(b, Rgb::BLACK, "wall {wall} at {x}");
+        }
+    }
+    // The ground outside is lit (less under the box's shadow).
+    let lit = vertices_of(&mesh, &radiosity, 6)
+        .map(|(_, b)| b.r)
+        .fold(0.0, f64::max);
+    assert!(lit > 1.4 && lit < 1.515, "{lit}");
+}
+
+/// Black walls and a ceiling around a `6 × 6` floor of reflectance 0.5,
+/// 2 units high, with a square hole of side `hole` in the middle of the
+/// ceiling: only the floor reflects, so its radiosity is `0.5 · S · F(x →
+/// hole)` exactly. Returns the scene and the hole's corners.
+fn room_with_skylight(hole: f32) -> (Scene, [Vec3; 4]) {
+    let (w, h) = (6.0f32, 2.0f32);
+    let (a, b) = ((w - hole) / 2.0, (w + hole) / 2.0);
+    // Ceiling pieces face down: listed counter-clockwise seen from below.
+    let ceiling = |x0: f32, x1: f32, z0: f32, z1: f32| {
+        polygon(1, &[[x0, h, z0], [x1, h, z0], [x1, h, z1], [x0, h, z1]])
+    };
+    let mut polygons = vec![
+        floor(w),
+        ceiling(0.0, w, 0.0, a),
+        ceiling(0.0, w, b, w),
+        ceiling(0.0, a, a, b),
+        ceiling(b, w, a, b),
+    ];
+    // Four walls facing in.
+    for wall in [
+        [[0., 0., 0.], [w, 0., 0.], [w, h, 0.], [0., h, 0.]],
+        [[w, 0., w], [0., 0., w], [0., h, w], [w, h, w]],
+        [[0., 0., w], [0., 0., 0.], [0., h, 0.], [0., h, w]],
+        [[w, 0., 0.], [w, 0., w], [w, h, w], [w, h, 0.]],
+    ] {
+        polygons.push(polygon(1, &wall));
+    }
+    let s = scene(
+        polygons,
+        vec![grey("floor", 0.0, 0.5), grey("black", 0.0, 0.0)],
+    );
+    for p in &s.polygons[1..] {
+        let inward = Vec3::new(w / 2.0, h / 2.0, w / 2.0) - p.vertices[0];
+        assert!(p.normal.dot(inward) > 0.0);
+    }
+    let corners = [
+        Vec3::new(a, h, a),
+        Vec3::new(b, h, a),
+        Vec3::new(b, h, b),
+        Vec3::new(a, h, b),
+    ];
+    (s, corners)
+}
+
+/// The `z` of the row of polygon `p`'s vertices nearest to `z`.
+fn row_nearest(mesh: &Mesh, p: usize, z: f32) -> f32 {
+    mesh.polygons[p]
+        .vertices
+        .clone()
+        .map(|l| mesh.sample_positions[l as usize].z)
+        .min_by(|a, b| (a - z).abs().total_cmp(&(b - z).abs()))
+        .unwrap_or(z)
+}
+
+/// Per floor vertex on the row nearest to `z = 3` across the room, sorted by `x`:
+/// (x, solved radiosity, exact radiosity).
+fn skylight_profile(hole: f32, lenmax: f32) -> Vec<(f32, f64, f64)> {
+    let (s, corners) = room_with_skylight(hole);
+    let (_, mesh, radiosity, _) = solve_under_sky(s, Rgb::splat(1.0), lenmax);
+    let z = row_nearest(&mesh, 0, 3.0);
+    let mut line: Vec<(f32, f64, f64)> = vertices_of(&mesh, &radiosity, 0)
+        .filter(|(x, _)| x.z == z)
+        .map(|(x, b)| (x.x, b.r, 0.5 * point_to_polygon(x, Vec3::Y, &corners)))
+        .collect();
+    line.sort_by(|a, b| a.0.total_cmp(&b.0));
+    line
+}
+
+#[test]
+fn sky_light_through_a_skylight_matches_lambert() {
+    let line = skylight_profile(1.0, 0.1);
+    assert!(line.len() > 50);
+    let peak = line.iter().map(|v| v.2).fold(0.0, f64::max);
+    let (mut worst, mut sum, mut exact_sum) = (0.0f64, 0.0, 0.0);
+    for &(_, got, want) in &line {
+        worst = worst.max((got - want).abs() / peak);
+        sum += got;
+        exact_sum += want;
+    }
+    eprintln!(
+        "skylight: worst {worst:.4} of the peak, sum {:.4}",
+        sum / exact_sum
+    );
+    // The light the floor gets along the line, within 1 %; no point off
+    // by more than a few percent of the peak.
+    assert!((sum / exact_sum - 1.0).abs() < 0.01, "{sum} vs {exact_sum}");
+    assert!(worst < 0.04, "worst error {worst} of the peak");
+}
+
+#[test]
+fn sky_light_through_a_skylight_is_smooth() {
+    // The floor under a skylight gets the sum of one sharp image of the
+    // hole per sky direction seen through it; enough directions make the
+    // sum smooth. Roughness: how far a vertex is from the mean of its two
+    // neighbours, relative to the peak, against the exact profile's own.
+    let line = skylight_profile(1.0, 0.05);
+    let peak = line.iter().map(|v| v.2).fold(0.0, f64::max);
+    let rough = |value: fn(&(f32, f64, f64)) -> f64| {
+        line.windows(3)
+            .map(|w| (value(&w[1]) - 0.5 * (value(&w[0]) + value(&w[2]))).abs() / peak)
+            .fold(0.0, f64::max)
+    };
+    let (solved, exact) = (rough(|v| v.1), rough(|v| v.2));
+    eprintln!("roughness: solved {solved:.4}, exact {exact:.4}");
+
+    assert!(solved < 0.02, "roughness {solved} (exact {exact})");
+}
+
+#[test]
+fn an_overhang_shades_the_floor_as_lambert_says() {
+    // A black roof 1 unit above the floor's half x < 2 (of a 4 × 4 floor):
+    // the floor sees the sky except where the roof hides it.
+    let roof = [[-1., 1., -1.], [2., 1., -1.], [2., 1., 5.], [-1., 1., 5.]];
+    let s = scene(
+        vec![floor(4.0), polygon(1, &roof)],
+        vec![grey("floor", 0.0, 0.5), grey("black", 0.0, 0.0)],
+    );
+    let (_, mesh, radiosity, _) = solve_under_sky(s, Rgb::splat(2.0), 0.2);
+    let corners = roof.map(Vec3::from_array);
+    let mut worst = 0.0f64;
+    let mut line: Vec<(f32, f64)> = Vec::new();
+    let z = row_nearest(&mesh, 0, 2.0);
+    for (x, b) in vertices_of(&mesh, &radiosity, 0) {
+        let exact = 0.5 * 2.0 * (1.0 - point_to_polygon(x, Vec3::Y, &corners));
+        worst = worst.max((b.r - exact).abs());
+        if x.z == z {
+            line.push((x.x, b.r));
+        }
+    }
+    assert!(worst < 0.03, "worst error {worst} of 1");
+    // Brighter and brighter from deep under the roof out into the open
+    // (nearer its far edge the floor sees the low sky beyond it again).
+    line.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let outward: Vec<&(f32, f64)> = line.iter().filter(|v| v.0 >= 1.0).collect();
+    assert!(outward.windows(2).all(|w| w[1].1 >= w[0].1), "{line:?}");
+    assert!(
+        line[0].1 < 0.25 && line[line.len() - 1].1 > 0.95,
+        "{line:?}"
+    );
+}
+
+#[test]
+fn a_courtyard_under_a_sky_reflects_before_it_converges() {
+    // Walls that reflect make the floor brighter than black walls do: the
+    // threshold must not stop the solve once the sky has shot (its own
+    // power is thousands of times the scene's).
+    let courtyard = |rho: f64| {
+        let (mut s, _) = room_with_skylight(1.0);
+        s.polygons.drain(1..5);
+        s.materials[1] = grey("walls", 0.0, rho);
+        s
+    };
+    let mean_floor = |s: Scene| {
+        let (_, mesh, radiosity, steps) = solve_under_sky(s, Rgb::splat(1.0), 0.25);
+        let n = mesh.polygons[0].vertex_count() as f64;
+        let sum: f64 = vertices_of(&mesh, &radiosity, 0).map(|(_, b)| b.r).sum();
+        (sum / n, steps)
+    };
+    let (black, black_steps) = mean_floor(courtyard(0.0));
+    let (grey_walls, grey_steps) = mean_floor(courtyard(0.6));
+    // The sky's 80 facets, then the floor; with grey walls, the walls too.
+    assert!(black_steps >= 80 && grey_steps > black_steps + 3);
+    assert!(
+        black < 0.5 && grey_walls > black * 1.05,
+        "{black} {grey_walls}"
+    );
+}
+
+#[test]
+fn the_sky_is_one_element_a_facet_and_is_left_out_of_the_drawn_mesh() {
+    let mut s = scene(vec![floor(2.0)], vec![grey("floor", 0.0, 0.5)]);
+    let bare = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.1,
+            inset: 0.05,
+        },
+    )
+    .unwrap();
+    s.add_sky(Rgb::splat(1.0)).unwrap();
+    let m = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.1,
+            inset: 0.05,
+        },
+    )
+    .unwrap();
+    m.validate().unwrap();
+    for pm in &m.polygons[1..] {
+        assert!(pm.sky);
+        assert_eq!((pm.elements.len(), pm.vertex_count()), (1, 3));
+    }
+    let radiosity: Vec<u32> = (0..m.vertex_count() as u32).collect();
+    let (drawn, kept) = m.without_sky(&radiosity).unwrap();
+    drawn.validate().unwrap();
+    assert_eq!(drawn.positions, bare.positions);
+    assert_eq!(drawn.elements, bare.elements);
+    assert_eq!(drawn.polygons.len(), m.polygons.len());
+    assert_eq!(kept, (0..bare.vertex_count() as u32).collect::<Vec<_>>());
+    assert!(bare.without_sky(&radiosity).is_none());
+}
+
+#[test]
+fn the_checkpoint_fingerprint_covers_the_sky() {
+    let base = scene(vec![floor(2.0)], vec![grey("floor", 0.0, 0.5)]);
+    let fingerprint = |sky: Option<Rgb>| {
+        let mut s = base.clone();
+        if let Some(sky) = sky {
+            s.add_sky(sky).unwrap();
+        }
+        let options = MeshOptions {
+            lenmax: 0.5,
+            inset: mesh::DEFAULT_INSET,
+        };
+        let m = mesh::build(&s, &options).unwrap();
+        checkpoint::fingerprint(&s, &m, &SolverOptions::default())
+    };
+    let (none, one, two) = (
+        fingerprint(None),
+        fingerprint(Some(Rgb::splat(1.0))),
+        fingerprint(Some(Rgb::splat(2.0))),
+    );
+    assert!(none != one && one != two && none != two);
+    assert_eq!(one, fingerprint(Some(Rgb::splat(1.0))));
+}
