@@ -34,6 +34,8 @@ use std::ops::Range;
 
 mod handle;
 pub mod refine;
+pub mod stitch;
+pub mod weld;
 
 pub use handle::MeshRef;
 
@@ -59,7 +61,7 @@ pub const MAX_ADDRESSABLE_ELEMENTS: u64 = u32::MAX as u64 / 4;
 
 /// A vertex counts as lying on a polygon edge when it is closer to the
 /// edge's line than this fraction of the polygon's extent.
-const ON_EDGE_TOLERANCE: f32 = 1e-5;
+pub(crate) const ON_EDGE_TOLERANCE: f32 = 1e-5;
 
 /// Relative tolerance for dropping a vertex of a 5+-gon as collinear with
 /// its neighbours (cross product against the product of edge lengths).
@@ -142,6 +144,10 @@ pub struct PolygonMesh {
     /// [`refine`]); 0 for the regular subdivision of [`build`], whose
     /// vertices are evenly spaced.
     pub levels: u32,
+    /// True when [`stitch`] added vertices to its mesh (or to the mesh it
+    /// was refined from): its vertices are then unevenly spaced along the
+    /// boundary.
+    pub stitched: bool,
 }
 
 impl PolygonMesh {
@@ -405,6 +411,18 @@ pub fn build_with_limit(
     options: &MeshOptions,
     max_elements: u64,
 ) -> Result<Mesh, MeshError> {
+    let mesh = build_unstitched_with_limit(scene, options, max_elements)?;
+    Ok(stitch::stitch(scene, mesh))
+}
+
+/// Each polygon meshed on its own, not [`stitch`]ed: the mesh before its
+/// shared edges are made watertight (what a comparison of the two, or a
+/// tool that wants the bare grids, starts from).
+pub fn build_unstitched_with_limit(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+) -> Result<Mesh, MeshError> {
     let max_elements = max_elements.min(MAX_ADDRESSABLE_ELEMENTS);
     check_options(options)?;
     let plans: Vec<Plan> = scene
@@ -455,6 +473,7 @@ pub fn build_with_limit(
             min_edge,
             inset: options.inset * min_edge,
             levels: 0,
+            stitched: false,
         });
     }
     Ok(mesh)
@@ -846,13 +865,13 @@ impl Mesh {
 
     /// Each of polygon `pm`'s vertices' weight in the polygon's mean
     /// (summing to 1, in vertex order): `1/n` on a regular mesh
-    /// (`levels == 0`), where every vertex stands for the same area as in
+    /// (`levels == 0`, not stitched), where every vertex stands for the same area as in
     /// the original algorithm; its share of the polygon's area
     /// ([`Mesh::vertex_areas`]) on a refined one, where vertices crowd
     /// the refined parts and an even weight would over-count them.
     pub fn polygon_vertex_weights(&self, pm: &PolygonMesh) -> Vec<f64> {
         let n = pm.vertex_count() as usize;
-        if pm.levels == 0 || n == 0 {
+        if (pm.levels == 0 && !pm.stitched) || n == 0 {
             return vec![1.0 / n.max(1) as f64; n];
         }
         let mut areas = vec![0.0; n];

@@ -664,6 +664,7 @@ mod tests {
                 min_edge: 1.0,
                 inset: 0.0,
                 levels: 0,
+                stitched: false,
             });
             self
         }
