@@ -16,8 +16,13 @@
 //!   carry the same vertices.
 //!
 //! Element vertices are shared between neighbouring elements of the same
-//! polygon, never between polygons: each polygon's radiosity is discontinuous
-//! at its boundary, as a diffuse polygon's is across a crease.
+//! polygon, never between polygons: each polygon's radiosity is
+//! discontinuous at its boundary, as a diffuse polygon's is across a crease.
+//! But polygons that share an edge or meet in a T-junction get vertices at
+//! the same positions along it ([`stitch`], run by [`build`] after every
+//! polygon is meshed), so the picture and the exports are watertight; and
+//! the vertices of a smooth surface's facets there show one radiosity
+//! ([`weld`]).
 //!
 //! **Inset.** Vertices on a polygon's boundary are evaluated (not drawn) at a
 //! point moved inward by `inset × h` along the in-plane inward normal of each
@@ -250,9 +255,12 @@ pub struct MeshSize {
     pub vertices: u64,
 }
 
-/// The exact element and vertex counts [`build`] would produce, computed
-/// from the subdivision counts alone (no allocation per element), so that
-/// a driver can refuse a mesh too large for memory before building it.
+/// The exact element and vertex counts of the polygons meshed each on its
+/// own ([`build_unstitched_with_limit`]), computed from the subdivision
+/// counts alone (no allocation per element), so that a driver can refuse a
+/// mesh too large for memory before building it. [`build`]'s stitching
+/// then adds the vertices polygons take from their neighbours' edges and
+/// the elements split to hold them: a few percent more.
 pub fn estimate(scene: &Scene, options: &MeshOptions) -> Result<MeshSize, MeshError> {
     check_options(options)?;
     let mut size = MeshSize {

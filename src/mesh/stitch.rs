@@ -88,7 +88,7 @@ struct BoundaryEdge {
 /// every vertex is [`Origin::Kept`] in place (nothing was inserted).
 pub(crate) fn stitch_with_origins(scene: &Scene, mut mesh: Mesh) -> (Mesh, Option<Vec<Origin>>) {
     let extent = scene.extent();
-    if mesh.polygons.len() < 2 || !(extent > 0.0) {
+    if mesh.polygons.len() < 2 || extent.is_nan() || extent <= 0.0 {
         return (mesh, None);
     }
     let eps = STITCH_TOLERANCE * extent;

@@ -236,13 +236,13 @@ mod tests {
             .map(|v| Rgb::splat(mesh.vertex_polygon[v].0 as f64 + 1.0))
             .collect();
         weld.apply(&mut values);
-        for v in 0..mesh.vertex_count() {
+        for (v, value) in values.iter().enumerate() {
             let expect = if mesh.positions[v].x == 0.0 {
                 1.5
             } else {
                 mesh.vertex_polygon[v].0 as f64 + 1.0
             };
-            assert!((values[v].luminance() - expect).abs() < 1e-5);
+            assert!((value.luminance() - expect).abs() < 1e-5);
         }
     }
 

@@ -21,7 +21,10 @@
 //! glTF material is unlit (`KHR_materials_unlit`) and single-sided, so a
 //! viewer shows the baked light as it is and one can look into a room from
 //! outside through its back faces. Vertices are not shared between
-//! polygons, as in the solver: the radiosity is discontinuous there.
+//! polygons, as in the solver, but neighbours have vertices at the same
+//! positions along their shared edges (the mesh is stitched): the
+//! radiosity is discontinuous there, except across a smooth surface's
+//! facet edges, where the exported solution is welded to one value.
 //!
 //! The glTF file follows the layout rules the Khronos validator checks: the
 //! JSON chunk is padded with spaces and the binary chunk with zeros to
