@@ -27,6 +27,7 @@
 use crate::color::Rgb;
 use crate::config::RunConfig;
 use crate::mesh::refine::{RefineOptions, RefineReport, Refiner, Refused};
+use crate::mesh::weld::Weld;
 use crate::mesh::{Mesh, MeshRef};
 use crate::prepare::Prepared;
 use crate::scene::Scene;
@@ -154,6 +155,9 @@ pub struct Session<'p> {
     /// Counts of the finished passes' solvers.
     finished: Totals,
     pass_start: PassStart,
+    /// The smooth surfaces' welded vertices of the current mesh, applied
+    /// in [`Session::shown`].
+    weld: Weld,
 }
 
 /// Where the current pass began: its clock and the solver's counters
@@ -183,6 +187,7 @@ impl<'p> Session<'p> {
         });
         let solver = Progressive::new(scene, mesh, visibility, options.solver);
         Session {
+            weld: Weld::new(scene, mesh),
             scene,
             visibility,
             options,
@@ -315,6 +320,7 @@ impl<'p> Session<'p> {
             solver.restore(state)?;
         }
         self.solver = solver;
+        self.weld = Weld::new(self.scene, self.solver.mesh());
         self.pass_start = PassStart {
             time: Instant::now(),
             steps: self.solver.steps(),
@@ -417,14 +423,30 @@ impl<'p> Session<'p> {
 
     /// The radiosity to draw, written into `out` (resized to the vertex
     /// count): with the ambient term when [`SessionOptions::ambient`] asks
-    /// for it, else the solution itself.
+    /// for it, else the solution itself; then made continuous across the
+    /// facet edges of smooth surfaces ([`Weld::apply`]). The one place
+    /// the window, the pictures and the mesh exports get their values.
     pub fn shown(&self, out: &mut Vec<Rgb>) {
         if self.options.ambient {
             self.solver.radiosity_with_ambient(out);
+            self.weld.apply(out);
         } else {
-            out.clear();
-            out.extend_from_slice(self.solver.radiosity());
+            self.solution(out);
         }
+    }
+
+    /// The solution without the ambient term, made continuous across the
+    /// facet edges of smooth surfaces like [`Session::shown`]: what a mesh
+    /// export carries.
+    pub fn solution(&self, out: &mut Vec<Rgb>) {
+        out.clear();
+        out.extend_from_slice(self.solver.radiosity());
+        self.weld.apply(out);
+    }
+
+    /// The welded vertices of the current mesh (see [`Session::shown`]).
+    pub fn weld(&self) -> &Weld {
+        &self.weld
     }
 
     /// Unshot power left as a fraction of the emitted power, on the

@@ -993,7 +993,10 @@ fn obj_scene_runs_with_camera_export_log_and_plot() {
     // The light shoots first: polygon 1, its face on line 21 of the OBJ.
     assert_eq!((rows[0][1], rows[0][2]), (1.0, 21.0));
     let last = rows.last().unwrap();
-    assert_eq!(last[4], stats["unshot_fraction"].as_f64().unwrap());
+    // serde_json's default float parser may be one unit in the last
+    // place off the value written (it is not correctly rounded).
+    let unshot = stats["unshot_fraction"].as_f64().unwrap();
+    assert!((last[4] - unshot).abs() <= 4.0 * f64::EPSILON * unshot);
 
     let plot = image::open(dir.path().join("convergence.png"))
         .unwrap()

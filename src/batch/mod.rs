@@ -466,9 +466,11 @@ fn solve<'p>(
     session.validate()?;
     let mut shown = Vec::new();
     session.shown(&mut shown);
+    let mut radiosity = Vec::new();
+    session.solution(&mut radiosity);
     Ok(Solved {
         mesh: session.mesh_ref(),
-        radiosity: session.radiosity().to_vec(),
+        radiosity,
         shown,
         records,
     })

@@ -16,8 +16,13 @@
 //!   carry the same vertices.
 //!
 //! Element vertices are shared between neighbouring elements of the same
-//! polygon, never between polygons: each polygon's radiosity is discontinuous
-//! at its boundary, as a diffuse polygon's is across a crease.
+//! polygon, never between polygons: each polygon's radiosity is
+//! discontinuous at its boundary, as a diffuse polygon's is across a crease.
+//! But polygons that share an edge or meet in a T-junction get vertices at
+//! the same positions along it ([`stitch`], run by [`build`] after every
+//! polygon is meshed), so the picture and the exports are watertight; and
+//! the vertices of a smooth surface's facets there show one radiosity
+//! ([`weld`]).
 //!
 //! **Inset.** Vertices on a polygon's boundary are evaluated (not drawn) at a
 //! point moved inward by `inset × h` along the in-plane inward normal of each
@@ -34,6 +39,8 @@ use std::ops::Range;
 
 mod handle;
 pub mod refine;
+pub mod stitch;
+pub mod weld;
 
 pub use handle::MeshRef;
 
@@ -59,7 +66,7 @@ pub const MAX_ADDRESSABLE_ELEMENTS: u64 = u32::MAX as u64 / 4;
 
 /// A vertex counts as lying on a polygon edge when it is closer to the
 /// edge's line than this fraction of the polygon's extent.
-const ON_EDGE_TOLERANCE: f32 = 1e-5;
+pub(crate) const ON_EDGE_TOLERANCE: f32 = 1e-5;
 
 /// Relative tolerance for dropping a vertex of a 5+-gon as collinear with
 /// its neighbours (cross product against the product of edge lengths).
@@ -154,6 +161,10 @@ pub struct PolygonMesh {
     /// the lenmax, never refined, drawn or exported (see
     /// [`Mesh::without_sky`]).
     pub sky: bool,
+    /// True when [`stitch`] added vertices to its mesh (or to the mesh it
+    /// was refined from): its vertices are then unevenly spaced along the
+    /// boundary.
+    pub stitched: bool,
 }
 
 impl PolygonMesh {
@@ -256,9 +267,12 @@ pub struct MeshSize {
     pub vertices: u64,
 }
 
-/// The exact element and vertex counts [`build`] would produce, computed
-/// from the subdivision counts alone (no allocation per element), so that
-/// a driver can refuse a mesh too large for memory before building it.
+/// The exact element and vertex counts of the polygons meshed each on its
+/// own ([`build_unstitched_with_limit`]), computed from the subdivision
+/// counts alone (no allocation per element), so that a driver can refuse a
+/// mesh too large for memory before building it. [`build`]'s stitching
+/// then adds the vertices polygons take from their neighbours' edges and
+/// the elements split to hold them: a few percent more.
 pub fn estimate(scene: &Scene, options: &MeshOptions) -> Result<MeshSize, MeshError> {
     check_options(options)?;
     let mut size = MeshSize {
@@ -417,6 +431,18 @@ pub fn build_with_limit(
     options: &MeshOptions,
     max_elements: u64,
 ) -> Result<Mesh, MeshError> {
+    let mesh = build_unstitched_with_limit(scene, options, max_elements)?;
+    Ok(stitch::stitch(scene, mesh))
+}
+
+/// Each polygon meshed on its own, not [`stitch`]ed: the mesh before its
+/// shared edges are made watertight (what a comparison of the two, or a
+/// tool that wants the bare grids, starts from).
+pub fn build_unstitched_with_limit(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+) -> Result<Mesh, MeshError> {
     let max_elements = max_elements.min(MAX_ADDRESSABLE_ELEMENTS);
     check_options(options)?;
     let plans: Vec<Plan> = scene
@@ -471,6 +497,7 @@ pub fn build_with_limit(
             layer: layers[index],
             has_back: polygon.surface.back.is_some(),
             sky: polygon.surface.sky,
+            stitched: false,
         });
     }
     Ok(mesh)
@@ -869,13 +896,13 @@ impl Mesh {
 
     /// Each of polygon `pm`'s vertices' weight in the polygon's mean
     /// (summing to 1, in vertex order): `1/n` on a regular mesh
-    /// (`levels == 0`), where every vertex stands for the same area as in
+    /// (`levels == 0`, not stitched), where every vertex stands for the same area as in
     /// the original algorithm; its share of the polygon's area
     /// ([`Mesh::vertex_areas`]) on a refined one, where vertices crowd
     /// the refined parts and an even weight would over-count them.
     pub fn polygon_vertex_weights(&self, pm: &PolygonMesh) -> Vec<f64> {
         let n = pm.vertex_count() as usize;
-        if pm.levels == 0 || n == 0 {
+        if (pm.levels == 0 && !pm.stitched) || n == 0 {
             return vec![1.0 / n.max(1) as f64; n];
         }
         let mut areas = vec![0.0; n];

@@ -24,11 +24,16 @@
 //!    T-vertex seam: every vertex's radiosity is computed, and every triangle
 //!    that touches the vertex interpolates it.
 //!
+//! Each emitted mesh is then stitched ([`super::stitch`]): a refined
+//! boundary edge gets its neighbours' vertices, and the neighbours get its
+//! new midpoints, so the refined mesh stays watertight.
+//!
 //! New vertices are the midpoints of their straight edges (and the centre of
 //! a quadrilateral is the mean of its corners, which is the bilinear patch's
 //! centre), so they lie exactly on the polygon. A new vertex on the polygon's
 //! boundary gets the same inset as the polygon's other boundary vertices.
 
+use super::stitch::Origin;
 use super::{inset_positions, Element, Mesh, PolygonMesh, VertexId};
 use crate::scene::{PolygonId, Scene};
 use glam::Vec3;
@@ -180,6 +185,14 @@ pub struct Refiner {
     passes: u32,
     /// The last pass, if it was refused for [`RefineOptions::max_elements`].
     refused: Option<Refused>,
+    /// True for the pool vertices stitching added to an emitted mesh
+    /// ([`super::stitch`]): they are no leaf's corner, and each emitted
+    /// mesh is stitched afresh, so [`Refiner::emit`] leaves them out.
+    stitch_only: Vec<bool>,
+    /// The pool id of each stitched vertex by polygon and exact position,
+    /// so that a vertex stitched again in a later pass keeps its id (and
+    /// its solved radiosity).
+    stitch_ids: HashMap<(u32, [u32; 3]), u32>,
 }
 
 fn edge_key(a: u32, b: u32) -> (u32, u32) {
@@ -218,6 +231,8 @@ impl Refiner {
             parents: vec![None; mesh.vertex_count()],
             passes: 0,
             refused: None,
+            stitch_only: vec![false; mesh.vertex_count()],
+            stitch_ids: HashMap::new(),
         }
     }
 
@@ -346,6 +361,7 @@ impl Refiner {
             p.levels = p.levels.max(leaf.level as u32);
         }
         let (mesh, fans) = self.emit(scene);
+        let mesh = self.stitch(scene, mesh);
         report.leaves = self.leaves.len();
         report.fans = fans;
         Some((mesh, report))
@@ -423,7 +439,48 @@ impl Refiner {
         self.positions.push(p);
         self.vertex_polygon.push(polygon);
         self.parents.push(Some(parents));
+        self.stitch_only.push(false);
         (self.positions.len() - 1) as u32
+    }
+
+    /// Stitches an emitted mesh ([`super::stitch`]) so that refined edges
+    /// meet their neighbours' vertices, and numbers the stitched vertices
+    /// in the pool: the same polygon and position keep their pool id from
+    /// pass to pass.
+    fn stitch(&mut self, scene: &Scene, mesh: Mesh) -> Mesh {
+        let (stitched, origins) = super::stitch::stitch_with_origins(scene, mesh);
+        let Some(origins) = origins else {
+            return stitched;
+        };
+        let emitted = std::mem::take(&mut self.mesh_to_pool);
+        self.mesh_to_pool = Vec::with_capacity(origins.len());
+        for (v, origin) in origins.iter().enumerate() {
+            let pool = match *origin {
+                Origin::Kept(i) => emitted[i as usize],
+                Origin::New([a, b]) => {
+                    let polygon = stitched.vertex_polygon[v];
+                    let key = (
+                        polygon.0,
+                        stitched.positions[v].to_array().map(f32::to_bits),
+                    );
+                    match self.stitch_ids.get(&key) {
+                        Some(&id) => id,
+                        None => {
+                            let id = self.vertex(
+                                stitched.positions[v],
+                                polygon,
+                                [emitted[a as usize], emitted[b as usize]],
+                            );
+                            self.stitch_only[id as usize] = true;
+                            self.stitch_ids.insert(key, id);
+                            id
+                        }
+                    }
+                }
+            };
+            self.mesh_to_pool.push(pool);
+        }
+        stitched
     }
 
     /// Splits leaf `k` into four; the first child takes its place.
@@ -523,7 +580,9 @@ impl Refiner {
         let polygon_count = self.polygons.len();
         let mut vertices_of: Vec<Vec<u32>> = vec![Vec::new(); polygon_count];
         for (v, p) in self.vertex_polygon.iter().enumerate() {
-            vertices_of[p.index()].push(v as u32);
+            if !self.stitch_only[v] {
+                vertices_of[p.index()].push(v as u32);
+            }
         }
         let mut leaves_of: Vec<Vec<usize>> = vec![Vec::new(); polygon_count];
         for (k, leaf) in self.leaves.iter().enumerate() {

@@ -18,8 +18,11 @@
 //! | faces | triangles (quads split along their `0–2` diagonal, as drawn), `UNSIGNED_INT` indices | elements as they are: triangles and quads, `list uchar uint vertex_indices` |
 //!
 //! Faces are counter-clockwise seen from the front, as in the scene.
-//! Vertices are not shared between polygons, as in the solver: the
-//! radiosity is discontinuous there.
+//! Vertices are not shared between polygons, as in the solver, but
+//! neighbours have vertices at the same positions along their shared edges
+//! (the mesh is stitched): the radiosity is discontinuous there, except
+//! across a smooth surface's facet edges, where the exported solution is
+//! welded to one value.
 //!
 //! **The model's structure (glTF).** The `.glb` keeps what the scene file
 //! named, so a model re-imported into Blender comes back as the objects

@@ -697,6 +697,7 @@ mod tests {
                 layer: 0,
                 has_back: false,
                 sky: false,
+                stitched: false,
             });
             self
         }

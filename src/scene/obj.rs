@@ -55,7 +55,19 @@
 //! Object (`o`) and group (`g`) names are recorded in [`Scene::groups`],
 //! for `--emit` and the warning when nothing emits.
 //!
-//! What is ignored: texture coordinates, normals, smoothing groups, lines
+//! **Smooth surfaces** ([`super::Surface::smooth`]): faces in one smoothing
+//! group (`s N`, `N` neither `0` nor `off`, counted within one `o` object
+//! so that two objects never join) form one smooth surface, and so do
+//! faces that share a corner with the same position and the same normal
+//! index (`f a//n`: Blender writes a shared `vn` for the faces of a mesh
+//! shaded smooth and a `vn` of its own for each flat face), joined
+//! transitively. A face with neither is faceted. The normals' directions
+//! are not used: shading follows the geometric normals, and the picture
+//! is made continuous across a smooth surface's facet edges (see
+//! `mesh::weld`). A face split into triangles gives each its
+//! surface.
+//!
+//! What is ignored: texture coordinates, the directions of normals, lines
 //! (`l`) and points (`p`), `Ka`, `Ns`, other maps,
 //! and what makes a material specular, a mirror, glass or metal: non-black
 //! `Ks` above [`DIFFUSE_SHEEN_LIMIT`] (Blender's default 0.5 is not), `illum` 3 to 9, `d`
@@ -88,7 +100,7 @@ use super::emit::GroupScan;
 use super::error::{cannot_read, fmt_num, negative_channel, FILE_START, MAX_DIAGNOSTICS};
 use super::{
     CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
-    SourcePos, Warning,
+    SmoothId, SourcePos, Warning,
 };
 use crate::color::Rgb;
 use glam::{DVec2, DVec3, Vec3};
@@ -170,7 +182,8 @@ pub type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
 /// folder of the library's name. The camera frames the model.
 pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let scan = scan_obj(text, file);
+    let mut scan = scan_obj(text, file);
+    smooth_surfaces(&mut scan.faces);
     let mut diags = scan.diags.clone();
     if diags.len() >= MAX_DIAGNOSTICS {
         return Err(LoadError::from_diagnostics(diags));
@@ -406,7 +419,10 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
                 })
                 .collect();
             match face_polygons(material, vertices, face.pos) {
-                Ok(ps) => {
+                Ok(mut ps) => {
+                    for p in &mut ps {
+                        p.surface.smooth = face.smooth.map(SmoothId);
+                    }
                     let first = polygons.len();
                     polygons.extend(ps);
                     scan.names
@@ -625,6 +641,14 @@ struct FaceLine {
     is_line: bool,
     /// Its objects and groups, for [`GroupScan::assign`].
     names: u32,
+    /// The smoothing group it is in, `(object, s number)`: the object
+    /// counts `o` statements, so two objects never share one.
+    smoothing: Option<(u32, u64)>,
+    /// Its corners that name a normal: `(position, normal)`, both
+    /// 1-based file indices (negative ones resolved).
+    normals: Vec<(u64, u64)>,
+    /// Its smooth surface, from [`smooth_surfaces`].
+    smooth: Option<u32>,
 }
 
 struct Named {
@@ -689,6 +713,8 @@ fn scan_obj(text: &str, file: &str) -> Scan {
         }
     }
     let mut seen = [0usize; 3];
+    let mut object = 0u32;
+    let mut smoothing: Option<u64> = None;
     for (number, line) in lines(text) {
         if scan.diags.len() >= MAX_DIAGNOSTICS {
             break;
@@ -748,10 +774,21 @@ fn scan_obj(text: &str, file: &str) -> Scan {
                     }
                 }
                 if ok && count >= 3 {
+                    let normals = if is_line {
+                        Vec::new()
+                    } else {
+                        w[1..]
+                            .iter()
+                            .filter_map(|&(word, _)| corner_normal(word, &seen))
+                            .collect()
+                    };
                     scan.faces.push(FaceLine {
                         pos: at(col),
                         is_line,
                         names: scan.names.current(),
+                        smoothing: smoothing.map(|s| (object, s)),
+                        normals,
+                        smooth: None,
                     });
                 }
             }
@@ -767,9 +804,27 @@ fn scan_obj(text: &str, file: &str) -> Scan {
                     });
                 }
             }
-            "o" | "g" => scan
-                .names
-                .statement(keyword, &line.trim_start()[keyword.len()..]),
+            "o" | "g" => {
+                if keyword == "o" {
+                    object += 1;
+                }
+                scan.names
+                    .statement(keyword, &line.trim_start()[keyword.len()..])
+            }
+            // `s off` and `s 0` end smoothing; any other number (or
+            // name) starts or continues that group.
+            "s" => {
+                smoothing = match w.get(1).map(|x| x.0) {
+                    None | Some("off") | Some("0") => None,
+                    Some(word) => Some(word.parse::<u64>().unwrap_or_else(|_| {
+                        // A non-numeric group name: a stable number for it.
+                        use std::hash::{Hash, Hasher};
+                        let mut h = std::collections::hash_map::DefaultHasher::new();
+                        word.hash(&mut h);
+                        h.finish()
+                    })),
+                }
+            }
             "mtllib" => {
                 if line.split_once(' ').map_or("", |x| x.1.trim()).is_empty() {
                     error(col, "`mtllib` needs a file name".into());
@@ -784,6 +839,75 @@ fn scan_obj(text: &str, file: &str) -> Scan {
         }
     }
     scan
+}
+
+/// The `(position, normal)` file indices (1-based, negative ones resolved
+/// against `seen`) of a checked face corner `v//vn` or `v/vt/vn`; `None`
+/// for a corner without a normal.
+fn corner_normal(word: &str, seen: &[usize; 3]) -> Option<(u64, u64)> {
+    let mut parts = word.split('/');
+    let v = parts.next()?;
+    let n = parts.nth(1)?;
+    let resolve = |part: &str, kind: usize| -> Option<u64> {
+        let i = part.parse::<i64>().ok()?;
+        if i > 0 {
+            Some(i as u64)
+        } else {
+            (seen[kind] as u64 + 1).checked_sub(i.unsigned_abs())
+        }
+    };
+    Some((resolve(v, 0)?, resolve(n, 2)?))
+}
+
+/// Gives each face its smooth surface (union-find over faces): faces of
+/// one smoothing group (`s N` within one `o` object) are one surface, and
+/// so are faces with a corner of the same position and the same normal
+/// (`f a//n`; Blender writes one shared `vn` per vertex of a face shaded
+/// smooth, and its own `vn` per flat face). A face with neither stays
+/// faceted (`None`). Surfaces are numbered from 0 in order of their first
+/// face.
+fn smooth_surfaces(faces: &mut [FaceLine]) {
+    let n = faces.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    let mut joined = vec![false; n];
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut union = |parent: &mut Vec<usize>, a: usize, b: usize| {
+        joined[a] = true;
+        joined[b] = true;
+        let (ra, rb) = (find(parent, a), find(parent, b));
+        parent[ra.max(rb)] = ra.min(rb);
+    };
+    let mut first_in_group: HashMap<(u32, u64), usize> = HashMap::new();
+    let mut first_with_corner: HashMap<(u64, u64), usize> = HashMap::new();
+    for (i, face) in faces.iter().enumerate() {
+        if face.is_line {
+            continue;
+        }
+        if let Some(g) = face.smoothing {
+            let first = *first_in_group.entry(g).or_insert(i);
+            union(&mut parent, first, i);
+        }
+        for &corner in &face.normals {
+            let first = *first_with_corner.entry(corner).or_insert(i);
+            if first != i {
+                union(&mut parent, first, i);
+            }
+        }
+    }
+    let mut ids: HashMap<usize, u32> = HashMap::new();
+    for i in 0..n {
+        if joined[i] {
+            let r = find(&mut parent, i);
+            let next = ids.len() as u32;
+            faces[i].smooth = Some(*ids.entry(r).or_insert(next));
+        }
+    }
 }
 
 /// Checks one face corner `v`, `v/vt`, `v//vn` or `v/vt/vn` against the
@@ -1781,6 +1905,38 @@ Kd 0.25
                 ":3:1: warning: 1 `map_Kd` path(s) written with `\\` (first `tex\\wall.png`), read with `/`"
             ),
             "{w:?}"
+        );
+    }
+
+    #[test]
+    fn smoothing_groups_and_shared_normals_make_smooth_surfaces() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\n\
+                   vn 0 0 1\nvn 0 0 1\nvn 0 1 0\n\
+                   o A\ns 1\nf 1 2 3\nf 1 3 4\n\
+                   o B\ns 1\nf 1 2 6\ns off\n\
+                   f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 1//3 2//3 6//3\n\
+                   f 1//2 2//2 5//2\ns 0\nf 1 2 5\n";
+        let s = parse(obj).unwrap();
+        let ids: Vec<Option<u32>> = s
+            .polygons
+            .iter()
+            .map(|p| p.surface.smooth.map(|i| i.0))
+            .collect();
+        // `s 1` in A, `s 1` in B (another object: another surface), two
+        // faces sharing `1//1` and `3//1`, then a face whose normals
+        // nobody shares, one with a normal of its own, one with none.
+        assert_eq!(
+            ids,
+            [
+                Some(0),
+                Some(0),
+                Some(1),
+                Some(2),
+                Some(2),
+                None,
+                None,
+                None
+            ]
         );
     }
 }
