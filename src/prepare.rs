@@ -92,6 +92,11 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
+    // Solids keep their outside only. Found before the cuts, which leave
+    // T-junctions on a box sunk into a floor; the pieces keep the mark.
+    if let Some(warning) = scene.orient_solids(config.sides, &config.scene.display_name()) {
+        scene.warnings.push(warning);
+    }
     // Not a quirk of the file, so no warning: geometry passing through
     // geometry is how models are built. Before the back copies, so that
     // each piece gets its own.

@@ -37,6 +37,7 @@ use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 use std::ops::Range;
 
+pub mod covered;
 mod handle;
 pub mod refine;
 pub mod stitch;

@@ -160,16 +160,10 @@ fn convex_overlap(a: &[DVec2], b: &[DVec2], tolerance: f64) -> bool {
     !separated_along(a) && !separated_along(b)
 }
 
-/// The draw layer of every polygon (see the module docs): 0 for a polygon
-/// that overlaps no earlier coplanar polygon facing its way; otherwise one
-/// more than the highest layer among the coplanar polygons it covers,
-/// capped at [`MAX_DRAW_LAYER`]. "Covers": it overlaps them and comes later
-/// in the scene, or it emits and they do not.
-///
-/// `classes` is [`plane_classes`] of the same scene.
-pub fn draw_layers(scene: &Scene, classes: &[u32]) -> Vec<u8> {
-    let n = scene.polygons.len();
-    let mut layers = vec![0u8; n];
+/// The plane classes of two or more polygons, each as its polygons' scene
+/// indices in the order they are laid down: non-emitters first, then
+/// emitters, each in scene order. Classes in a fixed order.
+fn class_members(scene: &Scene, classes: &[u32]) -> Vec<Vec<usize>> {
     let mut by_class: HashMap<u32, Vec<usize>> = HashMap::new();
     for (i, &c) in classes.iter().enumerate() {
         by_class.entry(c).or_default().push(i);
@@ -181,52 +175,73 @@ pub fn draw_layers(scene: &Scene, classes: &[u32]) -> Vec<u8> {
             .max_channel()
             > 0.0
     };
-    let mut members: Vec<Vec<usize>> = by_class.into_values().filter(|m| m.len() > 1).collect();
-    members.sort_unstable();
-    for mut members in members {
-        // The order in which polygons are laid down: non-emitters first,
-        // then emitters, each in file order.
+    let mut all: Vec<Vec<usize>> = by_class.into_values().filter(|m| m.len() > 1).collect();
+    all.sort_unstable();
+    for members in &mut all {
         members.sort_by_key(|&i| (emits(i), i));
-        let normal = canonical_plane(&scene.polygons[members[0]]).0;
-        let flat: Vec<Vec<DVec2>> = members
-            .iter()
-            .map(|&i| in_plane(&scene.polygons[i], normal))
-            .collect();
-        // Bounding boxes in the plane, for a sweep along the first axis.
-        let boxes: Vec<(DVec2, DVec2)> = flat
-            .iter()
-            .map(|q| {
-                q.iter()
-                    .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), x| {
-                        (lo.min(*x), hi.max(*x))
-                    })
-            })
-            .collect();
-        let mut order: Vec<usize> = (0..members.len()).collect();
-        order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
-        // Pairs whose boxes overlap, found by the sweep.
-        let mut below: Vec<Vec<usize>> = vec![Vec::new(); members.len()];
-        for (k, &a) in order.iter().enumerate() {
-            for &b in &order[k + 1..] {
-                if boxes[b].0.x >= boxes[a].1.x {
-                    break;
-                }
-                let (pa, pb) = (&scene.polygons[members[a]], &scene.polygons[members[b]]);
-                let same_facing = pa.normal.dot(pb.normal) > 0.0;
-                let size = (boxes[a].1 - boxes[a].0)
-                    .max_element()
-                    .min((boxes[b].1 - boxes[b].0).max_element());
-                let boxes_meet = boxes[a].0.y < boxes[b].1.y && boxes[b].0.y < boxes[a].1.y;
-                if same_facing
-                    && boxes_meet
-                    && convex_overlap(&flat[a], &flat[b], OVERLAP_TOLERANCE * size)
-                {
-                    // The one laid down later covers the other.
-                    let (lower, upper) = if a < b { (a, b) } else { (b, a) };
-                    below[upper].push(lower);
-                }
+    }
+    all
+}
+
+/// For polygons of one plane class, `members` (scene indices, at least
+/// two) in the order they are laid down: for each, the positions in
+/// `members` of the earlier ones it overlaps facing the same way, which
+/// it covers.
+fn laid_over(scene: &Scene, members: &[usize]) -> Vec<Vec<usize>> {
+    let normal = canonical_plane(&scene.polygons[members[0]]).0;
+    let flat: Vec<Vec<DVec2>> = members
+        .iter()
+        .map(|&i| in_plane(&scene.polygons[i], normal))
+        .collect();
+    // Bounding boxes in the plane, for a sweep along the first axis.
+    let boxes: Vec<(DVec2, DVec2)> = flat
+        .iter()
+        .map(|q| {
+            q.iter()
+                .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(*x), hi.max(*x))
+                })
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..members.len()).collect();
+    order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
+    // Pairs whose boxes overlap, found by the sweep.
+    let mut below: Vec<Vec<usize>> = vec![Vec::new(); members.len()];
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            if boxes[b].0.x >= boxes[a].1.x {
+                break;
+            }
+            let (pa, pb) = (&scene.polygons[members[a]], &scene.polygons[members[b]]);
+            let same_facing = pa.normal.dot(pb.normal) > 0.0;
+            let size = (boxes[a].1 - boxes[a].0)
+                .max_element()
+                .min((boxes[b].1 - boxes[b].0).max_element());
+            let boxes_meet = boxes[a].0.y < boxes[b].1.y && boxes[b].0.y < boxes[a].1.y;
+            if same_facing
+                && boxes_meet
+                && convex_overlap(&flat[a], &flat[b], OVERLAP_TOLERANCE * size)
+            {
+                // The one laid down later covers the other.
+                let (lower, upper) = if a < b { (a, b) } else { (b, a) };
+                below[upper].push(lower);
             }
         }
+    }
+    below
+}
+
+/// The draw layer of every polygon (see the module docs): 0 for a polygon
+/// that overlaps no earlier coplanar polygon facing its way; otherwise one
+/// more than the highest layer among the coplanar polygons it covers,
+/// capped at [`MAX_DRAW_LAYER`]. "Covers": it overlaps them and comes later
+/// in the scene, or it emits and they do not.
+///
+/// `classes` is [`plane_classes`] of the same scene.
+pub fn draw_layers(scene: &Scene, classes: &[u32]) -> Vec<u8> {
+    let mut layers = vec![0u8; scene.polygons.len()];
+    for members in class_members(scene, classes) {
+        let below = laid_over(scene, &members);
         for k in 0..members.len() {
             let top = below[k]
                 .iter()
@@ -237,6 +252,29 @@ pub fn draw_layers(scene: &Scene, classes: &[u32]) -> Vec<u8> {
         }
     }
     layers
+}
+
+/// For every polygon, the coplanar polygons laid over it (see
+/// [`draw_layers`]): they overlap it, face its way, and come later in the
+/// scene or emit where it does not. Where they cover it, it is hidden: it
+/// still shows a radiosity under them, but a receiver there would count
+/// the light they intercept a second time (a rug and the floor under it,
+/// the inside of a box and the floor it stands on, both catching the same
+/// light), so the solver leaves the covered part out of its unshot power
+/// (see `mesh::covered_vertices`).
+///
+/// `classes` is [`plane_classes`] of the same scene.
+pub fn covered_by(scene: &Scene, classes: &[u32]) -> Vec<Vec<u32>> {
+    let mut over = vec![Vec::new(); scene.polygons.len()];
+    for members in class_members(scene, classes) {
+        let below = laid_over(scene, &members);
+        for (upper, lowers) in below.iter().enumerate() {
+            for &lower in lowers {
+                over[members[lower]].push(members[upper] as u32);
+            }
+        }
+    }
+    over
 }
 
 #[cfg(test)]

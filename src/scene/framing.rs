@@ -20,8 +20,16 @@
 //! so does an open box (a Cornell box), whose opening takes about a sixth
 //! of the rays from its middle.
 //!
-//! - An **object** gets [`Camera::frame`] of its bounds, unchanged (from
-//!   the −z side, looking along +z).
+//! - An **open box** is an object whose middle sees no back face, front
+//!   faces in at least [`OPEN_BOX_MIN_FRONT_FRACTION`] of the rays, and
+//!   the rest leave through one side: the mean direction of the rays that
+//!   leave lies within 60° ([`OPEN_SIDE_MIN_ALIGNMENT`]) of a horizontal
+//!   axis (±x, ±z). The camera stands on that side, as far as
+//!   [`Camera::frame`] would, and looks in: a Cornell box exported open
+//!   towards +z (McGuire's) is looked into, not at its closed back.
+//! - Any other **object** gets [`Camera::frame`] of its bounds, unchanged
+//!   (from the −z side, looking along +z); so does an open box whose
+//!   opening faces −z, the bundled Cornell box's.
 //! - A **room** gets an eye inside. The candidates, in order of preference,
 //!   stand [`EYE_ALONG_FRACTIONS`] of the way along the longest horizontal
 //!   axis (x or z; z when they tie), at [`EYE_HEIGHT_FRACTIONS`] of the
@@ -55,6 +63,18 @@ pub const FRAMING_RAYS: usize = 64;
 /// Cornell box, which is meant to be looked into from outside) sees about a
 /// sixth of the rays leave and stays an object.
 pub const ROOM_MIN_FRONT_FRACTION: f64 = 0.9;
+
+/// The fraction of [`FRAMING_RAYS`] from the middle of an object that must
+/// hit a front face (and none a back face) for it to be an open box
+/// (dimensionless): a box missing one side sends about five sixths of its
+/// rays to its inside, an object seen from outside sends none there.
+pub const OPEN_BOX_MIN_FRONT_FRACTION: f64 = 0.5;
+
+/// The least cosine between the mean direction of the rays that leave an
+/// open box and the horizontal axis chosen as its open side
+/// (dimensionless, 0.5 = 60°): below it the opening is up, down or spread
+/// round, and the box is framed as any object.
+pub const OPEN_SIDE_MIN_ALIGNMENT: f64 = 0.5;
 
 /// Vertical field of view of a camera inside a room, in degrees: wider
 /// than [`crate::camera::DEFAULT_FOV_DEG`] so that a room seen from near
@@ -110,7 +130,63 @@ const RAY_ORDER_STRIDE: usize = 29;
 /// always a valid camera (it passes [`Camera::check`]).
 pub fn frame_camera(polygons: &[Polygon]) -> Camera {
     let (lo, hi) = polygon_bounds(polygons);
-    room_camera(polygons, lo, hi).unwrap_or_else(|| Camera::frame(lo, hi))
+    room_camera(polygons, lo, hi)
+        .or_else(|| open_box_camera(polygons, lo, hi))
+        .unwrap_or_else(|| Camera::frame(lo, hi))
+}
+
+/// The horizontal axis (a unit ±x or ±z) through which the middle of an
+/// open box sees out, or `None` when the polygons are no open box (see the
+/// module's rule).
+fn open_side(polygons: &[Polygon], lo: Vec3, hi: Vec3) -> Option<DVec3> {
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let size = hi - lo;
+    if !(size.min_element() > 0.0 && size.is_finite()) {
+        return None;
+    }
+    let edge_tol = RAY_EDGE_TOLERANCE * size.length();
+    let centre = 0.5 * (lo + hi);
+    let mut front = 0usize;
+    let mut out = DVec3::ZERO;
+    for d in directions() {
+        match nearest_hit(polygons, centre, d, edge_tol) {
+            Some(hit) if hit.front => front += 1,
+            // Inside something, or looking at an object's inside.
+            Some(_) => return None,
+            None => out += d,
+        }
+    }
+    if (front as f64) < OPEN_BOX_MIN_FRONT_FRACTION * FRAMING_RAYS as f64 {
+        return None;
+    }
+    let mean = out.try_normalize()?;
+    let axis = if mean.x.abs() > mean.z.abs() {
+        DVec3::X * mean.x.signum()
+    } else {
+        DVec3::Z * mean.z.signum()
+    };
+    (axis.dot(mean) >= OPEN_SIDE_MIN_ALIGNMENT).then_some(axis)
+}
+
+/// The camera outside an open box's open side, looking in, or `None` when
+/// it is no open box or its opening faces −z (then [`Camera::frame`] is
+/// that camera already, bit for bit).
+fn open_box_camera(polygons: &[Polygon], lo: Vec3, hi: Vec3) -> Option<Camera> {
+    let side = open_side(polygons, lo, hi)?;
+    if side == DVec3::NEG_Z {
+        return None;
+    }
+    // As Camera::frame, turned to the open side.
+    let framed = Camera::frame(lo, hi);
+    let centre = framed.lookat.as_dvec3();
+    let radius = 0.5 * (hi - lo).as_dvec3().length();
+    let distance = (radius / (0.5 * f64::from(framed.fov_y)).sin())
+        .max(centre.dot(side).abs() * crate::camera::FRAME_MIN_RELATIVE_DISTANCE);
+    let camera = Camera {
+        eye: (centre + side * distance).as_vec3(),
+        ..framed
+    };
+    camera.check().ok().map(|_| camera)
 }
 
 /// What the rays from one point first hit.
@@ -420,6 +496,49 @@ mod tests {
         assert_eq!(frame_camera(&square), Camera::frame(lo, hi));
         // Nothing at all.
         assert_eq!(frame_camera(&[]), Camera::frame(Vec3::ZERO, Vec3::ZERO));
+    }
+
+    #[test]
+    fn an_open_box_is_looked_into_through_its_open_side() {
+        let lo = Vec3::new(-1.0, 0.0, -1.0);
+        let hi = Vec3::new(1.0, 2.0, 1.0);
+        for (open_side, normal_away) in [
+            (DVec3::Z, Vec3::Z),
+            (DVec3::NEG_Z, Vec3::NEG_Z),
+            (DVec3::X, Vec3::X),
+            (DVec3::NEG_X, Vec3::NEG_X),
+        ] {
+            // Inward walls; the wall on the open side (its inward normal
+            // points away from that side) is left out.
+            let mut walls = cuboid(lo.into(), hi.into(), true);
+            walls.retain(|p| p.normal.dot(normal_away) > -0.5);
+            assert_eq!(walls.len(), 5);
+            let camera = frame_camera(&walls);
+            let framed = Camera::frame(lo, hi);
+            if open_side == DVec3::NEG_Z {
+                assert_eq!(camera, framed, "the old framing, bit for bit");
+                continue;
+            }
+            let eye = camera.eye.as_dvec3();
+            let centre = 0.5 * (lo + hi).as_dvec3();
+            assert_eq!(camera.lookat, framed.lookat);
+            assert_eq!(camera.fov_y, framed.fov_y);
+            let off = eye - centre;
+            // As far away as the default framing, on the open side.
+            let default_distance = (framed.eye - framed.lookat).length() as f64;
+            assert!((off.length() / default_distance - 1.0).abs() < 1e-6);
+            assert!(
+                off.normalize().dot(open_side) > 1.0 - 1e-9,
+                "{open_side}: {off}"
+            );
+            // Looking in, the eye sees the inside of the far wall: a front face.
+            let hit = nearest_hit(&walls, eye, -off.normalize(), RAY_EDGE_TOLERANCE);
+            assert!(hit.is_some_and(|h| h.front), "{open_side}: {hit:?}");
+        }
+        // Open upwards: no horizontal side, the default framing.
+        let mut tray = cuboid(lo.into(), hi.into(), true);
+        tray.retain(|p| p.normal.y > -0.5);
+        assert_eq!(frame_camera(&tray), Camera::frame(lo, hi));
     }
 
     #[test]

@@ -17,10 +17,12 @@ mod polygon;
 mod sc;
 mod sides;
 mod sky;
+mod solids;
 mod split;
 
 pub use coplanar::{
-    draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE, PLANE_OFFSET_TOLERANCE,
+    covered_by, draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE,
+    PLANE_OFFSET_TOLERANCE,
 };
 pub use emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
@@ -166,6 +168,10 @@ pub struct Surface {
     /// as one element, and is left out of the scene's bounds, the picture,
     /// the exports and adaptive refinement.
     pub sky: bool,
+    /// A face of a closed solid with nothing inside
+    /// ([`Scene::orient_solids`]): facing out, and one-sided whatever
+    /// [`Surface::two_sided`] says, as its inside is never seen.
+    pub solid: bool,
 }
 
 /// Whether the camera came from the file or was made to frame the scene.

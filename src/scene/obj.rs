@@ -188,6 +188,13 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
     if diags.len() >= MAX_DIAGNOSTICS {
         return Err(LoadError::from_diagnostics(diags));
     }
+    let repaired;
+    let text = if scan.repairs.is_empty() || !diags.is_empty() {
+        text
+    } else {
+        repaired = repaired_text(text, &scan.repairs);
+        repaired.as_str()
+    };
 
     // tobj reads the text through a reader that remembers how far it got,
     // so an error it reports can be placed on its line.
@@ -266,6 +273,30 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
         warnings.append(&mut lib.warnings);
     }
     warnings.extend(obj_warnings.into_inner());
+    for (tally, what, why) in [
+        (
+            &scan.dropped[0],
+            "texture coordinate",
+            "texture coordinates are not used",
+        ),
+        (
+            &scan.dropped[1],
+            "normal",
+            "normals only join smooth surfaces",
+        ),
+    ] {
+        if let Some((pos, first)) = &tally.first {
+            warnings.push(Warning::at(
+                file,
+                *pos,
+                format!(
+                    "{} face corner(s) name a {what} that does not exist (first `{first}`); \
+                     read without it ({why})",
+                    tally.count
+                ),
+            ));
+        }
+    }
     let backslashes = mtllib_backslashes.into_inner();
     if let Some((pos, first)) = backslashes.first {
         warnings.push(Warning::at(
@@ -634,6 +665,13 @@ struct Scan {
     mtllibs: Vec<MtlLib>,
     /// The `o` and `g` statements.
     names: GroupScan,
+    /// Face and line statements rewritten without the texture coordinate
+    /// or normal references that point at nothing: `(line number, the
+    /// line as tobj must read it)`.
+    repairs: Vec<(u32, String)>,
+    /// Corners whose texture coordinate `[0]` or normal `[1]` index is out
+    /// of range (both are dropped, see [`check_reference`]).
+    dropped: [Tally; 2],
 }
 
 struct FaceLine {
@@ -700,6 +738,8 @@ fn scan_obj(text: &str, file: &str) -> Scan {
         usemtls: Vec::new(),
         mtllibs: Vec::new(),
         names: GroupScan::default(),
+        repairs: Vec::new(),
+        dropped: [Tally::default(), Tally::default()],
     };
     // Positive indices may refer to any vertex of the file (tobj resolves
     // them at the end), negative ones count back from the current line.
@@ -767,19 +807,36 @@ fn scan_obj(text: &str, file: &str) -> Scan {
                     continue;
                 }
                 let mut ok = true;
+                // The corners as tobj gets them: out-of-range texture
+                // coordinate and normal references dropped.
+                let mut corners: Vec<String> = Vec::with_capacity(count);
                 for &(word, c) in &w[1..] {
-                    if let Err(message) = check_reference(word, &seen, &totals) {
-                        error(c, message);
-                        ok = false;
+                    match check_reference(word, &seen, &totals) {
+                        Ok(bad) => {
+                            for (k, tally) in scan.dropped.iter_mut().enumerate() {
+                                if bad[k] {
+                                    tally.add(at(c), || word.to_string());
+                                }
+                            }
+                            corners.push(without_references(word, bad));
+                        }
+                        Err(message) => {
+                            error(c, message);
+                            ok = false;
+                        }
                     }
+                }
+                if ok && corners.iter().zip(&w[1..]).any(|(a, b)| a != b.0) {
+                    scan.repairs
+                        .push((number, format!("{keyword} {}", corners.join(" "))));
                 }
                 if ok && count >= 3 {
                     let normals = if is_line {
                         Vec::new()
                     } else {
-                        w[1..]
+                        corners
                             .iter()
-                            .filter_map(|&(word, _)| corner_normal(word, &seen))
+                            .filter_map(|word| corner_normal(word, &seen))
                             .collect()
                     };
                     scan.faces.push(FaceLine {
@@ -913,7 +970,19 @@ fn smooth_surfaces(faces: &mut [FaceLine]) {
 /// Checks one face corner `v`, `v/vt`, `v//vn` or `v/vt/vn` against the
 /// counts of vertices, texture coordinates and normals (`seen` so far for
 /// negative indices, `totals` in the file for positive ones).
-fn check_reference(word: &str, seen: &[usize; 3], totals: &[usize; 3]) -> Result<(), String> {
+///
+/// A malformed corner or a vertex index out of range is an error. A
+/// texture coordinate or normal index out of range is not: texture
+/// coordinates are never used and normals only join smooth surfaces, so
+/// the corner has one sensible reading without them (exporters and hand
+/// edits leave such indices behind). The result says which of the two
+/// (`[texture coordinate, normal]`) must be dropped.
+fn check_reference(
+    word: &str,
+    seen: &[usize; 3],
+    totals: &[usize; 3],
+) -> Result<[bool; 2], String> {
+    let mut dropped = [false; 2];
     const WHAT: [&str; 3] = ["vertex", "texture coordinate", "normal"];
     const PLURAL: [&str; 3] = ["vertices", "texture coordinates", "normals"];
     let parts: Vec<&str> = word.split('/').collect();
@@ -936,7 +1005,9 @@ fn check_reference(word: &str, seen: &[usize; 3], totals: &[usize; 3]) -> Result
             i if i > 0 => i as u64 <= totals[k] as u64,
             i => i.unsigned_abs() <= seen[k] as u64,
         };
-        if !ok {
+        if !ok && k > 0 {
+            dropped[k - 1] = true;
+        } else if !ok {
             return Err(format!(
                 "{} index {i} in `{word}` is out of range: {} {} {}",
                 WHAT[k],
@@ -950,7 +1021,49 @@ fn check_reference(word: &str, seen: &[usize; 3], totals: &[usize; 3]) -> Result
             ));
         }
     }
-    Ok(())
+    Ok(dropped)
+}
+
+/// The corner `word` (checked by [`check_reference`]) without its texture
+/// coordinate (`drop[0]`) or normal (`drop[1]`) reference: `7/9/2` becomes
+/// `7//2`, `7/2` or `7`.
+fn without_references(word: &str, drop: [bool; 2]) -> String {
+    if drop == [false, false] {
+        return word.to_string();
+    }
+    let mut parts = word.split('/');
+    let v = parts.next().unwrap_or_default();
+    let vt = parts.next().filter(|p| !p.is_empty() && !drop[0]);
+    let vn = parts.next().filter(|p| !p.is_empty() && !drop[1]);
+    match (vt, vn) {
+        (None, None) => v.to_string(),
+        (Some(t), None) => format!("{v}/{t}"),
+        (None, Some(n)) => format!("{v}//{n}"),
+        (Some(t), Some(n)) => format!("{v}/{t}/{n}"),
+    }
+}
+
+/// `text` with the lines the scan rewrote ([`Scan::repairs`], in line
+/// order) put in place; every line keeps its number.
+fn repaired_text(text: &str, repairs: &[(u32, String)]) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut next = repairs.iter().peekable();
+    for (i, line) in text.split('\n').enumerate() {
+        if i > 0 {
+            out.push('\n');
+        }
+        match next.peek() {
+            Some((number, repaired)) if *number as usize == i + 1 => {
+                out.push_str(repaired);
+                if line.ends_with('\r') {
+                    out.push('\r');
+                }
+                next.next();
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
 }
 
 /// The 1-based number of the line that ends at byte `pos` (the last line
@@ -1597,10 +1710,52 @@ Kd 0.25
                 "m.obj:5:7: error: vertex index 5 in `5` is out of range: 4 vertices are defined in the file (indices count from 1)",
                 "m.obj:6:5: error: vertex index -5 in `-5` is out of range: 4 vertices are defined above this line",
                 "m.obj:7:5: error: vertex index 0 in `0` is out of range: 4 vertices are defined in the file (indices count from 1)",
-                "m.obj:8:3: error: texture coordinate index 7 in `1/7` is out of range: 0 texture coordinates are defined in the file (indices count from 1)",
                 "m.obj:9:3: error: invalid face vertex `1//x`: `x` is not a whole number",
             ]
         );
+    }
+
+    #[test]
+    fn texture_coordinates_and_normals_that_do_not_exist_are_dropped_with_a_warning() {
+        // As three.js's verify.obj: four `vt`, corners naming 7 to 10;
+        // and a normal index past the two `vn`. CRLF line ends.
+        let obj = "v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nv 0 0 1\r\n\
+                   vt 0 0\r\nvt 1 0\r\nvt 1 1\r\nvt 0 1\r\nvn 0 0 1\r\nvn 0 1 0\r\n\
+                   f 1/7/1 2/8/1 3/9/1\r\n\
+                   f 1/1/1   3/10/1 4/4/9\r\n\
+                   f 1//2 2//2 5/3/2\r\n";
+        let s = parse(obj).unwrap();
+        assert_eq!(s.polygons.len(), 3, "every face loads");
+        assert_eq!(
+            warning_lines(&s),
+            [
+                "m.obj:12:3: warning: 4 face corner(s) name a texture coordinate that does not \
+                 exist (first `1/7/1`); read without it (texture coordinates are not used)",
+                "m.obj:13:18: warning: 1 face corner(s) name a normal that does not exist \
+                 (first `4/4/9`); read without it (normals only join smooth surfaces)",
+            ]
+        );
+        // The corners kept their valid normals: the first two faces share
+        // `1//1` and `3//1`, one smooth surface; the third has its own.
+        let ids: Vec<_> = s.polygons.iter().map(|p| p.surface.smooth).collect();
+        assert_eq!(ids[0], ids[1]);
+        assert!(ids[0].is_some() && ids[2] != ids[0], "{ids:?}");
+        // A vertex that does not exist stays an error.
+        let e = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 4/5\n").unwrap_err();
+        assert_eq!(
+            messages(&e),
+            vec!["m.obj:5:11: error: vertex index 4 in `4/5` is out of range: 3 vertices are defined in the file (indices count from 1)"]
+        );
+    }
+
+    #[test]
+    fn without_references_keeps_what_exists() {
+        assert_eq!(without_references("7/9/2", [true, false]), "7//2");
+        assert_eq!(without_references("7/9/2", [false, true]), "7/9");
+        assert_eq!(without_references("7/9/2", [true, true]), "7");
+        assert_eq!(without_references("7//2", [false, true]), "7");
+        assert_eq!(without_references("-3/-1", [true, false]), "-3");
+        assert_eq!(without_references("5", [false, false]), "5");
     }
 
     #[test]
@@ -1910,12 +2065,15 @@ Kd 0.25
 
     #[test]
     fn smoothing_groups_and_shared_normals_make_smooth_surfaces() {
+        // Faces 7 to 12 stand apart from faces 1 to 6: a face that
+        // repeated an earlier one would be dropped.
         let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\n\
+                   v 0 0 2\nv 1 0 2\nv 1 1 2\nv 0 1 2\nv 0 0 3\nv 1 0 3\n\
                    vn 0 0 1\nvn 0 0 1\nvn 0 1 0\n\
                    o A\ns 1\nf 1 2 3\nf 1 3 4\n\
                    o B\ns 1\nf 1 2 6\ns off\n\
-                   f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 1//3 2//3 6//3\n\
-                   f 1//2 2//2 5//2\ns 0\nf 1 2 5\n";
+                   f 7//1 8//1 9//1\nf 7//1 9//1 10//1\nf 7//3 8//3 11//3\n\
+                   f 7//2 8//2 12//2\ns 0\nf 9 10 12\n";
         let s = parse(obj).unwrap();
         let ids: Vec<Option<u32>> = s
             .polygons

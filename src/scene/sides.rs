@@ -173,11 +173,12 @@ impl Scene {
                 continue;
             }
             let p = &self.polygons[i];
-            let two = match sides {
-                Sides::AsLoaded => p.surface.two_sided,
-                Sides::One => false,
-                Sides::Two => true,
-            };
+            let two = !p.surface.solid
+                && match sides {
+                    Sides::AsLoaded => p.surface.two_sided,
+                    Sides::One => false,
+                    Sides::Two => true,
+                };
             if !two {
                 continue;
             }

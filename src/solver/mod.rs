@@ -325,7 +325,8 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|p| emission[p.index()])
             .collect();
-        let unshot = UnshotField::new(options.unshot, mesh, &emission, &samples, &sets);
+        let covered = crate::mesh::covered::covered_vertices(scene, mesh);
+        let unshot = UnshotField::new(options.unshot, mesh, &emission, &samples, &sets, covered);
         let power_weight = sky_power_weights(mesh);
         let mut tiles = Vec::new();
         let mut tile_of = vec![0u32; mesh.vertex_count()];

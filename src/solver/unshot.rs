@@ -11,6 +11,8 @@
 use super::formfactor::{SampleSet, ShooterSample};
 use super::UnshotScheme;
 use crate::color::Rgb;
+#[cfg(doc)]
+use crate::mesh::covered::covered_vertices;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, PolygonMesh};
 
@@ -44,6 +46,10 @@ enum Layout {
         /// Per vertex: the area it stands for ([`Mesh::vertex_areas`]), in
         /// square scene units, for polygon means.
         vertex_area: Vec<f64>,
+        /// Per vertex: hidden under a coplanar polygon laid over its own
+        /// ([`covered_vertices`]); its unshot radiosity stays 0. Empty
+        /// when nothing is covered.
+        covered: Vec<bool>,
         /// Per polygon and shooter sample: where its unshot radiosity is
         /// read from.
         sources: Vec<Vec<SampleSource>>,
@@ -68,32 +74,68 @@ impl UnshotField {
     /// The field at the start of a solve: every polygon's (or vertex's)
     /// `Δb = e`, its polygon's emission. `samples` are every polygon's
     /// shooter samples, chosen as `sets` (one per polygon) say.
+    ///
+    /// `covered` ([`covered_vertices`], empty when nothing is covered)
+    /// marks the vertices hidden under a coplanar polygon laid over their
+    /// own: they hold no unshot radiosity, and what they receive is not
+    /// added to it, so light is not sent out twice from one place.
     pub(crate) fn new(
         scheme: UnshotScheme,
         mesh: &Mesh,
         emission: &[Rgb],
         samples: &[Vec<ShooterSample>],
         sets: &[SampleSet],
+        covered: Vec<bool>,
     ) -> Self {
+        let is_covered = |l: usize| covered.get(l).copied().unwrap_or(false);
         match scheme {
-            UnshotScheme::Polygon => UnshotField {
-                values: emission.to_vec(),
-                layout: Layout::Polygon {
-                    mean_weight: mesh
-                        .polygons
-                        .iter()
-                        .flat_map(|pm| mesh.polygon_vertex_weights(pm))
-                        .collect(),
-                },
-            },
+            UnshotScheme::Polygon => {
+                let mut mean_weight: Vec<f64> = mesh
+                    .polygons
+                    .iter()
+                    .flat_map(|pm| mesh.polygon_vertex_weights(pm))
+                    .collect();
+                let mut values = emission.to_vec();
+                if !covered.is_empty() {
+                    // Not renormalised: the weights then sum to the open
+                    // share of the polygon, and `value × area` is the
+                    // power of its open part.
+                    for (j, pm) in mesh.polygons.iter().enumerate() {
+                        let range = pm.vertices.start as usize..pm.vertices.end as usize;
+                        if !range.clone().any(is_covered) {
+                            continue;
+                        }
+                        let mut open = 0.0;
+                        for l in range {
+                            if is_covered(l) {
+                                mean_weight[l] = 0.0;
+                            }
+                            open += mean_weight[l];
+                        }
+                        values[j] = values[j] * open;
+                    }
+                }
+                UnshotField {
+                    values,
+                    layout: Layout::Polygon { mean_weight },
+                }
+            }
             UnshotScheme::Vertex => UnshotField {
                 values: mesh
                     .vertex_polygon
                     .iter()
-                    .map(|p| emission[p.index()])
+                    .enumerate()
+                    .map(|(l, p)| {
+                        if is_covered(l) {
+                            Rgb::BLACK
+                        } else {
+                            emission[p.index()]
+                        }
+                    })
                     .collect(),
                 layout: Layout::Vertex {
                     vertex_area: mesh.vertex_areas(),
+                    covered,
                     sources: samples
                         .iter()
                         .zip(&mesh.polygons)
@@ -135,6 +177,13 @@ impl UnshotField {
     /// [`UnshotField::expected_len`] of them, each finite and `>= 0`.
     pub(crate) fn set_values(&mut self, values: Vec<Rgb>) {
         self.values = values;
+        // A field carried over from a coarser mesh knows nothing of which
+        // of this mesh's vertices are hidden.
+        if let Layout::Vertex { covered, .. } = &self.layout {
+            for (value, _) in self.values.iter_mut().zip(covered).filter(|x| *x.1) {
+                *value = Rgb::BLACK;
+            }
+        }
     }
 
     /// Area-weighted mean unshot radiosity of polygon `j`.
@@ -163,6 +212,7 @@ impl UnshotField {
             Layout::Vertex {
                 vertex_area,
                 sources,
+                ..
             } => {
                 let mean = polygon_mean(&mesh.polygons[i], vertex_area, &self.values);
                 read_at_samples(&sources[i], &self.values, mean, out);
@@ -185,9 +235,11 @@ impl UnshotField {
                 }
                 self.values[j] += gathered;
             }
-            Layout::Vertex { .. } => {
+            Layout::Vertex { covered, .. } => {
                 for l in pm.vertices.clone() {
-                    self.values[l as usize] += delta[l as usize];
+                    if !covered.get(l as usize).copied().unwrap_or(false) {
+                        self.values[l as usize] += delta[l as usize];
+                    }
                 }
             }
         }
@@ -224,6 +276,7 @@ impl UnshotField {
         let Layout::Vertex {
             vertex_area,
             sources,
+            covered,
         } = &self.layout
         else {
             return None;
@@ -231,7 +284,12 @@ impl UnshotField {
         let shot_field: Vec<Rgb> = radiosity
             .iter()
             .zip(&self.values)
-            .map(|(b, u)| {
+            .enumerate()
+            .map(|(l, (b, u))| {
+                // A hidden vertex shows light but never sent any out.
+                if covered.get(l).copied().unwrap_or(false) {
+                    return Rgb::BLACK;
+                }
                 Rgb::new(
                     (b.r - u.r).max(0.0),
                     (b.g - u.g).max(0.0),
