@@ -154,8 +154,9 @@ pub struct PolygonMesh {
     /// way ([`crate::scene::draw_layers`]): where they overlap, the
     /// picture shows the highest layer. 0 for most polygons.
     pub layer: u8,
-    /// True when another polygon draws its back side (its back copy, or a
-    /// face of the file that is its reverse, [`crate::scene::Surface::back`]):
+    /// True when another polygon draws its back side (its back copy, the
+    /// front it is the back copy of, or a face of the file that is its
+    /// reverse, [`crate::scene::Surface::back`]):
     /// the picture then draws this one from the front only.
     pub has_back: bool,
     /// A sky facet ([`crate::scene::Surface::sky`]): one element whatever
@@ -496,7 +497,9 @@ pub fn build_unstitched_with_limit(
             inset: options.inset * min_edge,
             levels: 0,
             layer: layers[index],
-            has_back: polygon.surface.back.is_some(),
+            // A back copy is the other side of its front: neither draws
+            // the side the other draws, or the two would z-fight.
+            has_back: polygon.surface.back.is_some() || polygon.surface.back_of.is_some(),
             sky: polygon.surface.sky,
             stitched: false,
         });

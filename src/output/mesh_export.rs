@@ -244,10 +244,11 @@ pub fn export_nodes(scene: &Scene, name: &str) -> Vec<ExportNode> {
             }
         }
     }
-    // Back copies follow their front; what is left goes to one node.
+    // Back copies follow their front; what is left goes to one node. The
+    // sky's facets light the model but are no part of it: no node.
     let mut rest = None;
     for p in 0..n {
-        if owner[p].is_some() {
+        if owner[p].is_some() || scene.polygons[p].surface.sky {
             continue;
         }
         let front = scene.polygons[p]

@@ -112,7 +112,7 @@ impl UnshotField {
                             }
                             open += mean_weight[l];
                         }
-                        values[j] = values[j] * open;
+                        values[j] *= open;
                     }
                 }
                 UnshotField {
