@@ -6,9 +6,9 @@
 //! plane, see `visibility`), so the floor's vertices under the rug receive
 //! the light the rug receives there. Drawn, they are hidden under the rug
 //! ([`crate::scene::draw_layers`]); but counted in the floor's unshot
-//! power they would send that light out a second time. In a closed cavity
-//! (a box's two-sided bottom on a floor) the light goes round the two
-//! floors again and again, and the solution grows without bound.
+//! power they would send that light out a second time: energy made from
+//! nothing, and in a sealed cavity (a box's two-sided bottom on a floor)
+//! light that goes round the two floors again and again.
 //!
 //! [`covered_vertices`] marks the vertices strictly inside a polygon laid
 //! over theirs; the solver keeps their displayed radiosity (so Gouraud

@@ -225,37 +225,53 @@ fn directions() -> Vec<DVec3> {
         .collect()
 }
 
+/// Where the ray `origin + t * dir` meets polygon `p`: its `t > 0`, or
+/// `None` when it misses it, runs parallel to its plane (within
+/// [`RAY_PARALLEL_COSINE`]) or meets it behind the origin. A hit outside
+/// an edge by at most `edge_tol` (scene units) counts, so that rays
+/// through a shared edge do not leak between polygons.
+pub(super) fn ray_polygon_hit(
+    p: &Polygon,
+    origin: DVec3,
+    dir: DVec3,
+    edge_tol: f64,
+) -> Option<f64> {
+    let n = p.normal.as_dvec3();
+    let cosine = n.dot(dir);
+    if cosine.abs() < RAY_PARALLEL_COSINE {
+        return None;
+    }
+    let first = p.vertices.first()?;
+    let t = n.dot(first.as_dvec3() - origin) / cosine;
+    // Also refuses a NaN `t` (a degenerate polygon).
+    if t.is_nan() || t <= 0.0 {
+        return None;
+    }
+    let x = origin + t * dir;
+    let k = p.vertices.len();
+    let inside = (0..k).all(|j| {
+        let a = p.vertices[j].as_dvec3();
+        let b = p.vertices[(j + 1) % k].as_dvec3();
+        let edge = b - a;
+        // Counter-clockwise from the front: inside is to the left.
+        edge.cross(x - a).dot(n) >= -edge_tol * edge.length()
+    });
+    inside.then_some(t)
+}
+
 /// The nearest polygon hit by the ray `origin + t * dir`, `t > 0`
 /// (brute force: the scene sits below the BVH in the crate).
 fn nearest_hit(polygons: &[Polygon], origin: DVec3, dir: DVec3, edge_tol: f64) -> Option<Hit> {
     let mut best: Option<Hit> = None;
     // The sky encloses everything: it is no wall of a room.
     for p in polygons.iter().filter(|p| !p.surface.sky) {
-        let n = p.normal.as_dvec3();
-        let cosine = n.dot(dir);
-        if cosine.abs() < RAY_PARALLEL_COSINE {
-            continue;
-        }
-        let Some(first) = p.vertices.first() else {
+        let Some(t) = ray_polygon_hit(p, origin, dir, edge_tol) else {
             continue;
         };
-        let t = n.dot(first.as_dvec3() - origin) / cosine;
-        if !(t > 0.0 && best.is_none_or(|b| t < b.t)) {
-            continue;
-        }
-        let x = origin + t * dir;
-        let k = p.vertices.len();
-        let inside = (0..k).all(|j| {
-            let a = p.vertices[j].as_dvec3();
-            let b = p.vertices[(j + 1) % k].as_dvec3();
-            let edge = b - a;
-            // Counter-clockwise from the front: inside is to the left.
-            edge.cross(x - a).dot(n) >= -edge_tol * edge.length()
-        });
-        if inside {
+        if best.is_none_or(|b| t < b.t) {
             best = Some(Hit {
                 t,
-                front: cosine < 0.0,
+                front: p.normal.as_dvec3().dot(dir) < 0.0,
             });
         }
     }

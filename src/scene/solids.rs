@@ -73,27 +73,10 @@ fn signed_volume6(polygons: &[Polygon], faces: &[u32], origin: DVec3) -> f64 {
 fn inside(polygons: &[Polygon], faces: &[u32], x: DVec3) -> bool {
     // Not along an axis or a diagonal, where modelled edges line up.
     let dir = DVec3::new(0.573_462, 0.688_791, 0.443_296).normalize();
-    let mut crossings = 0u32;
-    for &f in faces {
-        let p = &polygons[f as usize];
-        let n = p.normal.as_dvec3();
-        let cosine = n.dot(dir);
-        if cosine.abs() < 1e-12 {
-            continue;
-        }
-        let t = n.dot(p.vertices[0].as_dvec3() - x) / cosine;
-        if t <= 0.0 {
-            continue;
-        }
-        let hit = x + dir * t;
-        let k = p.vertices.len();
-        let within = (0..k).all(|j| {
-            let a = p.vertices[j].as_dvec3();
-            let b = p.vertices[(j + 1) % k].as_dvec3();
-            (b - a).cross(hit - a).dot(n) >= 0.0
-        });
-        crossings += u32::from(within);
-    }
+    let crossings = faces
+        .iter()
+        .filter(|&&f| super::framing::ray_polygon_hit(&polygons[f as usize], x, dir, 0.0).is_some())
+        .count();
     crossings % 2 == 1
 }
 

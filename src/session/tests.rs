@@ -306,3 +306,42 @@ fn a_thin_two_sided_wall_is_dark_on_its_unlit_side() {
     assert!(mean(1) > 0.05, "lit side {}", mean(1));
     assert_eq!(mean(2), 0.0, "the back of the wall gets no light");
 }
+
+/// The thin wall of the test above, tilted off the axes: the two sides of
+/// a face lie in one plane only up to rounding, and a point of one side
+/// then lies inside the other side's cells. Their exact near-field form
+/// factor there is ±1 instead of 0, and the back copied the front's light
+/// in blotches (McGuire's short box) or, inside sealed two-sided boxes,
+/// the light grew without bound. Coplanar polygons exchange nothing.
+#[test]
+fn a_tilted_thin_wall_is_dark_on_its_unlit_side() {
+    use crate::scene::Sides;
+    use crate::testutil::{grey, polygon, scene};
+    let turn = glam::Quat::from_axis_angle(glam::Vec3::new(0.3, 0.7, 0.2).normalize(), 0.9);
+    let tilt = |v: [[f32; 3]; 4]| v.map(|p| (turn * glam::Vec3::from(p) + 0.37).to_array());
+    let lamp = polygon(
+        1,
+        &tilt([[0., 0., 0.], [0., 1., 0.], [0., 1., 1.], [0., 0., 1.]]),
+    );
+    let wall = polygon(
+        0,
+        &tilt([[1., 0., 0.], [1., 0., 1.], [1., 1., 1.], [1., 1., 0.]]),
+    );
+    let mut s = scene(
+        vec![lamp, wall],
+        vec![grey("wall", 0.0, 0.9), grey("lamp", 1.0, 0.0)],
+    );
+    s.polygons[1].surface.two_sided = true;
+    let s = s.with_sides(Sides::AsLoaded);
+    let m = build(&s, 0.05);
+    let vis = Visibility::new(&s);
+    assert!(vis.coplanar(crate::scene::PolygonId(1), crate::scene::PolygonId(2)));
+    let mut session = Session::new(&s, &m, &vis, options(None));
+    run_to_end(&mut session);
+    let b = session.radiosity();
+    let lit = m.polygons[1].vertices.clone().map(|v| b[v as usize].r);
+    assert!(lit.fold(0.0, f64::max) > 0.05);
+    for v in m.polygons[2].vertices.clone() {
+        assert_eq!(b[v as usize].r, 0.0, "back vertex {v} got light");
+    }
+}

@@ -618,6 +618,9 @@ impl<'a> Progressive<'a> {
             };
             self.receives[j] = j != i
                 && !self.reflectance[j].is_black()
+                && !self
+                    .visibility
+                    .coplanar(PolygonId(i as u32), PolygonId(j as u32))
                 && pm.vertex_count() > 0
                 && visible_side();
         }
@@ -833,7 +836,9 @@ impl<'a> Progressive<'a> {
                 let mut sum = Rgb::BLACK;
                 let mut rays = 0;
                 for (i, (samples, values)) in self.samples.iter().zip(&shot).enumerate() {
-                    if i == j.index() {
+                    // Coplanar polygons exchange no light (see
+                    // `Visibility::coplanar`).
+                    if i == j.index() || visibility.coplanar(PolygonId(i as u32), j) {
                         continue;
                     }
                     let shooter = PolygonId(i as u32);

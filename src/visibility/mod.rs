@@ -327,6 +327,19 @@ impl Visibility {
         p == ends.0 .0 || p == ends.1 .0 || own == plane(ends.0) || own == plane(ends.1)
     }
 
+    /// True when polygons `a` and `b` lie in one plane
+    /// ([`scene::plane_classes`]), facing the same way or not: a point of
+    /// one sees the other edge-on, so they exchange no light. (The exact
+    /// near-field form factor of a source cell to a point lying inside
+    /// it, in its plane, is not 0 but ±1: the two sides of a two-sided
+    /// face would copy each other's light.)
+    pub fn coplanar(&self, a: PolygonId, b: PolygonId) -> bool {
+        match (self.planes.get(a.index()), self.planes.get(b.index())) {
+            (Some(pa), Some(pb)) => pa == pb,
+            _ => false,
+        }
+    }
+
     /// Number of polygons.
     pub fn polygon_count(&self) -> usize {
         self.blockers.len()
