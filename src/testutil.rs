@@ -83,6 +83,26 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
     }
 }
 
+/// The box `lo..hi` as six quads of material 0 ([`closed_box`]'s order),
+/// facing inwards (`inward`) or outwards.
+pub fn cuboid(lo: [f32; 3], hi: [f32; 3], inward: bool) -> Vec<Polygon> {
+    let s = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    closed_box(1.0, [0; 6])
+        .into_iter()
+        .map(|p| {
+            let mut v: Vec<[f32; 3]> = p
+                .vertices
+                .iter()
+                .map(|q| [lo[0] + q.x * s[0], lo[1] + q.y * s[1], lo[2] + q.z * s[2]])
+                .collect();
+            if !inward {
+                v.reverse();
+            }
+            polygon(0, &v)
+        })
+        .collect()
+}
+
 /// The six inward-facing walls of the box `[0, s]³`, wall `k` with
 /// material `materials[k]`, in the order -x, +x, -y, +y, -z, +z.
 pub fn closed_box(s: f32, materials: [u32; 6]) -> Vec<Polygon> {

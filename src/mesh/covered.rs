@@ -42,33 +42,51 @@ pub fn covered_vertices(scene: &Scene, mesh: &Mesh) -> Vec<bool> {
             continue;
         };
         for &q in above {
-            let q = &scene.polygons[q as usize];
+            let cover = Cover::new(&scene.polygons[q as usize]);
             for l in pm.vertices.clone() {
                 let l = l as usize;
-                covered[l] = covered[l] || strictly_inside(q, mesh.positions[l].as_dvec3());
+                covered[l] = covered[l] || cover.strictly_inside(mesh.positions[l].as_dvec3());
             }
         }
     }
     covered
 }
 
-/// True when `x` (in `q`'s plane) is inside the convex polygon `q` by more
-/// than [`COVER_EDGE_TOLERANCE`] of its extent.
-fn strictly_inside(q: &Polygon, x: DVec3) -> bool {
-    let v: Vec<DVec3> = q.vertices.iter().map(|p| p.as_dvec3()).collect();
-    let extent = v
-        .iter()
-        .flat_map(|a| v.iter().map(move |b| a.distance(*b)))
-        .fold(0.0, f64::max);
-    let margin = COVER_EDGE_TOLERANCE * extent;
-    let n = q.normal.as_dvec3();
-    (0..v.len()).all(|k| {
-        let (a, b) = (v[k], v[(k + 1) % v.len()]);
-        let edge = b - a;
-        let len = edge.length();
+/// A covering convex polygon, ready for many inside tests: its edges as
+/// `(start, unit direction)`, its normal and its margin.
+struct Cover {
+    edges: Vec<(DVec3, DVec3)>,
+    normal: DVec3,
+    /// [`COVER_EDGE_TOLERANCE`] of its longest extent, scene units.
+    margin: f64,
+}
+
+impl Cover {
+    fn new(q: &Polygon) -> Self {
+        let v: Vec<DVec3> = q.vertices.iter().map(|p| p.as_dvec3()).collect();
+        let extent = v
+            .iter()
+            .flat_map(|a| v.iter().map(move |b| a.distance(*b)))
+            .fold(0.0, f64::max);
+        Cover {
+            // A zero-length edge has no inside: its direction stays zero
+            // and no point passes it.
+            edges: (0..v.len())
+                .map(|k| (v[k], (v[(k + 1) % v.len()] - v[k]).normalize_or_zero()))
+                .collect(),
+            normal: q.normal.as_dvec3(),
+            margin: COVER_EDGE_TOLERANCE * extent,
+        }
+    }
+
+    /// True when `x` (in the polygon's plane) is inside it by more than
+    /// the margin.
+    fn strictly_inside(&self, x: DVec3) -> bool {
         // Counter-clockwise from the front: inside is to the left.
-        len > 0.0 && edge.cross(x - a).dot(n) / len > margin
-    })
+        self.edges
+            .iter()
+            .all(|&(a, dir)| dir.cross(x - a).dot(self.normal) > self.margin)
+    }
 }
 
 #[cfg(test)]

@@ -400,28 +400,8 @@ fn room_camera(polygons: &[Polygon], lo: Vec3, hi: Vec3) -> Option<Camera> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testutil::{closed_box, polygon};
+    use crate::testutil::{cuboid, polygon};
 
-    /// The box `lo..hi` as six quads facing inwards (`inward`) or outwards.
-    fn cuboid(lo: [f32; 3], hi: [f32; 3], inward: bool) -> Vec<Polygon> {
-        let s = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-        closed_box(1.0, [0; 6])
-            .into_iter()
-            .map(|p| {
-                let mut v: Vec<[f32; 3]> = p
-                    .vertices
-                    .iter()
-                    .map(|q| [lo[0] + q.x * s[0], lo[1] + q.y * s[1], lo[2] + q.z * s[2]])
-                    .collect();
-                if !inward {
-                    v.reverse();
-                }
-                polygon(0, &v)
-            })
-            .collect()
-    }
-
-    /// A room 6 wide (x), 2.7 high, 4 deep.
     fn room() -> Vec<Polygon> {
         cuboid([0.0, 0.0, 0.0], [6.0, 2.7, 4.0], true)
     }

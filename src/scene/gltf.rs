@@ -81,9 +81,7 @@
 //! `0:0`.
 
 use super::error::{fmt_num, MAX_DIAGNOSTICS};
-use super::obj::{
-    average_image, is_degenerate, name_list, Tally, DEFAULT_REFLECTANCE, MAX_MTL_REFLECTANCE,
-};
+use super::obj::{average_image, is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
 use super::{
     CameraSource, Diagnostic, Group, GroupKind, LoadError, Material, MaterialId, Polygon, Scene,
     SmoothId, SourcePos, Warning, MAX_EMISSION,
@@ -458,12 +456,7 @@ impl<'a> Reader<'a> {
                 let material = match primitive.material().index() {
                     Some(i) => MaterialId(i as u32),
                     None => *default_material.get_or_insert_with(|| {
-                        materials.push(Material {
-                            name: DEFAULT_MATERIAL_NAME.to_string(),
-                            color: Rgb::splat(DEFAULT_REFLECTANCE),
-                            k_diffrefl: 1.0,
-                            k_emission: 0.0,
-                        });
+                        materials.push(super::obj::default_material(DEFAULT_MATERIAL_NAME));
                         MaterialId(materials.len() as u32 - 1)
                     }),
                 };

@@ -117,6 +117,17 @@ pub const DEFAULT_MATERIAL_NAME: &str = "(no usemtl)";
 /// 0.8, the default base colour of a new Blender material.
 pub const DEFAULT_REFLECTANCE: f64 = 0.8;
 
+/// The material of faces that name none, called `name`: grey
+/// [`DEFAULT_REFLECTANCE`], emitting nothing.
+pub(super) fn default_material(name: &str) -> Material {
+    Material {
+        name: name.to_string(),
+        color: Rgb::splat(DEFAULT_REFLECTANCE),
+        k_diffrefl: 1.0,
+        k_emission: 0.0,
+    }
+}
+
 /// The largest `Ks` channel (and, for `Pr`, the smallest roughness) that
 /// still reads as a diffuse material without a warning, dimensionless:
 /// Blender writes `Ks 0.5 0.5 0.5` and `Pr 0.5` for every material of
@@ -403,12 +414,7 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
         let material = match mesh.material_id {
             Some(i) if i < materials.len() => MaterialId(i as u32),
             _ => *default_id.get_or_insert_with(|| {
-                materials.push(Material {
-                    name: DEFAULT_MATERIAL_NAME.to_string(),
-                    color: Rgb::splat(DEFAULT_REFLECTANCE),
-                    k_diffrefl: 1.0,
-                    k_emission: 0.0,
-                });
+                materials.push(default_material(DEFAULT_MATERIAL_NAME));
                 MaterialId(materials.len() as u32 - 1)
             }),
         };

@@ -136,8 +136,15 @@ impl Scene {
             .filter(|c| c.len() >= 4 && !c.iter().any(|&f| open[f as usize]))
             .collect();
         components.sort_unstable();
+        if components.is_empty() {
+            return None;
+        }
         let emits = |p: &Polygon| self.materials[p.material.index()].emission().max_channel() > 0.0;
         let centres: Vec<DVec3> = self.polygons.iter().map(centre).collect();
+        // Polygons by the x of their centre, so that each component finds
+        // those in its bounds by a binary search, not a pass over all.
+        let mut by_x: Vec<usize> = (0..n).filter(|&i| !self.polygons[i].surface.sky).collect();
+        by_x.sort_by(|&a, &b| centres[a].x.total_cmp(&centres[b].x));
         let mut turned = (0usize, 0usize);
         let mut member = vec![false; n];
         for faces in components {
@@ -152,13 +159,12 @@ impl Scene {
                     hi = hi.max(v.as_dvec3());
                 }
             }
-            let candidates: Vec<usize> = (0..n)
-                .filter(|&i| {
-                    !member[i]
-                        && !self.polygons[i].surface.sky
-                        && centres[i].cmpgt(lo).all()
-                        && centres[i].cmplt(hi).all()
-                })
+            let start = by_x.partition_point(|&i| centres[i].x <= lo.x);
+            let end = by_x.partition_point(|&i| centres[i].x < hi.x);
+            let candidates: Vec<usize> = by_x[start..end.max(start)]
+                .iter()
+                .copied()
+                .filter(|&i| !member[i] && centres[i].cmpgt(lo).all() && centres[i].cmplt(hi).all())
                 .collect();
             let stride = candidates.len().div_ceil(SOLID_CONTENT_PROBES).max(1);
             let holds_something = candidates
@@ -203,23 +209,15 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testutil::{closed_box, grey, polygon, scene};
+    use crate::testutil::{cuboid, grey, scene};
 
-    /// The unit box `closed_box` makes (normals inward), moved by `at` and
-    /// scaled by `size`, two-sided; turned outward with `outward`.
-    fn cube(at: [f32; 3], size: f32, outward: bool, material: u32) -> Vec<Polygon> {
-        closed_box(1.0, [0; 6])
+    /// The box of side `size` from `at`, two-sided, its faces facing out
+    /// (`outward`) or in.
+    fn cube(at: [f32; 3], size: f32, outward: bool) -> Vec<Polygon> {
+        let hi = at.map(|x| x + size);
+        cuboid(at, hi, !outward)
             .into_iter()
-            .map(|p| {
-                let mut v: Vec<[f32; 3]> = p
-                    .vertices
-                    .iter()
-                    .map(|q| [at[0] + q.x * size, at[1] + q.y * size, at[2] + q.z * size])
-                    .collect();
-                if outward {
-                    v[1..].reverse();
-                }
-                let mut p = polygon(material, &v);
+            .map(|mut p| {
                 p.surface.two_sided = true;
                 p
             })
@@ -232,7 +230,7 @@ mod tests {
 
     #[test]
     fn an_empty_closed_box_is_a_solid_and_keeps_one_side() {
-        let mut s = scene(cube([0.0; 3], 1.0, true, 0), materials());
+        let mut s = scene(cube([0.0; 3], 1.0, true), materials());
         assert_eq!(s.orient_solids(Sides::AsLoaded, "m.obj"), None);
         assert!(s.polygons.iter().all(|p| p.surface.solid));
         let s = s.with_sides(Sides::AsLoaded);
@@ -241,7 +239,7 @@ mod tests {
 
     #[test]
     fn an_inward_solid_is_turned_out_with_a_warning() {
-        let mut s = scene(cube([0.0; 3], 1.0, false, 0), materials());
+        let mut s = scene(cube([0.0; 3], 1.0, false), materials());
         let before: Vec<_> = s.polygons.iter().map(|p| p.normal).collect();
         let w = s.orient_solids(Sides::Two, "m.obj").expect("a warning");
         assert_eq!(
@@ -260,8 +258,8 @@ mod tests {
     #[test]
     fn a_room_with_something_inside_or_a_glowing_wall_keeps_both_sides() {
         // A room of outward faces with a small box inside it.
-        let mut polygons = cube([0.0; 3], 10.0, true, 0);
-        polygons.extend(cube([4.0, 0.0, 4.0], 1.0, true, 0));
+        let mut polygons = cube([0.0; 3], 10.0, true);
+        polygons.extend(cube([4.0, 0.0, 4.0], 1.0, true));
         let mut s = scene(polygons, materials());
         s.orient_solids(Sides::AsLoaded, "m.obj");
         let solid: Vec<bool> = s.polygons.iter().map(|p| p.surface.solid).collect();
@@ -272,7 +270,7 @@ mod tests {
         assert!(solid[6..].iter().all(|x| *x), "the box in it is a solid");
         assert_eq!(s.with_sides(Sides::AsLoaded).polygons.len(), 12 + 6);
         // An empty room whose ceiling glows.
-        let mut polygons = cube([0.0; 3], 10.0, true, 0);
+        let mut polygons = cube([0.0; 3], 10.0, true);
         polygons[5].material = crate::scene::MaterialId(1);
         let mut s = scene(polygons, materials());
         s.orient_solids(Sides::AsLoaded, "m.obj");
@@ -281,12 +279,12 @@ mod tests {
 
     #[test]
     fn open_boxes_and_one_sided_faces_are_left_alone() {
-        let mut open = cube([0.0; 3], 1.0, true, 0);
+        let mut open = cube([0.0; 3], 1.0, true);
         open.pop();
         let mut s = scene(open, materials());
         s.orient_solids(Sides::AsLoaded, "m.obj");
         assert!(s.polygons.iter().all(|p| !p.surface.solid));
-        let mut s = scene(cube([0.0; 3], 1.0, false, 0), materials());
+        let mut s = scene(cube([0.0; 3], 1.0, false), materials());
         assert_eq!(s.orient_solids(Sides::One, "m.obj"), None);
         assert!(s.polygons.iter().all(|p| !p.surface.solid));
     }
