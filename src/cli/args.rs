@@ -97,6 +97,15 @@ pub struct Args {
     #[arg(long)]
     pub(crate) no_shaft_culling: bool,
 
+    /// Shoot every polygon alone (the solver without clusters).
+    ///
+    /// By default nearby small polygons (a tessellated sphere, a chair)
+    /// shoot their unshot power together in one step, from strata of their
+    /// cells; emitters and polygons larger than an eighth of the scene
+    /// always shoot alone. This is the brute-force twin, for comparison.
+    #[arg(long)]
+    pub(crate) no_clustering: bool,
+
     /// Where unshot radiosity is kept between shooting steps.
     #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]
     pub(crate) unshot: UnshotScheme,

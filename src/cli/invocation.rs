@@ -134,6 +134,7 @@ impl TryFrom<Args> for Invocation {
                 near_field: !args.no_near_field,
                 shaft_culling: !args.no_shaft_culling,
                 unshot: args.unshot,
+                clustering: !args.no_clustering,
             },
             size: args.size,
             exposure,
@@ -237,6 +238,7 @@ mod tests {
             "all",
             "--no-near-field",
             "--no-shaft-culling",
+            "--no-clustering",
             "--size",
             "32x24",
             "--exposure",
@@ -277,6 +279,7 @@ mod tests {
                 near_field: false,
                 shaft_culling: false,
                 unshot: UnshotScheme::Vertex,
+                clustering: false,
             }
         );
         assert_eq!(c.size, Some((32, 24)));

@@ -18,6 +18,7 @@ mod sc;
 mod sides;
 mod sky;
 mod solids;
+pub mod sphere_box;
 mod split;
 
 pub use coplanar::{

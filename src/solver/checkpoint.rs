@@ -199,6 +199,7 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         ShooterSamples::AtMost(n) => n as u64,
     });
     h.word(options.near_field as u64);
+    h.word(options.clustering as u64);
     h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
     h.word(match options.unshot {
         super::UnshotScheme::Polygon => 1,

@@ -56,6 +56,11 @@ pub const SHAFT_TOLERANCE: f64 = 1e-5;
 /// blocker's plane, where the cosine factors make their rays worthless.
 pub const PLANE_SIDE_TOLERANCE: f64 = 1e-9;
 
+/// A run of a candidate list: a range of its entries, all of one group of
+/// nearby polygons, and the group's bounds `(min, max)` in scene units
+/// (see [`Visibility::refine_candidates_in_runs`]).
+pub type CandidateRun = (std::ops::Range<u32>, (DVec3, DVec3));
+
 /// A polygon prepared for ray tests.
 struct Blocker {
     /// First vertex (a point of the plane).
@@ -224,6 +229,52 @@ impl Visibility {
         out.dedup();
     }
 
+    /// The polygons that may block a segment from any point of the box
+    /// `from` (`(min, max)`, a cluster of shooting polygons) to any point
+    /// of polygon `to`, by the shaft between their bounding boxes; written
+    /// to `out` (cleared first) in increasing order. Unlike
+    /// [`Visibility::shaft_candidates`] only `to` and the polygons in its
+    /// plane are left out: the polygons inside the box are listed when they
+    /// may block, and the ray test leaves out each segment's own shooter
+    /// ([`Visibility::occluded_among_ends`]).
+    pub fn box_shaft_candidates(&self, from: (DVec3, DVec3), to: PolygonId, out: &mut Vec<u32>) {
+        out.clear();
+        let (Some(regions), Some(b)) = (&self.regions, self.blockers.get(to.index())) else {
+            return;
+        };
+        let shaft = Shaft::between(from, b.exact_bounds, self.shaft_tolerance);
+        let mut stack: Vec<u32> = vec![0];
+        while let Some(n) = stack.pop() {
+            let Some(node) = regions.nodes.get(n as usize) else {
+                continue;
+            };
+            if !shaft.may_overlap_box(node.aabb.min.as_dvec3(), node.aabb.max.as_dvec3()) {
+                continue;
+            }
+            if node.prim_count == 0 {
+                stack.push(node.first_index);
+                stack.push(node.first_index + 1);
+                continue;
+            }
+            let first = node.first_index as usize;
+            for &p in regions
+                .primitive_indices
+                .get(first..first + node.prim_count as usize)
+                .unwrap_or(&[])
+            {
+                let blocker = &self.blockers[p as usize];
+                if !self.in_plane_of(p, (to, to))
+                    && shaft.may_overlap_points(blocker.vertices.iter().copied())
+                    && self.boxes_straddle(blocker, from, b.exact_bounds)
+                {
+                    out.push(p);
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+
     /// True unless all `points` lie in one closed half-space of
     /// `blocker`'s plane (within [`PLANE_SIDE_TOLERANCE`]). A segment
     /// between two of them then cannot cross the blocker's plane except at
@@ -286,6 +337,55 @@ impl Visibility {
         }
     }
 
+    /// [`Visibility::refine_candidates`] with `within` in runs: each run a
+    /// range of `within` and the bounds `(min, max)` of its polygons (a
+    /// cluster of a tessellated object, say). A run whose bounds miss the
+    /// thin shaft is passed over whole, so a sphere of a thousand
+    /// triangles beside the shaft costs one box test, not a thousand.
+    /// Written to `out`, cleared first.
+    pub fn refine_candidates_in_runs(
+        &self,
+        from: &[Vec3],
+        to: &[Vec3],
+        within: &[u32],
+        runs: &[CandidateRun],
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        if from.is_empty() || to.is_empty() {
+            return;
+        }
+        let bounds = |points: &[Vec3]| {
+            points
+                .iter()
+                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+                })
+        };
+        let (a, b) = (bounds(from), bounds(to));
+        let shaft = Shaft::between(a, b, self.shaft_tolerance);
+        for (range, (lo, hi)) in runs {
+            let run = within
+                .get(range.start as usize..range.end as usize)
+                .unwrap_or(&[]);
+            if run.len() > 1 && !shaft.may_overlap_box(*lo, *hi) {
+                continue;
+            }
+            for &p in run {
+                let Some(blocker) = self.blockers.get(p as usize) else {
+                    continue;
+                };
+                let (lo, hi) = blocker.exact_bounds;
+                if shaft.may_overlap_box(lo, hi)
+                    && self.boxes_straddle(blocker, a, b)
+                    && shaft.may_overlap_points(blocker.vertices.iter().copied())
+                {
+                    out.push(p);
+                }
+            }
+        }
+    }
+
     /// [`Visibility::straddles`] for the points of two boxes, from the
     /// boxes alone: false when both boxes lie in one closed half-space of
     /// the blocker's plane.
@@ -314,6 +414,29 @@ impl Visibility {
             self.blockers
                 .get(p as usize)
                 .is_some_and(|blocker| blocker.intersect(&ray).is_finite())
+        })
+    }
+
+    /// [`Visibility::occluded_among`] leaving out `ends` and the polygons
+    /// in their planes, as [`Visibility::occluded`] does: for candidates
+    /// from [`Visibility::box_shaft_candidates`], which may list the
+    /// segment's own shooter.
+    pub fn occluded_among_ends(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        candidates: &[u32],
+        ends: (PolygonId, PolygonId),
+    ) -> bool {
+        let Some(ray) = segment_ray(a, b) else {
+            return false;
+        };
+        candidates.iter().any(|&p| {
+            !self.in_plane_of(p, ends)
+                && self
+                    .blockers
+                    .get(p as usize)
+                    .is_some_and(|blocker| blocker.intersect(&ray).is_finite())
         })
     }
 

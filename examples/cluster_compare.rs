@@ -1,0 +1,196 @@
+//! Compares the clustered solver with its brute-force twin
+//! (`--no-clustering`) on one scene and mesh (`docs/accuracy.md`,
+//! `docs/performance.md`):
+//!
+//! ```sh
+//! cargo run --release --example sphere_box -- 32 > spheres32.sc
+//! cargo run --release --example cluster_compare -- spheres32.sc
+//! cargo run --release --example cluster_compare -- hall.sc 0.25
+//! ```
+//!
+//! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
+//! absent for the program's default) and the threshold (default 0.001). Solves without clustering (the
+//! reference) and with it, to the default threshold, and prints for each
+//! the steps, rays and solve seconds; for the clustered solve, its
+//! difference from the reference: the picture's relative L1 error (mean
+//! absolute luminance difference over mean luminance, over the pixels
+//! the scene's camera shows, lamps excluded), the same over vertices
+//! (area-weighted, emitters excluded), and the largest difference of a
+//! polygon's mean radiosity, relative to it (polygons whose mean is at
+//! least a thousandth of the brightest non-emitting polygon's).
+
+use radiosity::color::Rgb;
+use radiosity::config::{RunConfig, SceneSource};
+use radiosity::prepare::{self, Prepared};
+use radiosity::render::Frame;
+use radiosity::session::{Session, SessionOptions};
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+fn luminance(c: Rgb) -> f64 {
+    0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(scene) = args.first() else {
+        eprintln!("usage: cluster_compare SCENE [LENMAX|-] [THRESHOLD]");
+        std::process::exit(2);
+    };
+    let mut config = RunConfig::new(SceneSource::File(PathBuf::from(scene)));
+    config.lenmax = args.get(1).and_then(|l| l.parse().ok());
+    if let Some(t) = args.get(2).and_then(|t| t.parse().ok()) {
+        config.solver.threshold = t;
+    }
+    let prepared: Prepared = match prepare::prepare(&config) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
+    let view = prepared.view(&config).expect("the scene's camera");
+    let emitting: Vec<bool> = prepared
+        .scene
+        .polygons
+        .iter()
+        .map(|p| {
+            !prepared.scene.materials[p.material.index()]
+                .emission()
+                .is_black()
+        })
+        .collect();
+    println!(
+        "# {scene}: {} polygons, {} vertices, lenmax {}",
+        prepared.scene.polygons.len(),
+        prepared.mesh.vertex_count(),
+        prepared.lenmax
+    );
+    println!("| solver | clusters | steps | rays | solve s | picture relL1 | vertex relL1 | worst polygon mean |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut reference: Option<(Frame, Vec<Rgb>, Vec<Rgb>)> = None;
+    for clustering in [false, true] {
+        let mut c = config.clone();
+        c.solver.clustering = clustering;
+        let t = Instant::now();
+        let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
+        session
+            .run_to_end(&AtomicBool::new(false))
+            .expect("an uncancelled solve");
+        let seconds = t.elapsed().as_secs_f64();
+        let mesh = session.mesh();
+        let radiosity = session.radiosity().to_vec();
+        let frame = radiosity::render::render(mesh, &radiosity, &view).expect("renders");
+        let areas = mesh.vertex_areas();
+        let means: Vec<Rgb> = mesh
+            .polygons
+            .iter()
+            .map(|pm| {
+                let mut sum = Rgb::BLACK;
+                for l in pm.vertices.clone() {
+                    sum += radiosity[l as usize] * areas[l as usize];
+                }
+                if pm.area > 0.0 {
+                    sum / pm.area
+                } else {
+                    Rgb::BLACK
+                }
+            })
+            .collect();
+        let solver = session.solver();
+        let clusters = solver.clusters();
+        let label = if clustering {
+            "clustered"
+        } else {
+            "--no-clustering"
+        };
+        let head = format!(
+            "| {label} | {} ({} grouped) | {} | {:.1} M | {seconds:.1} |",
+            clusters.len(),
+            clusters.grouped(),
+            session.totals().steps,
+            session.totals().rays as f64 / 1e6,
+        );
+        match &reference {
+            None => {
+                println!("{head} (reference) | | |");
+                reference = Some((frame, radiosity, means));
+            }
+            Some((rf, rr, rm)) => {
+                // Lamps: pixels where a mask of the emitters renders lit.
+                let mask: Vec<Rgb> = mesh
+                    .vertex_polygon
+                    .iter()
+                    .map(|p| {
+                        if emitting[p.index()] {
+                            Rgb::new(1.0, 1.0, 1.0)
+                        } else {
+                            Rgb::BLACK
+                        }
+                    })
+                    .collect();
+                let lamps = radiosity::render::render(mesh, &mask, &view).expect("renders");
+                let (mut diff, mut total) = (0.0, 0.0);
+                for k in 0..rf.pixels.len() {
+                    if !rf.covered[k] || lamps.pixels[k][0] > 0.0 {
+                        continue;
+                    }
+                    let px =
+                        |p: [f32; 3]| luminance(Rgb::new(p[0].into(), p[1].into(), p[2].into()));
+                    diff += (px(frame.pixels[k]) - px(rf.pixels[k])).abs();
+                    total += px(rf.pixels[k]);
+                }
+                let picture = diff / total.max(f64::MIN_POSITIVE);
+                let (mut vd, mut vt) = (0.0, 0.0);
+                for (l, p) in mesh.vertex_polygon.iter().enumerate() {
+                    if emitting[p.index()] {
+                        continue;
+                    }
+                    vd += (luminance(radiosity[l]) - luminance(rr[l])).abs() * areas[l];
+                    vt += luminance(rr[l]) * areas[l];
+                }
+                let brightest = rm
+                    .iter()
+                    .zip(&emitting)
+                    .filter(|(_, e)| !**e)
+                    .map(|(m, _)| luminance(*m))
+                    .fold(0.0, f64::max);
+                let mut worst = (0.0f64, 0usize);
+                let mut over = 0;
+                for (j, (a, b)) in means.iter().zip(rm).enumerate() {
+                    let b = luminance(*b);
+                    if emitting[j] || b < 1e-3 * brightest {
+                        continue;
+                    }
+                    let d = (luminance(*a) - b).abs() / b;
+                    over += (d > 0.02) as usize;
+                    if std::env::var_os("CC_LIST").is_some() && d > 0.02 {
+                        eprintln!(
+                            "polygon {j} line {} area {:.4}: {:.5} vs {:.5} ({:+.2} %)",
+                            prepared.scene.polygons[j].origin.line,
+                            mesh.polygons[j].area,
+                            luminance(*a),
+                            b,
+                            (luminance(*a) / b - 1.0) * 100.0
+                        );
+                    }
+                    if d > worst.0 {
+                        worst = (d, j);
+                    }
+                }
+                eprintln!("{over} polygons differ by more than 2 %");
+                let line = prepared.scene.polygons[worst.1].origin.line;
+                println!(
+                    "{head} {:.2} % | {:.2} % | {:.2} % (line {line}, area {:.3}, {:.4} vs {:.4}) |",
+                    picture * 100.0,
+                    vd / vt.max(f64::MIN_POSITIVE) * 100.0,
+                    worst.0 * 100.0,
+                    mesh.polygons[worst.1].area,
+                    luminance(means[worst.1]),
+                    luminance(rm[worst.1]),
+                );
+            }
+        }
+    }
+}
