@@ -1,7 +1,8 @@
-//! Solve benchmarks: the bundled `rtable` and `cornell` scenes at their
-//! README settings (default lenmax, 64 shooter samples, 0.1 % threshold),
-//! from mesh to converged solution. Rays per second are printed once per
-//! scene; criterion reports the time per solve.
+//! Solve benchmarks: the bundled `rtable`, `cornell` and `table_chair`
+//! scenes at their README settings (default lenmax, 64 shooter samples,
+//! 0.1 % threshold), from mesh to converged solution, with clusters (the
+//! default) and without (`--no-clustering`). Rays per second are printed
+//! once per run; criterion reports the time per solve.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use radiosity::mesh::{self, MeshOptions};
@@ -19,10 +20,14 @@ fn load(name: &str) -> Scene {
 }
 
 /// One full solve; returns (steps, rays).
-fn solve(scene: &Scene) -> (u64, u64) {
+fn solve(scene: &Scene, clustering: bool) -> (u64, u64) {
     let mesh = mesh::build(scene, &MeshOptions::for_scene(scene)).expect("mesh");
     let visibility = Visibility::new(scene);
-    let mut solver = Progressive::new(scene, &mesh, &visibility, SolverOptions::default());
+    let options = SolverOptions {
+        clustering,
+        ..SolverOptions::default()
+    };
+    let mut solver = Progressive::new(scene, &mesh, &visibility, options);
     while !solver.is_done() && solver.step().is_some() {}
     (solver.steps(), solver.rays())
 }
@@ -30,18 +35,25 @@ fn solve(scene: &Scene) -> (u64, u64) {
 fn bench_solve(c: &mut Criterion) {
     let mut group = c.benchmark_group("solve");
     group.sample_size(10);
-    for name in ["rtable.sc", "cornell.sc"] {
+    for name in ["rtable.sc", "cornell.sc", "table_chair.sc"] {
         let scene = load(name);
-        let t = Instant::now();
-        let (steps, rays) = solve(&scene);
-        let secs = t.elapsed().as_secs_f64();
-        eprintln!(
-            "{name}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
-            rays as f64 / 1e6,
-            secs,
-            rays as f64 / secs / 1e6
-        );
-        group.bench_function(name, |b| b.iter(|| solve(&scene)));
+        for clustering in [true, false] {
+            let label = if clustering {
+                name.to_string()
+            } else {
+                format!("{name} --no-clustering")
+            };
+            let t = Instant::now();
+            let (steps, rays) = solve(&scene, clustering);
+            let secs = t.elapsed().as_secs_f64();
+            eprintln!(
+                "{label}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
+                rays as f64 / 1e6,
+                secs,
+                rays as f64 / secs / 1e6
+            );
+            group.bench_function(&label, |b| b.iter(|| solve(&scene, clustering)));
+        }
     }
     group.finish();
 }

@@ -71,6 +71,8 @@ pub struct Clusters {
     /// Per cluster: the bounds `(min, max)` of its members' vertices, in
     /// scene units.
     bounds: Vec<(Vec3, Vec3)>,
+    /// Clusters with more than one member.
+    grouped: usize,
 }
 
 impl Clusters {
@@ -123,6 +125,7 @@ impl Clusters {
             bounds.push((lo, hi));
         }
         Clusters {
+            grouped: groups.iter().filter(|m| m.len() > 1).count(),
             members: groups,
             of,
             bounds,
@@ -156,7 +159,7 @@ impl Clusters {
 
     /// Number of clusters with more than one member.
     pub fn grouped(&self) -> usize {
-        self.members.iter().filter(|m| m.len() > 1).count()
+        self.grouped
     }
 }
 
@@ -257,6 +260,11 @@ pub struct Stratum {
     /// `Σ p_k cosθ_k = P · (mean_normal · direction)` holds exactly while
     /// every cell faces the receiver, which a far node ensures.
     pub mean_normal: Vec3,
+    /// Its power split by the dominant axis of each cell's normal (±x, ±y,
+    /// ±z): per bin the power per channel and the power-weighted mean
+    /// normal (length at most 1). A node whose cells face every way (a
+    /// chair) is taken from far as these six, each with its own cosine.
+    pub bins: [(Rgb, Vec3); 6],
 }
 
 /// How a receiver point sees a stratum.
@@ -268,6 +276,10 @@ pub enum Seen {
     /// Every cell faces the receiver and lies in front of it, and the
     /// receiver is far enough for one term from the representative.
     Far,
+    /// Every cell lies in front of the receiver, far enough away, but
+    /// their normals are too spread for one cosine: one term per normal
+    /// bin ([`Stratum::bins`]).
+    FarBinned,
     /// Anything else: take the halves (or, for one cell, its exact rules).
     Near,
 }
@@ -311,7 +323,24 @@ impl Stratum {
                 }
             }
         }
-        Seen::Near
+        if s >= r && !self.is_near(x) {
+            Seen::FarBinned
+        } else {
+            Seen::Near
+        }
+    }
+
+    /// Index of the normal bin of `n`: its dominant axis and sign.
+    pub fn bin_of(n: Vec3) -> usize {
+        let a = n.abs();
+        let axis = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        axis * 2 + usize::from(n[axis] < 0.0)
     }
 
     /// True when `x` is too close to the stratum for its representative.
@@ -333,6 +362,9 @@ pub struct Strata {
     /// The cut: node indices, in cell order, covering every cell with
     /// power once.
     pub roots: Vec<u32>,
+    /// Per node: its position in the cut when it is in it, else
+    /// `u32::MAX`.
+    pub root_index: Vec<u32>,
 }
 
 impl Strata {
@@ -364,6 +396,10 @@ impl Strata {
                 .children
                 .expect("filtered on children");
             cut.splice(at..=at, [left, right]);
+        }
+        strata.root_index = vec![u32::MAX; strata.nodes.len()];
+        for (at, &n) in cut.iter().enumerate() {
+            strata.root_index[n as usize] = at as u32;
         }
         strata.roots = cut;
         strata
@@ -413,6 +449,19 @@ impl Strata {
             weight += w;
         }
         let mean_normal = axis / weight as f32;
+        let mut bins = [(Rgb::BLACK, Vec3::ZERO); 6];
+        let mut bin_weight = [0.0f64; 6];
+        for cell in &cells[range.clone()] {
+            let b = Stratum::bin_of(cell.normal);
+            bins[b].0 += cell.unshot * cell.area;
+            bins[b].1 += cell.normal * cell.power.max(0.0) as f32;
+            bin_weight[b] += cell.power.max(0.0);
+        }
+        for (bin, w) in bins.iter_mut().zip(bin_weight) {
+            if w > 0.0 {
+                bin.1 /= w as f32;
+            }
+        }
         let centroid = (centroid / weight).as_vec3();
         let axis = axis.normalize_or_zero();
         let cone_cos = if axis == Vec3::ZERO {
@@ -439,6 +488,7 @@ impl Strata {
             cone_sin: (1.0 - cone_cos * cone_cos).max(0.0).sqrt(),
             centroid,
             mean_normal,
+            bins,
         });
         if range.len() > 1 {
             let left = self.node(cells, range.start..split, corners);
@@ -530,12 +580,13 @@ mod tests {
             cone_sin: 0.0,
             centroid: Vec3::new(0.5, 0.0, 0.0),
             mean_normal: Vec3::Z,
+            bins: [(Rgb::BLACK, Vec3::ZERO); 6],
         };
         assert!(s.is_near(Vec3::new(0.5, 0.0, STRATUM_NEAR_RATIO * 0.99)));
         assert!(!s.is_near(Vec3::new(0.5, 0.0, STRATUM_NEAR_RATIO * 1.01)));
         assert!(s.is_near(Vec3::new(1.0 + STRATUM_NEAR_RATIO * 0.99, 0.0, 0.0)));
         // Facing the stratum from far above: one term; from below its
-        // plane: nothing; from beside it, grazing: the halves.
+        // plane: nothing; too close: the halves.
         assert_eq!(s.seen_from(Vec3::new(0.5, 0.0, 10.0), -Vec3::Z), Seen::Far);
         assert_eq!(
             s.seen_from(Vec3::new(0.5, 0.0, -10.0), Vec3::Z),
@@ -545,7 +596,12 @@ mod tests {
             s.seen_from(Vec3::new(0.5, 0.0, 10.0), Vec3::Z),
             Seen::Behind
         );
-        assert_eq!(s.seen_from(Vec3::new(10.0, 0.0, 0.2), -Vec3::X), Seen::Near);
+        // Grazing: far and in front, but its cells' cosines to the
+        // receiver are not all positive: taken by normal bins, if at all.
+        assert_eq!(
+            s.seen_from(Vec3::new(10.0, 0.0, 0.2), -Vec3::X),
+            Seen::FarBinned
+        );
         assert_eq!(s.seen_from(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z), Seen::Near);
     }
 }

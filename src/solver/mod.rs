@@ -63,6 +63,13 @@ pub const TILE_VERTICES: u32 = 16;
 /// grid) for shaft culling, for the same reason as [`TILE_VERTICES`].
 pub const SHOOTER_GROUP: usize = 8;
 
+/// A receiver polygon with fewer element vertices than this tests its rays
+/// against the BVH rather than building a shaft to the shooter: a shaft
+/// query walks the BVH much as a ray does, and a small facet (a triangle
+/// of a tessellated sphere) casts too few rays to pay for it. Same result
+/// bits either way.
+pub const SHAFT_MIN_VERTICES: u32 = 8;
+
 /// A receiver whose shaft to the shooter holds more polygons than this
 /// skips the thin shafts and tests its rays against the BVH: narrowing a
 /// long list costs a box test per polygon per tile and sample group, and
@@ -309,6 +316,9 @@ pub struct Progressive<'a> {
     /// Per polygon: scratch, the polygons in its shaft to the shooter,
     /// ordered by their culling group.
     candidates: Vec<Vec<u32>>,
+    /// Per polygon: fewer vertices than [`SHAFT_MIN_VERTICES`], so its
+    /// rays always ask the BVH.
+    small: Vec<bool>,
     /// Per polygon: scratch, its candidates in runs of one culling group
     /// with the group's bounds.
     candidate_runs: Vec<Vec<crate::visibility::CandidateRun>>,
@@ -435,6 +445,11 @@ impl<'a> Progressive<'a> {
             receives: vec![false; mesh.polygons.len()],
             candidates: vec![Vec::new(); mesh.polygons.len()],
             candidate_runs: vec![Vec::new(); mesh.polygons.len()],
+            small: mesh
+                .polygons
+                .iter()
+                .map(|pm| pm.vertex_count() < SHAFT_MIN_VERTICES)
+                .collect(),
             culling_groups,
             tile_candidates: Vec::new(),
             group_points: Vec::new(),
@@ -654,11 +669,13 @@ impl<'a> Progressive<'a> {
         let (cluster, shot_power) = self.choose_shooter()?;
         let shooter = self.strongest_member(cluster);
         let roots = self.step_roots(shot_power);
-        // Emitters, and every polygon without clustering, keep their own
-        // samples; a polygon whose light is weak shoots through strata,
-        // as a cluster of one.
+        // Emitters, every polygon without clustering and every polygon of
+        // a scene where nothing clusters (a room of large walls, where
+        // strata would only add work) keep their own samples; a polygon
+        // whose light is weak shoots through strata, as a cluster of one.
         let alone = self.clusters.members(cluster).len() == 1
             && (!self.clustered
+                || self.clusters.grouped() == 0
                 || !self.emission[shooter.index()].is_black()
                 || roots >= self.samples[shooter.index()].len());
         let gathered = if alone {
@@ -668,7 +685,8 @@ impl<'a> Progressive<'a> {
         } else {
             self.read_cluster(cluster, roots);
             self.cull_cluster(cluster);
-            self.gather_cluster(cluster, cancel)?
+            let from_top = roots < self.step_roots(f64::INFINITY);
+            self.gather_cluster(cluster, from_top, cancel)?
         };
         Some(self.apply(cluster, shooter, shot_power, gathered))
     }
@@ -782,11 +800,12 @@ impl<'a> Progressive<'a> {
     fn cull_polygon_shafts(&mut self, shooter: PolygonId) {
         let visibility = self.visibility;
         let receives = &self.receives;
+        let small = &self.small;
         self.candidates
             .par_iter_mut()
             .enumerate()
             .for_each(|(j, c)| {
-                if receives[j] {
+                if receives[j] && !small[j] {
                     visibility.shaft_candidates(shooter, PolygonId(j as u32), c);
                 } else {
                     c.clear();
@@ -889,6 +908,7 @@ impl<'a> Progressive<'a> {
         let groups = self.shooter_groups(i);
         let receives = &self.receives;
         let candidates = &self.candidates;
+        let small = &self.small;
         let tile_candidates = &self.tile_candidates;
         let tile_of = &self.tile_of;
         let samples = &self.samples[i];
@@ -921,7 +941,8 @@ impl<'a> Progressive<'a> {
                         let blockers = tile_candidates
                             .get(tile + k / SHOOTER_GROUP)
                             .map_or(&[][..], |c| &c[..]);
-                        if !culling || candidates[j.index()].len() > REFINE_MAX {
+                        if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX
+                        {
                             rays += 1;
                             visibility.occluded(s, x, (shooter, j))
                         } else if blockers.is_empty() {
@@ -1007,12 +1028,13 @@ impl<'a> Progressive<'a> {
         let visibility = self.visibility;
         let receives = &self.receives;
         let clusters = &self.clusters;
+        let small = &self.small;
         self.candidates
             .par_iter_mut()
             .enumerate()
             .for_each(|(j, c)| {
                 let member = clusters.of(PolygonId(j as u32)) == cluster;
-                if receives[j] && !member {
+                if receives[j] && !member && !small[j] {
                     visibility.box_shaft_candidates(bounds, PolygonId(j as u32), c);
                 } else {
                     c.clear();
@@ -1034,7 +1056,12 @@ impl<'a> Progressive<'a> {
     /// its halves, down to single cells with the rules of a polygon's
     /// shot. Cells never shoot to their own polygon or one coplanar with
     /// it. Per vertex and independent, as [`Progressive::gather`].
-    fn gather_cluster(&mut self, cluster: usize, cancel: &AtomicBool) -> Option<Gathered> {
+    fn gather_cluster(
+        &mut self,
+        cluster: usize,
+        from_top: bool,
+        cancel: &AtomicBool,
+    ) -> Option<Gathered> {
         let mesh: &Mesh = &self.mesh;
         let visibility = self.visibility;
         let culling = self.options.shaft_culling;
@@ -1046,6 +1073,7 @@ impl<'a> Progressive<'a> {
         let near_field = self.options.near_field;
         let clusters = &self.clusters;
         let candidates = &self.candidates;
+        let small = &self.small;
         let cells = &self.cells;
         let cell_samples = &self.cell_samples;
         let strata = &self.strata;
@@ -1065,76 +1093,106 @@ impl<'a> Progressive<'a> {
                 let nx = mesh.polygons[j.index()].normal;
                 let tile = tile_of[l] as usize * groups;
                 let (mut sum, mut pairs, mut rays) = (Rgb::BLACK, 0u64, 0u64);
-                let mut stack: Vec<u32> = Vec::with_capacity(32);
-                for (si, &root) in strata.roots.iter().enumerate() {
-                    let blockers = (culling
-                        && !member
-                        && candidates[j.index()].len() <= REFINE_MAX)
-                        .then(|| {
-                            tile_candidates
-                                .get(tile + si / SHOOTER_GROUP)
-                                .map_or(&[][..], |c| &c[..])
-                        });
+                // (node, its cut index or NONE above the cut)
+                const NONE: u32 = u32::MAX;
+                let mut stack: Vec<(u32, u32)> = Vec::with_capacity(48);
+                if from_top {
+                    stack.push((0, strata.root_index.first().copied().unwrap_or(NONE)));
+                } else {
+                    stack.extend(strata.roots.iter().enumerate().map(|(i, &r)| (r, i as u32)));
+                    stack.reverse();
+                }
+                let whole = &candidates[j.index()];
+                while let Some((n, si)) = stack.pop() {
+                    // Rays from a node in or below the cut are culled by
+                    // its group's thin shaft; from above, by the receiver's
+                    // shaft to the whole cluster.
+                    let blockers =
+                        (culling && !member && !small[j.index()] && whole.len() <= REFINE_MAX)
+                            .then(|| {
+                                if si == NONE {
+                                    &whole[..]
+                                } else {
+                                    tile_candidates
+                                        .get(tile + si as usize / SHOOTER_GROUP)
+                                        .map_or(&[][..], |c| &c[..])
+                                }
+                            });
                     let mut blocked = |from: glam::Vec3, own: PolygonId| {
                         let (hit, cast) = ray_blocked(visibility, blockers, from, x, (own, j));
                         rays += cast;
                         hit
                     };
-                    stack.clear();
-                    stack.push(root);
-                    while let Some(n) = stack.pop() {
-                        let node = &strata.nodes[n as usize];
-                        let rep = &cells[node.representative as usize];
-                        let seen = node.seen_from(x, nx);
-                        if seen == Seen::Behind {
+                    let node = &strata.nodes[n as usize];
+                    let rep = &cells[node.representative as usize];
+                    let seen = node.seen_from(x, nx);
+                    if seen == Seen::Behind {
+                        continue;
+                    }
+                    let binned = seen == Seen::FarBinned && from_top;
+                    let far = (seen == Seen::Far || binned) && !visibility.coplanar(rep.polygon, j);
+                    match node.children {
+                        Some((a, b)) if !far => {
+                            let child = |c: u32| {
+                                let at = strata.root_index[c as usize];
+                                (c, if at != NONE { at } else { si })
+                            };
+                            stack.push(child(b));
+                            stack.push(child(a));
                             continue;
                         }
-                        let far = seen == Seen::Far && !visibility.coplanar(rep.polygon, j);
-                        match node.children {
-                            Some((a, b)) if !far => {
-                                stack.push(b);
-                                stack.push(a);
+                        None if !far => {
+                            // A single cell close by: the exact rules of a
+                            // polygon's shot.
+                            if rep.polygon == j || visibility.coplanar(rep.polygon, j) {
                                 continue;
                             }
-                            None if !far => {
-                                // A single cell close by: the exact rules
-                                // of a polygon's shot.
-                                if rep.polygon == j || visibility.coplanar(rep.polygon, j) {
-                                    continue;
-                                }
-                                let (f, asked) = weighted_point_to_samples(
-                                    x,
-                                    nx,
-                                    mesh.polygons[rep.polygon.index()].normal,
-                                    std::slice::from_ref(
-                                        &cell_samples[node.representative as usize],
-                                    ),
-                                    |_| rep.unshot,
-                                    near_field,
-                                    |_, from| blocked(from, rep.polygon),
-                                );
-                                sum += f;
-                                pairs += asked;
-                                continue;
-                            }
-                            _ => {}
-                        }
-                        // Far: the node's power from its centroid, with
-                        // its mean normal; the ray from the representative.
-                        let sample = &cell_samples[node.representative as usize];
-                        let d = x - node.centroid;
-                        let r2 = d.length_squared();
-                        let (cos_s, cos_x) = (node.mean_normal.dot(d), -nx.dot(d));
-                        if cos_s <= 0.0 || cos_x <= 0.0 || r2 <= 0.0 {
+                            let (f, asked) = weighted_point_to_samples(
+                                x,
+                                nx,
+                                mesh.polygons[rep.polygon.index()].normal,
+                                std::slice::from_ref(&cell_samples[node.representative as usize]),
+                                |_| rep.unshot,
+                                near_field,
+                                |_, from| blocked(from, rep.polygon),
+                            );
+                            sum += f;
+                            pairs += asked;
                             continue;
                         }
-                        pairs += 1;
-                        if !blocked(sample.position, rep.polygon) {
-                            let r2 = f64::from(r2);
-                            let term = f64::from(cos_s) * f64::from(cos_x)
-                                / (std::f64::consts::PI * r2 * r2);
-                            sum += node.power * term;
+                        _ => {}
+                    }
+                    // Far: the node's power from its centroid, with its
+                    // mean normal (or, binned, each normal bin's); the ray
+                    // from the representative.
+                    let sample = &cell_samples[node.representative as usize];
+                    let d = x - node.centroid;
+                    let r2 = d.length_squared();
+                    let cos_x = -nx.dot(d);
+                    if cos_x <= 0.0 || r2 <= 0.0 {
+                        continue;
+                    }
+                    let mut power = Rgb::BLACK;
+                    if binned {
+                        for (p, normal) in &node.bins {
+                            let cos_s = normal.dot(d);
+                            if cos_s > 0.0 {
+                                power += *p * f64::from(cos_s);
+                            }
                         }
+                    } else {
+                        let cos_s = node.mean_normal.dot(d);
+                        if cos_s > 0.0 {
+                            power = node.power * f64::from(cos_s);
+                        }
+                    }
+                    if power.is_black() {
+                        continue;
+                    }
+                    pairs += 1;
+                    if !blocked(sample.position, rep.polygon) {
+                        let r2 = f64::from(r2);
+                        sum += power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
                     }
                 }
                 *delta = reflectance[j.index()] * sum;
@@ -1173,7 +1231,7 @@ impl<'a> Progressive<'a> {
                 continue;
             }
             receivers += 1;
-            clear += (culling && self.candidates[j].is_empty()) as u64;
+            clear += (culling && !self.small[j] && self.candidates[j].is_empty()) as u64;
             for l in pm.vertices.clone() {
                 self.radiosity[l as usize] += self.delta[l as usize];
             }
