@@ -197,34 +197,11 @@ impl Visibility {
             return;
         };
         let shaft = Shaft::between(a.exact_bounds, b.exact_bounds, self.shaft_tolerance);
-        let mut stack: Vec<u32> = vec![0];
-        while let Some(n) = stack.pop() {
-            let Some(node) = regions.nodes.get(n as usize) else {
-                continue;
-            };
-            if !shaft.may_overlap_box(node.aabb.min.as_dvec3(), node.aabb.max.as_dvec3()) {
-                continue;
-            }
-            if node.prim_count == 0 {
-                stack.push(node.first_index);
-                stack.push(node.first_index + 1);
-                continue;
-            }
-            let first = node.first_index as usize;
-            for &p in regions
-                .primitive_indices
-                .get(first..first + node.prim_count as usize)
-                .unwrap_or(&[])
-            {
-                let blocker = &self.blockers[p as usize];
-                if !self.in_plane_of(p, (from, to))
-                    && shaft.may_overlap_points(blocker.vertices.iter().copied())
-                    && self.straddles(blocker, a.vertices.iter().chain(&b.vertices).copied())
-                {
-                    out.push(p);
-                }
-            }
-        }
+        self.polygons_in_shaft(regions, &shaft, out, |p, blocker| {
+            !self.in_plane_of(p, (from, to))
+                && shaft.may_overlap_points(blocker.vertices.iter().copied())
+                && self.straddles(blocker, a.vertices.iter().chain(&b.vertices).copied())
+        });
         out.sort_unstable();
         out.dedup();
     }
@@ -243,6 +220,25 @@ impl Visibility {
             return;
         };
         let shaft = Shaft::between(from, b.exact_bounds, self.shaft_tolerance);
+        self.polygons_in_shaft(regions, &shaft, out, |p, blocker| {
+            !self.in_plane_of(p, (to, to))
+                && shaft.may_overlap_points(blocker.vertices.iter().copied())
+                && self.boxes_straddle(blocker, from, b.exact_bounds)
+        });
+        out.sort_unstable();
+        out.dedup();
+    }
+
+    /// Appends to `out` every polygon whose box the binary BVH `regions`
+    /// finds overlapping `shaft` and that `keep` accepts (given its index
+    /// and its blocker).
+    fn polygons_in_shaft(
+        &self,
+        regions: &Bvh2,
+        shaft: &Shaft,
+        out: &mut Vec<u32>,
+        keep: impl Fn(u32, &Blocker) -> bool,
+    ) {
         let mut stack: Vec<u32> = vec![0];
         while let Some(n) = stack.pop() {
             let Some(node) = regions.nodes.get(n as usize) else {
@@ -262,17 +258,11 @@ impl Visibility {
                 .get(first..first + node.prim_count as usize)
                 .unwrap_or(&[])
             {
-                let blocker = &self.blockers[p as usize];
-                if !self.in_plane_of(p, (to, to))
-                    && shaft.may_overlap_points(blocker.vertices.iter().copied())
-                    && self.boxes_straddle(blocker, from, b.exact_bounds)
-                {
+                if keep(p, &self.blockers[p as usize]) {
                     out.push(p);
                 }
             }
         }
-        out.sort_unstable();
-        out.dedup();
     }
 
     /// True unless all `points` lie in one closed half-space of
@@ -295,54 +285,16 @@ impl Visibility {
     }
 
     /// Narrows `within` (candidates for a shooter and a receiver polygon,
-    /// from [`Visibility::shaft_candidates`]) to those that may block a
+    /// from [`Visibility::shaft_candidates`] or
+    /// [`Visibility::box_shaft_candidates`]) to those that may block a
     /// segment from one of `from` (a group of shooter points) to one of
     /// `to` (a group of receiver points), using the thin shaft between the
-    /// two groups' bounding boxes. Written to `out`, cleared first, in the
-    /// order of `within`.
-    pub fn refine_candidates(
-        &self,
-        from: &[Vec3],
-        to: &[Vec3],
-        within: &[u32],
-        out: &mut Vec<u32>,
-    ) {
-        out.clear();
-        if from.is_empty() || to.is_empty() {
-            return;
-        }
-        let bounds = |points: &[Vec3]| {
-            points
-                .iter()
-                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-                })
-        };
-        let (a, b) = (bounds(from), bounds(to));
-        let shaft = Shaft::between(a, b, self.shaft_tolerance);
-        for &p in within {
-            let Some(blocker) = self.blockers.get(p as usize) else {
-                continue;
-            };
-            // Cheapest tests first: the blocker's box against the shaft,
-            // then the two groups' boxes against its plane (a box on one
-            // side holds its points on that side), then its vertices.
-            let (lo, hi) = blocker.exact_bounds;
-            if shaft.may_overlap_box(lo, hi)
-                && self.boxes_straddle(blocker, a, b)
-                && shaft.may_overlap_points(blocker.vertices.iter().copied())
-            {
-                out.push(p);
-            }
-        }
-    }
-
-    /// [`Visibility::refine_candidates`] with `within` in runs: each run a
-    /// range of `within` and the bounds `(min, max)` of its polygons (a
-    /// cluster of a tessellated object, say). A run whose bounds miss the
-    /// thin shaft is passed over whole, so a sphere of a thousand
-    /// triangles beside the shaft costs one box test, not a thousand.
-    /// Written to `out`, cleared first.
+    /// two groups' bounding boxes. `within` comes in runs: each run a range
+    /// of it and the bounds `(min, max)` of its polygons (a cluster of a
+    /// tessellated object, say). A run whose bounds miss the thin shaft is
+    /// passed over whole, so a sphere of a thousand triangles beside the
+    /// shaft costs one box test, not a thousand. Written to `out`, cleared
+    /// first, in the order of `within`.
     pub fn refine_candidates_in_runs(
         &self,
         from: &[Vec3],
