@@ -1082,7 +1082,8 @@ impl<'a> Progressive<'a> {
             .par_iter_mut()
             .enumerate()
             .with_min_len(64)
-            .map(|(l, delta)| {
+            // One traversal stack per worker, reused from vertex to vertex.
+            .map_init(Vec::new, |stack: &mut Vec<(u32, u32)>, (l, delta)| {
                 let j = mesh.vertex_polygon[l];
                 if !receives[j.index()] || cancel.load(Ordering::Relaxed) {
                     *delta = Rgb::BLACK;
@@ -1095,7 +1096,7 @@ impl<'a> Progressive<'a> {
                 let (mut sum, mut pairs, mut rays) = (Rgb::BLACK, 0u64, 0u64);
                 // (node, its cut index or NONE above the cut)
                 const NONE: u32 = u32::MAX;
-                let mut stack: Vec<(u32, u32)> = Vec::with_capacity(48);
+                stack.clear();
                 if from_top {
                     stack.push((0, strata.root_index.first().copied().unwrap_or(NONE)));
                 } else {
