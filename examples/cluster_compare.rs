@@ -1,5 +1,5 @@
-//! Compares the clustered solver with its brute-force twin
-//! (`--no-clustering`) on one scene and mesh (`docs/accuracy.md`,
+//! Compares the clustered solver with its brute-force twins
+//! (`--no-clustering`, and `--exact-receivers`) on one scene and mesh (`docs/accuracy.md`,
 //! `docs/performance.md`):
 //!
 //! ```sh
@@ -10,9 +10,10 @@
 //!
 //! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
 //! absent for the program's default) and the threshold (default 0.001). Solves without clustering (the
-//! reference) and with it, to the default threshold, and prints for each
-//! the steps, rays and solve seconds; for the clustered solve, its
-//! difference from the reference: the picture's relative L1 error (mean
+//! reference; `CC_SKIP_BRUTE=1` skips it, and the clustered solve with
+//! exact receivers is then the reference) and with it, to the default threshold, and prints for each
+//! the steps, rays and solve seconds; for the clustered solves (exact
+//! receivers, then interpolated), their difference from the reference: the picture's relative L1 error (mean
 //! absolute luminance difference over mean luminance, over the pixels
 //! the scene's camera shows, lamps excluded), the same over vertices
 //! (area-weighted, emitters excluded), and the largest difference of a
@@ -70,9 +71,19 @@ fn main() {
     println!("| solver | clusters | steps | rays | solve s | picture relL1 | vertex relL1 | worst polygon mean |");
     println!("|---|---|---|---|---|---|---|---|");
     let mut reference: Option<(Frame, Vec<Rgb>, Vec<Rgb>)> = None;
-    for clustering in [false, true] {
+    // (clustering, receiver interpolation, label); the first run is the
+    // reference. CC_SKIP_BRUTE=1 skips the (slow) unclustered solve, so the
+    // clustered solve with exact receivers is the reference.
+    let skip_brute = std::env::var_os("CC_SKIP_BRUTE").is_some();
+    let modes = [
+        (false, false, "--no-clustering"),
+        (true, false, "--exact-receivers"),
+        (true, true, "clustered"),
+    ];
+    for &(clustering, interpolation, label) in &modes[skip_brute as usize..] {
         let mut c = config.clone();
         c.solver.clustering = clustering;
+        c.solver.receiver_interpolation = interpolation;
         let t = Instant::now();
         let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
         session
@@ -100,11 +111,6 @@ fn main() {
             .collect();
         let solver = session.solver();
         let clusters = solver.clusters();
-        let label = if clustering {
-            "clustered"
-        } else {
-            "--no-clustering"
-        };
         let head = format!(
             "| {label} | {} ({} grouped) | {} | {:.1} M | {seconds:.1} |",
             clusters.len(),

@@ -176,6 +176,7 @@ mod tests {
             unshot: vec![Rgb::new(7.0, 8.0, 9.0)],
             steps: 42,
             rays: 1 << 40,
+            charges: Vec::new(),
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("solve.ckpt");

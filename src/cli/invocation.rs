@@ -135,6 +135,7 @@ impl TryFrom<Args> for Invocation {
                 shaft_culling: !args.no_shaft_culling,
                 unshot: args.unshot,
                 clustering: !args.no_clustering,
+                receiver_interpolation: !args.exact_receivers,
             },
             size: args.size,
             exposure,
@@ -239,6 +240,7 @@ mod tests {
             "--no-near-field",
             "--no-shaft-culling",
             "--no-clustering",
+            "--exact-receivers",
             "--size",
             "32x24",
             "--exposure",
@@ -280,6 +282,7 @@ mod tests {
                 shaft_culling: false,
                 unshot: UnshotScheme::Vertex,
                 clustering: false,
+                receiver_interpolation: false,
             }
         );
         assert_eq!(c.size, Some((32, 24)));

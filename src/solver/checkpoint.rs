@@ -5,31 +5,37 @@
 //! driver's business.
 //!
 //! A solve's future depends only on its per-vertex radiosity, its unshot
-//! radiosity, and the fixed inputs (scene, mesh, solver options); the step
-//! and ray counters are carried along for the statistics. Every value is
+//! radiosity, the interpolation error charged to each vertex
+//! ([`super::receivers`]), and the fixed inputs (scene, mesh, solver
+//! options); the step and ray counters are carried along for the
+//! statistics. Every value is
 //! stored as its exact `f64` bits, so a resumed solve continues bit for bit.
 //!
-//! The file format (version 2), all integers little-endian:
+//! The file format (version 3), all integers little-endian:
 //!
 //! ```text
 //! offset  size        field
 //! 0       8           magic "RADCKPT\0"
-//! 8       4           version (u32) = 2
+//! 8       4           version (u32) = 3
 //! 12      8           fingerprint (u64) of scene + mesh + solver options
 //! 20      8           steps taken (u64)
 //! 28      8           shadow rays cast (u64)
 //! 36      8           radiosity entries R (u64, one per mesh vertex)
 //! 44      8           unshot entries U (u64)
 //! 52      8           driver record length X (u64, in bytes)
-//! 60      24 R        radiosity: r, g, b as f64 bits per vertex
+//! 60      8           charge entries C (u64, 0 or one per mesh vertex)
+//! 68      24 R        radiosity: r, g, b as f64 bits per vertex
 //! ...     24 U        unshot radiosity: r, g, b as f64 bits per entry
+//! ...     24 C        interpolation error charged: r, g, b per vertex
 //! ...     X           the driver's record, opaque here (the batch run keeps
 //!                     its step log there, so a resumed log continues)
 //! end-8   8           checksum (u64): FNV-1a of every byte before it
 //! ```
 //!
-//! Version 1 is version 2 without the record-length field and the record
-//! (its header is 52 bytes); it is still read, with an empty record.
+//! Version 2 is version 3 without the charges (its header is 60 bytes);
+//! version 1 is version 2 without the record-length field and the record
+//! (its header is 52 bytes). Both are still read, with no charges (and
+//! version 1 with an empty record).
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
 //! materials (those `--emit` changed, and the facets and radiosity of a
@@ -49,13 +55,16 @@ use crate::solver::{FormFactorMethod, Progressive, ShooterSamples, SolverOptions
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 /// The oldest format version this build still reads.
 pub const OLDEST_VERSION: u32 = 1;
 
 /// Bytes before the radiosity data.
-const HEADER_LEN: usize = 60;
+const HEADER_LEN: usize = 68;
+
+/// Bytes before the radiosity data in version 2.
+const V2_HEADER_LEN: usize = 60;
 
 /// Bytes before the radiosity data in version 1.
 const V1_HEADER_LEN: usize = 52;
@@ -82,6 +91,10 @@ pub struct SolverState {
     pub steps: u64,
     /// Shadow rays cast.
     pub rays: u64,
+    /// Per mesh vertex, the interpolation error charged to it as a check
+    /// vertex ([`super::receivers::accept`]); empty when none was (a
+    /// solve that never interpolated, or a checkpoint before version 3).
+    pub charges: Vec<Rgb>,
 }
 
 /// Why checkpoint bytes cannot be decoded. The messages read as the end of
@@ -108,8 +121,8 @@ pub enum DecodeError {
     },
     /// The length differs from what the header's entry counts need.
     #[error(
-        "its length ({len} bytes) does not match its header ({radiosity} radiosity and \
-         {unshot} unshot entries, {record} record bytes): truncated or damaged"
+        "its length ({len} bytes) does not match its header ({radiosity} radiosity, \
+         {unshot} unshot and {charges} charge entries, {record} record bytes): truncated or damaged"
     )]
     Length {
         /// Its length, in bytes.
@@ -118,6 +131,8 @@ pub enum DecodeError {
         radiosity: u64,
         /// Unshot entries the header promises.
         unshot: u64,
+        /// Charge entries the header promises.
+        charges: u64,
         /// Driver record bytes the header promises.
         record: u64,
     },
@@ -200,6 +215,7 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     });
     h.word(options.near_field as u64);
     h.word(options.clustering as u64);
+    h.word(options.receiver_interpolation as u64);
     h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
     h.word(match options.unshot {
         super::UnshotScheme::Polygon => 1,
@@ -226,6 +242,7 @@ pub fn encode(fingerprint: u64, solver: &Progressive, record: &[u8]) -> Vec<u8> 
         fingerprint,
         solver.radiosity(),
         solver.unshot(),
+        solver.charges(),
         solver.steps(),
         solver.rays(),
         record,
@@ -238,6 +255,7 @@ pub fn encode_state(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec
         fingerprint,
         &state.radiosity,
         &state.unshot,
+        &state.charges,
         state.steps,
         state.rays,
         record,
@@ -248,11 +266,15 @@ fn encode_parts(
     fingerprint: u64,
     radiosity: &[Rgb],
     unshot: &[Rgb],
+    charges: &[Rgb],
     steps: u64,
     rays: u64,
     record: &[u8],
 ) -> Vec<u8> {
-    let len = HEADER_LEN + RGB_LEN * (radiosity.len() + unshot.len()) + record.len() + CHECKSUM_LEN;
+    let len = HEADER_LEN
+        + RGB_LEN * (radiosity.len() + unshot.len() + charges.len())
+        + record.len()
+        + CHECKSUM_LEN;
     let mut out = Vec::with_capacity(len);
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
@@ -263,10 +285,11 @@ fn encode_parts(
         radiosity.len() as u64,
         unshot.len() as u64,
         record.len() as u64,
+        charges.len() as u64,
     ] {
         out.extend_from_slice(&w.to_le_bytes());
     }
-    for c in radiosity.iter().chain(unshot) {
+    for c in radiosity.iter().chain(unshot).chain(charges) {
         for x in [c.r, c.g, c.b] {
             out.extend_from_slice(&x.to_bits().to_le_bytes());
         }
@@ -280,7 +303,7 @@ fn encode_parts(
 }
 
 /// Reads the fingerprint, state and driver record from checkpoint bytes
-/// (version 1 or 2), or says what is wrong with them. Never allocates more
+/// (version 1, 2 or 3), or says what is wrong with them. Never allocates more
 /// than the input's size.
 pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
@@ -300,10 +323,10 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     if !(OLDEST_VERSION..=VERSION).contains(&version) {
         return Err(DecodeError::Version { found: version });
     }
-    let header_len = if version == 1 {
-        V1_HEADER_LEN
-    } else {
-        HEADER_LEN
+    let header_len = match version {
+        1 => V1_HEADER_LEN,
+        2 => V2_HEADER_LEN,
+        _ => HEADER_LEN,
     };
     if bytes.len() < header_len + CHECKSUM_LEN {
         return Err(DecodeError::Truncated { len: bytes.len() });
@@ -311,8 +334,10 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     let (fingerprint, steps, rays) = (u64_at(12), u64_at(20), u64_at(28));
     let (n_radiosity, n_unshot) = (u64_at(36), u64_at(44));
     let n_record = if version == 1 { 0 } else { u64_at(52) };
+    let n_charges = if version <= 2 { 0 } else { u64_at(60) };
     let expected = n_radiosity
         .checked_add(n_unshot)
+        .and_then(|n| n.checked_add(n_charges))
         .and_then(|n| n.checked_mul(RGB_LEN as u64))
         .and_then(|n| n.checked_add(n_record))
         .and_then(|n| n.checked_add((header_len + CHECKSUM_LEN) as u64));
@@ -321,6 +346,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
             len: bytes.len(),
             radiosity: n_radiosity,
             unshot: n_unshot,
+            charges: n_charges,
             record: n_record,
         });
     }
@@ -338,8 +364,8 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
             f64::from_bits(u64_at(at + 16)),
         )
     };
-    let (nr, nu) = (n_radiosity as usize, n_unshot as usize);
-    let record_start = header_len + (nr + nu) * RGB_LEN;
+    let (nr, nu, nc) = (n_radiosity as usize, n_unshot as usize, n_charges as usize);
+    let record_start = header_len + (nr + nu + nc) * RGB_LEN;
     Ok(Checkpoint {
         fingerprint,
         state: SolverState {
@@ -347,6 +373,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
             unshot: (nr..nr + nu).map(rgb_at).collect(),
             steps,
             rays,
+            charges: (nr + nu..nr + nu + nc).map(rgb_at).collect(),
         },
         record: body[record_start..].to_vec(),
     })
@@ -362,6 +389,7 @@ mod tests {
             unshot: vec![Rgb::new(7.0, 8.0, 9.0)],
             steps: 42,
             rays: 1 << 40,
+            charges: vec![Rgb::new(0.0, 1e-9, 2.0), Rgb::BLACK],
         }
     }
 
@@ -379,21 +407,44 @@ mod tests {
         assert_eq!(back.radiosity[1].b.to_bits(), 5e-324f64.to_bits());
     }
 
-    #[test]
-    fn version_1_files_still_read() {
-        // Version 1 is version 2 without the record-length field.
-        let v2 = encode_state(5, &state(), b"");
-        let mut v1 = v2[..8].to_vec();
-        v1.extend_from_slice(&1u32.to_le_bytes());
-        v1.extend_from_slice(&v2[12..52]);
-        v1.extend_from_slice(&v2[60..v2.len() - CHECKSUM_LEN]);
+    /// `state()` without charges, as versions 1 and 2 hold it.
+    fn uncharged() -> SolverState {
+        SolverState {
+            charges: Vec::new(),
+            ..state()
+        }
+    }
+
+    /// Version `v` bytes made from version 3 bytes of an uncharged state:
+    /// the header cut to `header` bytes, the record kept or not.
+    fn older(v: u32, header: usize, record: &[u8]) -> Vec<u8> {
+        let v3 = encode_state(5, &uncharged(), record);
+        let mut out = v3[..8].to_vec();
+        out.extend_from_slice(&v.to_le_bytes());
+        out.extend_from_slice(&v3[12..header]);
+        let end = if v == 1 {
+            v3.len() - CHECKSUM_LEN - record.len()
+        } else {
+            v3.len() - CHECKSUM_LEN
+        };
+        out.extend_from_slice(&v3[HEADER_LEN..end]);
         let mut h = Fnv::new();
-        h.bytes(&v1);
-        v1.extend_from_slice(&h.0.to_le_bytes());
-        let back = decode(&v1).unwrap();
+        h.bytes(&out);
+        out.extend_from_slice(&h.0.to_le_bytes());
+        out
+    }
+
+    #[test]
+    fn version_1_and_2_files_still_read() {
+        // Version 1 is version 2 without the record-length field.
+        let back = decode(&older(1, V1_HEADER_LEN, b"")).unwrap();
         assert_eq!(back.fingerprint, 5);
-        assert_eq!(back.state, state());
+        assert_eq!(back.state, uncharged());
         assert!(back.record.is_empty());
+        // Version 2 is version 3 without the charges.
+        let back = decode(&older(2, V2_HEADER_LEN, b"log")).unwrap();
+        assert_eq!(back.state, uncharged());
+        assert_eq!(back.record, b"log");
     }
 
     #[test]

@@ -31,6 +31,12 @@
 //! Shadow-ray candidates are culled by the same groups in both modes, so
 //! a tessellated object beside a thin shaft costs one box test.
 //!
+//! **Hierarchical receivers** ([`receivers`], with clusters, unless
+//! [`SolverOptions::receiver_interpolation`] is off): a step of reflected
+//! light evaluates large receiving grids at every fourth row and column
+//! and at a check vertex per coarse cell, and interpolates the cell's
+//! other vertices when the check shows the interpolation holds.
+//!
 //! Emission and reflection are from the front only. Receivers are
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
@@ -39,6 +45,7 @@
 pub mod checkpoint;
 pub mod cluster;
 pub mod formfactor;
+pub mod receivers;
 mod unshot;
 
 use crate::color::Rgb;
@@ -49,6 +56,7 @@ use crate::visibility::Visibility;
 use cluster::{Cell, Clusters, Seen, Strata};
 use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
+use receivers::CoarseGrid;
 use std::sync::atomic::{AtomicBool, Ordering};
 use unshot::UnshotField;
 
@@ -156,6 +164,10 @@ pub struct SolverOptions {
     /// estimate on a grid ([`ShooterSamples::AtMost`]) clusters: the
     /// other settings exist to reproduce the original algorithm.
     pub clustering: bool,
+    /// Let a clustered step interpolate receiving grids from their coarse
+    /// vertices where [`receivers::accept`] allows; off, every receiving
+    /// vertex is evaluated exactly (the twin it is compared with).
+    pub receiver_interpolation: bool,
 }
 
 /// Where unshot radiosity is kept between shooting steps.
@@ -184,6 +196,7 @@ impl Default for SolverOptions {
             shaft_culling: true,
             unshot: UnshotScheme::Vertex,
             clustering: true,
+            receiver_interpolation: true,
         }
     }
 }
@@ -348,6 +361,15 @@ pub struct Progressive<'a> {
     cells: Vec<Cell>,
     cell_samples: Vec<ShooterSample>,
     strata: Strata,
+    /// Per polygon: its regular grid, whose vertices between coarse rows
+    /// and columns a cluster step may interpolate ([`receivers`]).
+    coarse: Vec<Option<CoarseGrid>>,
+    /// Per vertex: scratch, a cluster step's `Δrad` at the vertices
+    /// evaluated exactly, read while the others are interpolated.
+    coarse_delta: Vec<Rgb>,
+    /// Per vertex: the interpolation error charged to it as a check vertex
+    /// ([`receivers::accept`]), in radiosity units per channel.
+    spent: Vec<Rgb>,
     pairs: u64,
     receiver_pairs: u64,
     clear_receiver_pairs: u64,
@@ -458,6 +480,13 @@ impl<'a> Progressive<'a> {
             cells: Vec::new(),
             cell_samples: Vec::new(),
             strata: Strata::default(),
+            coarse: mesh
+                .polygons
+                .iter()
+                .map(|pm| CoarseGrid::detect(mesh, pm))
+                .collect(),
+            coarse_delta: Vec::new(),
+            spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,
             tiles,
             pairs: 0,
@@ -916,55 +945,63 @@ impl<'a> Progressive<'a> {
         let reflectance = &self.reflectance;
         let near_field = self.options.near_field;
         let shot = &self.shot;
-        let (pairs, rays) = self
-            .delta
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(256)
-            .map(|(l, delta)| {
-                let j = mesh.vertex_polygon[l];
-                if !receives[j.index()] || cancel.load(Ordering::Relaxed) {
-                    *delta = Rgb::BLACK;
-                    return (0, 0);
-                }
-                let x = mesh.sample_positions[l];
-                let tile = tile_of[l] as usize * groups;
-                let mut rays = 0u64;
-                let (f, pairs) = weighted_point_to_samples(
-                    x,
-                    mesh.polygons[j.index()].normal,
-                    shooter_normal,
-                    samples,
-                    |k| shot[k],
-                    near_field,
-                    |k, s| {
-                        let blockers = tile_candidates
-                            .get(tile + k / SHOOTER_GROUP)
-                            .map_or(&[][..], |c| &c[..]);
-                        if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX
-                        {
-                            rays += 1;
-                            visibility.occluded(s, x, (shooter, j))
-                        } else if blockers.is_empty() {
-                            // Nothing in the shaft: visible, no ray needed.
-                            false
-                        } else if blockers.len() <= LINEAR_CANDIDATES {
-                            rays += 1;
-                            visibility.occluded_among(s, x, blockers)
-                        } else {
-                            rays += 1;
-                            visibility.occluded(s, x, (shooter, j))
-                        }
-                    },
-                );
-                *delta = reflectance[j.index()] * f;
-                (pairs, rays)
-            })
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-        if cancel.load(Ordering::Relaxed) {
-            return None;
-        }
-        Some(Gathered { pairs, rays })
+        // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
+        // pairs and rays it took.
+        let exact = |l: usize, j: PolygonId, _: &mut Vec<(u32, u32)>| -> (Rgb, u64, u64) {
+            let x = mesh.sample_positions[l];
+            let tile = tile_of[l] as usize * groups;
+            let mut rays = 0u64;
+            let (f, pairs) = weighted_point_to_samples(
+                x,
+                mesh.polygons[j.index()].normal,
+                shooter_normal,
+                samples,
+                |k| shot[k],
+                near_field,
+                |k, s| {
+                    let blockers = tile_candidates
+                        .get(tile + k / SHOOTER_GROUP)
+                        .map_or(&[][..], |c| &c[..]);
+                    if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX {
+                        rays += 1;
+                        visibility.occluded(s, x, (shooter, j))
+                    } else if blockers.is_empty() {
+                        // Nothing in the shaft: visible, no ray needed.
+                        false
+                    } else if blockers.len() <= LINEAR_CANDIDATES {
+                        rays += 1;
+                        visibility.occluded_among(s, x, blockers)
+                    } else {
+                        rays += 1;
+                        visibility.occluded(s, x, (shooter, j))
+                    }
+                },
+            );
+            (reflectance[j.index()] * f, pairs, rays)
+        };
+        // Reflected light may be interpolated across receiving grids; an
+        // emitter's shot, which draws the sharpest shadows, never is.
+        let cells = Interpolating {
+            on: self.clustered
+                && self.options.receiver_interpolation
+                && self.emission[i].is_black(),
+            coarse: &self.coarse,
+            clusters: &self.clusters,
+            receives,
+            cluster: self.clusters.of(shooter),
+            shooter: self.clusters.bounds(self.clusters.of(shooter)),
+            positions: &mesh.positions,
+            held: &self.radiosity,
+        };
+        gather_passes(
+            &mut self.delta,
+            &mut self.coarse_delta,
+            &mut self.spent,
+            mesh,
+            &cells,
+            cancel,
+            exact,
+        )
     }
 
     /// Cluster step, phase 2: the cluster's cells (every member's shooter
@@ -1077,133 +1114,138 @@ impl<'a> Progressive<'a> {
         let cells = &self.cells;
         let cell_samples = &self.cell_samples;
         let strata = &self.strata;
-        let (pairs, rays) = self
-            .delta
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(64)
-            // One traversal stack per worker, reused from vertex to vertex.
-            .map_init(Vec::new, |stack: &mut Vec<(u32, u32)>, (l, delta)| {
-                let j = mesh.vertex_polygon[l];
-                if !receives[j.index()] || cancel.load(Ordering::Relaxed) {
-                    *delta = Rgb::BLACK;
-                    return (0, 0);
+        // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
+        // pairs and rays it took.
+        let exact = |l: usize, j: PolygonId, stack: &mut Vec<(u32, u32)>| -> (Rgb, u64, u64) {
+            let member = clusters.of(j) == cluster;
+            let x = mesh.sample_positions[l];
+            let nx = mesh.polygons[j.index()].normal;
+            let tile = tile_of[l] as usize * groups;
+            let (mut sum, mut pairs, mut rays) = (Rgb::BLACK, 0u64, 0u64);
+            // (node, its cut index or NONE above the cut)
+            const NONE: u32 = u32::MAX;
+            stack.clear();
+            if from_top {
+                stack.push((0, strata.root_index.first().copied().unwrap_or(NONE)));
+            } else {
+                stack.extend(strata.roots.iter().enumerate().map(|(i, &r)| (r, i as u32)));
+                stack.reverse();
+            }
+            let whole = &candidates[j.index()];
+            while let Some((n, si)) = stack.pop() {
+                // Rays from a node in or below the cut are culled by
+                // its group's thin shaft; from above, by the receiver's
+                // shaft to the whole cluster.
+                let blockers =
+                    (culling && !member && !small[j.index()] && whole.len() <= REFINE_MAX).then(
+                        || {
+                            if si == NONE {
+                                &whole[..]
+                            } else {
+                                tile_candidates
+                                    .get(tile + si as usize / SHOOTER_GROUP)
+                                    .map_or(&[][..], |c| &c[..])
+                            }
+                        },
+                    );
+                let mut blocked = |from: glam::Vec3, own: PolygonId| {
+                    let (hit, cast) = ray_blocked(visibility, blockers, from, x, (own, j));
+                    rays += cast;
+                    hit
+                };
+                let node = &strata.nodes[n as usize];
+                let rep = &cells[node.representative as usize];
+                let seen = node.seen_from(x, nx);
+                if seen == Seen::Behind {
+                    continue;
                 }
-                let member = clusters.of(j) == cluster;
-                let x = mesh.sample_positions[l];
-                let nx = mesh.polygons[j.index()].normal;
-                let tile = tile_of[l] as usize * groups;
-                let (mut sum, mut pairs, mut rays) = (Rgb::BLACK, 0u64, 0u64);
-                // (node, its cut index or NONE above the cut)
-                const NONE: u32 = u32::MAX;
-                stack.clear();
-                if from_top {
-                    stack.push((0, strata.root_index.first().copied().unwrap_or(NONE)));
-                } else {
-                    stack.extend(strata.roots.iter().enumerate().map(|(i, &r)| (r, i as u32)));
-                    stack.reverse();
-                }
-                let whole = &candidates[j.index()];
-                while let Some((n, si)) = stack.pop() {
-                    // Rays from a node in or below the cut are culled by
-                    // its group's thin shaft; from above, by the receiver's
-                    // shaft to the whole cluster.
-                    let blockers =
-                        (culling && !member && !small[j.index()] && whole.len() <= REFINE_MAX)
-                            .then(|| {
-                                if si == NONE {
-                                    &whole[..]
-                                } else {
-                                    tile_candidates
-                                        .get(tile + si as usize / SHOOTER_GROUP)
-                                        .map_or(&[][..], |c| &c[..])
-                                }
-                            });
-                    let mut blocked = |from: glam::Vec3, own: PolygonId| {
-                        let (hit, cast) = ray_blocked(visibility, blockers, from, x, (own, j));
-                        rays += cast;
-                        hit
-                    };
-                    let node = &strata.nodes[n as usize];
-                    let rep = &cells[node.representative as usize];
-                    let seen = node.seen_from(x, nx);
-                    if seen == Seen::Behind {
+                let binned = seen == Seen::FarBinned && from_top;
+                let far = (seen == Seen::Far || binned) && !visibility.coplanar(rep.polygon, j);
+                match node.children {
+                    Some((a, b)) if !far => {
+                        let child = |c: u32| {
+                            let at = strata.root_index[c as usize];
+                            (c, if at != NONE { at } else { si })
+                        };
+                        stack.push(child(b));
+                        stack.push(child(a));
                         continue;
                     }
-                    let binned = seen == Seen::FarBinned && from_top;
-                    let far = (seen == Seen::Far || binned) && !visibility.coplanar(rep.polygon, j);
-                    match node.children {
-                        Some((a, b)) if !far => {
-                            let child = |c: u32| {
-                                let at = strata.root_index[c as usize];
-                                (c, if at != NONE { at } else { si })
-                            };
-                            stack.push(child(b));
-                            stack.push(child(a));
+                    None if !far => {
+                        // A single cell close by: the exact rules of a
+                        // polygon's shot.
+                        if rep.polygon == j || visibility.coplanar(rep.polygon, j) {
                             continue;
                         }
-                        None if !far => {
-                            // A single cell close by: the exact rules of a
-                            // polygon's shot.
-                            if rep.polygon == j || visibility.coplanar(rep.polygon, j) {
-                                continue;
-                            }
-                            let (f, asked) = weighted_point_to_samples(
-                                x,
-                                nx,
-                                mesh.polygons[rep.polygon.index()].normal,
-                                std::slice::from_ref(&cell_samples[node.representative as usize]),
-                                |_| rep.unshot,
-                                near_field,
-                                |_, from| blocked(from, rep.polygon),
-                            );
-                            sum += f;
-                            pairs += asked;
-                            continue;
-                        }
-                        _ => {}
-                    }
-                    // Far: the node's power from its centroid, with its
-                    // mean normal (or, binned, each normal bin's); the ray
-                    // from the representative.
-                    let sample = &cell_samples[node.representative as usize];
-                    let d = x - node.centroid;
-                    let r2 = d.length_squared();
-                    let cos_x = -nx.dot(d);
-                    if cos_x <= 0.0 || r2 <= 0.0 {
+                        let (f, asked) = weighted_point_to_samples(
+                            x,
+                            nx,
+                            mesh.polygons[rep.polygon.index()].normal,
+                            std::slice::from_ref(&cell_samples[node.representative as usize]),
+                            |_| rep.unshot,
+                            near_field,
+                            |_, from| blocked(from, rep.polygon),
+                        );
+                        sum += f;
+                        pairs += asked;
                         continue;
                     }
-                    let mut power = Rgb::BLACK;
-                    if binned {
-                        for (p, normal) in &node.bins {
-                            let cos_s = normal.dot(d);
-                            if cos_s > 0.0 {
-                                power += *p * f64::from(cos_s);
-                            }
-                        }
-                    } else {
-                        let cos_s = node.mean_normal.dot(d);
+                    _ => {}
+                }
+                // Far: the node's power from its centroid, with its
+                // mean normal (or, binned, each normal bin's); the ray
+                // from the representative.
+                let sample = &cell_samples[node.representative as usize];
+                let d = x - node.centroid;
+                let r2 = d.length_squared();
+                let cos_x = -nx.dot(d);
+                if cos_x <= 0.0 || r2 <= 0.0 {
+                    continue;
+                }
+                let mut power = Rgb::BLACK;
+                if binned {
+                    for (p, normal) in &node.bins {
+                        let cos_s = normal.dot(d);
                         if cos_s > 0.0 {
-                            power = node.power * f64::from(cos_s);
+                            power += *p * f64::from(cos_s);
                         }
                     }
-                    if power.is_black() {
-                        continue;
-                    }
-                    pairs += 1;
-                    if !blocked(sample.position, rep.polygon) {
-                        let r2 = f64::from(r2);
-                        sum += power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
+                } else {
+                    let cos_s = node.mean_normal.dot(d);
+                    if cos_s > 0.0 {
+                        power = node.power * f64::from(cos_s);
                     }
                 }
-                *delta = reflectance[j.index()] * sum;
-                (pairs, rays)
-            })
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-        if cancel.load(Ordering::Relaxed) {
-            return None;
-        }
-        Some(Gathered { pairs, rays })
+                if power.is_black() {
+                    continue;
+                }
+                pairs += 1;
+                if !blocked(sample.position, rep.polygon) {
+                    let r2 = f64::from(r2);
+                    sum += power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
+                }
+            }
+            (reflectance[j.index()] * sum, pairs, rays)
+        };
+        let cells = Interpolating {
+            on: self.options.receiver_interpolation,
+            coarse: &self.coarse,
+            clusters,
+            receives,
+            cluster,
+            shooter: clusters.bounds(cluster),
+            positions: &mesh.positions,
+            held: &self.radiosity,
+        };
+        gather_passes(
+            &mut self.delta,
+            &mut self.coarse_delta,
+            &mut self.spent,
+            mesh,
+            &cells,
+            cancel,
+            exact,
+        )
     }
 
     /// Phase 5, apply: adds the gathered `Δrad` to every receiver's
@@ -1329,6 +1371,8 @@ impl<'a> Progressive<'a> {
             unshot,
             steps: self.steps,
             rays: self.rays + rays,
+            // Interpolation on the refined mesh starts with no charges.
+            charges: Vec::new(),
         })
     }
 
@@ -1362,6 +1406,18 @@ impl<'a> Progressive<'a> {
             unshot: self.unshot().to_vec(),
             steps: self.steps,
             rays: self.rays,
+            charges: self.charges().to_vec(),
+        }
+    }
+
+    /// Per mesh vertex, the interpolation error charged to it as a check
+    /// vertex ([`receivers::accept`]), in the scene's emission units; empty
+    /// while none has been (so a solve that never interpolates saves none).
+    pub fn charges(&self) -> &[Rgb] {
+        if self.spent.iter().all(|c| c.is_black()) {
+            &[]
+        } else {
+            &self.spent
         }
     }
 
@@ -1371,6 +1427,7 @@ impl<'a> Progressive<'a> {
     pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), SolverError> {
         if state.radiosity.len() != self.radiosity.len()
             || state.unshot.len() != self.unshot.values().len()
+            || !(state.charges.is_empty() || state.charges.len() == self.radiosity.len())
         {
             return Err(SolverError::StateMismatch {
                 radiosity: state.radiosity.len(),
@@ -1380,15 +1437,174 @@ impl<'a> Progressive<'a> {
             });
         }
         let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
-        if state.radiosity.iter().chain(&state.unshot).any(bad) {
+        if state
+            .radiosity
+            .iter()
+            .chain(&state.unshot)
+            .chain(&state.charges)
+            .any(bad)
+        {
             return Err(SolverError::BadStateValue);
         }
+        self.spent = if state.charges.is_empty() {
+            vec![Rgb::BLACK; self.radiosity.len()]
+        } else {
+            state.charges
+        };
         self.radiosity = state.radiosity;
         self.unshot.set_values(state.unshot);
         self.steps = state.steps;
         self.rays = state.rays;
         Ok(())
     }
+}
+
+/// Which receiving vertices a step may interpolate
+/// ([`receivers`]): those of a receiving grid, not a member of the
+/// shooting cluster (those are near it), neither coarse nor a check.
+struct Interpolating<'s> {
+    /// False when the step evaluates every vertex exactly.
+    on: bool,
+    coarse: &'s [Option<CoarseGrid>],
+    clusters: &'s Clusters,
+    receives: &'s [bool],
+    /// The shooting cluster.
+    cluster: usize,
+    /// The shooting cluster's bounds.
+    shooter: (glam::Vec3, glam::Vec3),
+    /// Element vertex positions.
+    positions: &'s [glam::Vec3],
+    /// Per vertex, the radiosity before the step.
+    held: &'s [Rgb],
+}
+
+impl Interpolating<'_> {
+    /// The coarse cell vertex `l` of polygon `j` may be interpolated from.
+    fn cell(&self, l: usize, j: PolygonId) -> Option<receivers::Interpolation> {
+        if !self.on || !self.receives[j.index()] || self.clusters.of(j) == self.cluster {
+            return None;
+        }
+        match self.coarse[j.index()]?.role(l as u32) {
+            receivers::Role::Fine(cell) => self.usable(cell),
+            receivers::Role::Exact | receivers::Role::Check(_) => None,
+        }
+    }
+
+    /// The coarse cell vertex `l` of polygon `j` is the check vertex of,
+    /// when the step may interpolate that cell.
+    fn checked_cell(&self, l: usize, j: PolygonId) -> Option<receivers::Interpolation> {
+        if !self.on || !self.receives[j.index()] || self.clusters.of(j) == self.cluster {
+            return None;
+        }
+        match self.coarse[j.index()]?.role(l as u32) {
+            receivers::Role::Check(cell) => self.usable(cell),
+            receivers::Role::Exact | receivers::Role::Fine(_) => None,
+        }
+    }
+
+    /// `cell`, unless it is too near the shooter ([`receivers::far_from`]).
+    fn usable(&self, cell: receivers::Interpolation) -> Option<receivers::Interpolation> {
+        let corners = cell.corners.map(|c| self.positions[c as usize]);
+        receivers::far_from(corners, self.shooter).then_some(cell)
+    }
+}
+
+/// A step's gather, phase 4, in two passes over the vertices: first every
+/// receiving vertex `cells` does not offer (by `exact`, which returns a
+/// vertex's `Δrad`, pairs and rays), then the others, each interpolated
+/// from its coarse cell when [`receivers::accept`] allows and exact
+/// otherwise; last, each check vertex of a cell accepted by the weak rule
+/// is charged its error in `spent`. Writes `delta` (black for
+/// non-receivers). Each vertex depends only on itself and the
+/// first pass, so the bits do not depend on the thread count. `None` once
+/// `cancel` is set, with only scratch written.
+fn gather_passes<E>(
+    delta: &mut [Rgb],
+    coarse_delta: &mut Vec<Rgb>,
+    spent: &mut [Rgb],
+    mesh: &Mesh,
+    cells: &Interpolating,
+    cancel: &AtomicBool,
+    exact: E,
+) -> Option<Gathered>
+where
+    E: Fn(usize, PolygonId, &mut Vec<(u32, u32)>) -> (Rgb, u64, u64) + Sync,
+{
+    let (receives, held) = (cells.receives, cells.held);
+    let (pairs, rays) = delta
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(64)
+        // One traversal stack per worker, reused from vertex to vertex.
+        .map_init(Vec::new, |stack: &mut Vec<(u32, u32)>, (l, delta)| {
+            let j = mesh.vertex_polygon[l];
+            if !receives[j.index()] || cancel.load(Ordering::Relaxed) || cells.cell(l, j).is_some()
+            {
+                *delta = Rgb::BLACK;
+                return (0, 0);
+            }
+            let (d, pairs, rays) = exact(l, j, stack);
+            *delta = d;
+            (pairs, rays)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    if cancel.load(Ordering::Relaxed) {
+        return None;
+    }
+    if !cells.on {
+        return Some(Gathered { pairs, rays });
+    }
+    coarse_delta.clear();
+    coarse_delta.extend_from_slice(delta);
+    let first = &coarse_delta[..];
+    let spent_now = &*spent;
+    let (pairs2, rays2) = delta
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(64)
+        .map_init(Vec::new, |stack: &mut Vec<(u32, u32)>, (l, delta)| {
+            let j = mesh.vertex_polygon[l];
+            let Some(cell) = cells.cell(l, j) else {
+                return (0, 0);
+            };
+            if cancel.load(Ordering::Relaxed) {
+                return (0, 0);
+            }
+            let corners = cell.corners.map(|c| first[c as usize]);
+            let c = cell.check as usize;
+            if receivers::accept(corners, first[c], cell.check_weights, held[c], spent_now[c])
+                .is_some()
+            {
+                *delta = receivers::blend(corners, cell.weights);
+                return (0, 0);
+            }
+            let (d, pairs, rays) = exact(l, j, stack);
+            *delta = d;
+            (pairs, rays)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    if cancel.load(Ordering::Relaxed) {
+        return None;
+    }
+    spent
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(256)
+        .for_each(|(l, s)| {
+            let j = mesh.vertex_polygon[l];
+            if let Some(cell) = cells.checked_cell(l, j) {
+                let corners = cell.corners.map(|c| first[c as usize]);
+                if let Some(cost) =
+                    receivers::accept(corners, first[l], cell.check_weights, held[l], *s)
+                {
+                    *s += cost;
+                }
+            }
+        });
+    Some(Gathered {
+        pairs: pairs + pairs2,
+        rays: rays + rays2,
+    })
 }
 
 /// Whether the segment from `from` to `x` is blocked, and the rays cast
