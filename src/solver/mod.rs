@@ -925,10 +925,11 @@ impl<'a> Progressive<'a> {
 
     /// Phase 4, gather: every receiving vertex's `Δrad = ρ_j · Σ_k Δb_k ·
     /// F(l → sample k)` into `self.delta` (black for the others), in
-    /// parallel. Each vertex's sum is independent of the others, so the
-    /// bits do not depend on the thread count. Returns `None` once
-    /// `cancel` is set, with the solution untouched (only scratch
-    /// written).
+    /// parallel; with clusters, a non-emitter's shot interpolates where
+    /// [`gather_passes`] allows. Each vertex's value depends only on its
+    /// own sum and the first pass, so the bits do not depend on the thread
+    /// count. Returns `None` once `cancel` is set, with the solution
+    /// untouched (only scratch written).
     fn gather(&mut self, shooter: PolygonId, cancel: &AtomicBool) -> Option<Gathered> {
         let i = shooter.index();
         let mesh: &Mesh = &self.mesh;
@@ -1092,7 +1093,8 @@ impl<'a> Progressive<'a> {
     /// and one ray; one wholly behind gives nothing; any other descends to
     /// its halves, down to single cells with the rules of a polygon's
     /// shot. Cells never shoot to their own polygon or one coplanar with
-    /// it. Per vertex and independent, as [`Progressive::gather`].
+    /// it. Per vertex, in the two passes of [`gather_passes`], as
+    /// [`Progressive::gather`].
     fn gather_cluster(
         &mut self,
         cluster: usize,
