@@ -107,6 +107,9 @@ pub struct RunConfig {
     pub adaptive: Option<RefineOptions>,
     /// Draw the element mesh over the picture (8-bit pictures only).
     pub mesh_lines: bool,
+    /// Samples per pixel side of written pictures
+    /// ([`crate::render::antialias`]), `1..=MAX_AA`.
+    pub aa: u32,
     /// `--emit NAME=VALUE`, in order: the material, OBJ object or group
     /// `NAME` emits `VALUE` (radiosity in the scene's units, every channel
     /// finite, `>= 0` and at most [`crate::scene::MAX_EMISSION`]). Applied
@@ -148,6 +151,7 @@ impl RunConfig {
             ambient: None,
             adaptive: None,
             mesh_lines: false,
+            aa: crate::render::antialias::DEFAULT_AA,
             emit: Vec::new(),
             sides: Sides::AsLoaded,
             sky: None,

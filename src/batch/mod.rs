@@ -33,7 +33,7 @@ use crate::mesh::MeshRef;
 use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, OutputError};
 use crate::prepare::{self, PhaseSeconds, PrepareError, Prepared};
-use crate::render::{self, Exposure, Rasterizer, RenderError, ViewError};
+use crate::render::{self, antialias, Exposure, Rasterizer, RenderError, View, ViewError};
 use crate::session::{Event, PassStats, Session, SessionOptions};
 use crate::solver::checkpoint::fingerprint;
 use crate::solver::SolverError;
@@ -249,14 +249,26 @@ pub fn run_prepared(
         return Err(interrupted());
     }
     let t = Instant::now();
+    // Rendered at `aa × aa` samples a pixel, averaged to the picture.
+    let aa = antialias::factor_for(view.width(), view.height(), config.aa);
     let mut rasterizer = Rasterizer::new();
-    rasterizer.render(mesh, &solved.shown, &view)?;
-    let frame = rasterizer.frame();
+    if aa > 1 {
+        let fine = View::with_size(
+            &prepared.scene.camera,
+            view.width() * aa,
+            view.height() * aa,
+        )?;
+        rasterizer.render(mesh, &solved.shown, &fine)?;
+    } else {
+        rasterizer.render(mesh, &solved.shown, &view)?;
+    }
+    let picture_frame = (aa > 1).then(|| antialias::downsample(rasterizer.frame(), aa));
+    let frame = picture_frame.as_ref().unwrap_or(rasterizer.frame());
     seconds.render = t.elapsed().as_secs_f64();
     // One line on a (nearly) black picture, whatever `--quiet` says, like
     // the load warnings: it explains a picture the user did not expect.
     // Not when nothing emits: the load warning has said why already.
-    let dark = render::PictureCoverage::of(frame, rasterizer.front_faces())
+    let dark = render::PictureCoverage::of(rasterizer.frame(), rasterizer.front_faces())
         .dark_warning()
         .filter(|_| prepared.scene.emits())
         .map(|w| format!("warning: {w}"));
@@ -272,13 +284,12 @@ pub fn run_prepared(
     let exposure = config.exposure.resolve(frame);
     if config.mesh_lines {
         let mut picture = render::to_srgb8(frame, exposure);
-        render::draw_mesh_edges(
-            &mut picture,
-            mesh,
-            &view,
-            rasterizer.inv_depth(),
-            render::MESH_COLOR,
-        );
+        let depth = if aa > 1 {
+            antialias::nearest_depth(rasterizer.inv_depth(), view.width() * aa, aa)
+        } else {
+            rasterizer.inv_depth().to_vec()
+        };
+        render::draw_mesh_edges(&mut picture, mesh, &view, &depth, render::MESH_COLOR);
         output::write_rgb8(&output, &picture).map_err(RunError::Write)?;
     } else {
         output::write_picture(&output, frame, Exposure::Fixed(exposure))

@@ -10,6 +10,7 @@ use crate::color::Rgb;
 use crate::config;
 use crate::mesh::refine;
 use crate::mesh::DEFAULT_INSET;
+use crate::render::antialias;
 use crate::solver::{FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_THRESHOLD};
 use std::path::PathBuf;
 
@@ -144,6 +145,16 @@ pub struct Args {
     /// Each split halves the element's edges.
     #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS, requires = "adaptive")]
     pub(crate) adaptive_levels: u32,
+
+    /// Samples per pixel side for written pictures (1 to 8).
+    ///
+    /// The picture is rendered at N × N samples a pixel and averaged in
+    /// linear radiosity, so polygon edges are smooth; .exr and .pfm keep
+    /// the averaged linear values. 1 draws one sample a pixel, as the
+    /// window does. Very large pictures use fewer samples (at most 64 M).
+    #[arg(long, value_name = "N", default_value_t = antialias::DEFAULT_AA,
+          value_parser = clap::value_parser!(u32).range(1..=antialias::MAX_AA as i64))]
+    pub(crate) aa: u32,
 
     /// Draw the element mesh over the written picture.
     ///

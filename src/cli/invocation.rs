@@ -158,6 +158,7 @@ impl TryFrom<Args> for Invocation {
             },
             adaptive: args.adaptive.then_some(refine),
             mesh_lines: args.mesh_lines,
+            aa: args.aa,
             emit: args.emit,
             sides: match (args.one_sided, args.two_sided) {
                 (true, _) => Sides::One,
@@ -222,6 +223,16 @@ mod tests {
     }
 
     #[test]
+    fn antialiasing_takes_1_to_8_samples_a_side() {
+        assert_eq!(config(&[]).aa, crate::render::antialias::DEFAULT_AA);
+        assert_eq!(config(&["--aa", "1"]).aa, 1);
+        assert_eq!(config(&["--aa", "8"]).aa, 8);
+        for bad in ["0", "9", "-1", "two"] {
+            assert!(parse(&["--aa", bad]).is_err(), "--aa {bad}");
+        }
+    }
+
+    #[test]
     fn every_option_reaches_the_config() {
         let c = config(&[
             "room.sc",
@@ -241,6 +252,8 @@ mod tests {
             "--no-shaft-culling",
             "--no-clustering",
             "--exact-receivers",
+            "--aa",
+            "5",
             "--size",
             "32x24",
             "--exposure",
@@ -286,6 +299,7 @@ mod tests {
             }
         );
         assert_eq!(c.size, Some((32, 24)));
+        assert_eq!(c.aa, 5);
         assert_eq!(c.exposure, Exposure::Fixed(2.0));
         assert_eq!(c.stats, Some(PathBuf::from("s.json")));
         assert_eq!(c.camera, Some(PathBuf::from("cam.sc")));

@@ -14,6 +14,9 @@
 //!    with [`auto_exposure`]) and encodes it with the sRGB curve for 8-bit
 //!    pictures. High-dynamic-range outputs take the linear [`Frame`] as it is.
 //!
+//! Written pictures are antialiased ([`antialias`]): rendered at `n × n`
+//! samples a pixel and averaged in linear radiosity.
+//!
 //! [`PictureCoverage`] counts what a drawn picture shows (background, back
 //! faces, unlit or lit front faces, from [`Rasterizer::front_faces`]) and
 //! words the warning for a picture that came out (nearly) black.
@@ -21,6 +24,7 @@
 //! The module knows nothing of files or windows: the viewer shows and the
 //! batch command writes the very same frames.
 
+pub mod antialias;
 pub mod camera;
 pub mod coverage;
 pub mod overlay;
