@@ -226,6 +226,25 @@ fn window_writes_a_picture_and_quits_on_keys() {
         stdout.contains("wrote cornell-001.tiff"),
         "stdout: {stdout}"
     );
+    // One summary line on the terminal when the window closes.
+    let mut stderr = String::new();
+    program
+        .0
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    let summary: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("window closed after"))
+        .collect();
+    assert_eq!(summary.len(), 1, "stderr: {stderr}");
+    assert!(
+        summary[0].contains("% unshot") && summary[0].contains("1 picture written"),
+        "{}",
+        summary[0]
+    );
 }
 
 #[test]

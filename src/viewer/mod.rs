@@ -187,8 +187,40 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
         };
         let result = ui.run(&progress, &control);
         control.quit.store(true, Ordering::Relaxed);
+        if config.progress {
+            if let Ok(p) = progress.lock() {
+                eprintln!(
+                    "{}",
+                    closing_summary(&stem, &p, prepared.scene.emits(), ui.written)
+                );
+            }
+        }
         result
     })
+}
+
+/// The line printed on the terminal when the window closes (unless
+/// `--quiet`): how far the solve got, in the words of the batch summary,
+/// and how many pictures `w` wrote.
+fn closing_summary(stem: &str, p: &Progress, emits: bool, written: u32) -> String {
+    let state = match p.stopped {
+        Some(_) if !emits => "nothing emits",
+        Some(StopReason::Converged) => "converged",
+        Some(StopReason::MaxSteps) => "step limit",
+        None => "not converged",
+    };
+    let pictures = match written {
+        0 => String::new(),
+        1 => ", 1 picture written".into(),
+        n => format!(", {n} pictures written"),
+    };
+    format!(
+        "{stem}: window closed after {} steps, {:.2} s solving, {:.1} M rays, {:.3}% unshot, {state}{pictures}",
+        p.step,
+        p.solving,
+        p.rays as f64 / 1e6,
+        p.unshot_fraction * 100.0
+    )
 }
 
 /// The solver thread: runs the solve session (which, with adaptive
@@ -578,5 +610,33 @@ impl<'a> Ui<'a> {
             .map(|n| PathBuf::from(format!("{}-{n:03}.tiff", self.stem)))
             .find(|p| !p.exists())
             .unwrap_or_else(|| PathBuf::from(format!("{}.tiff", self.stem)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_closing_summary_says_how_far_the_solve_got() {
+        let progress = |stopped| Progress {
+            step: 65,
+            unshot_fraction: 0.00097,
+            rays: 12_700_000,
+            solving: 1.351,
+            stopped,
+            ..Progress::default()
+        };
+        let p = progress(Some(StopReason::Converged));
+        assert_eq!(
+            closing_summary("cornell", &p, true, 2),
+            "cornell: window closed after 65 steps, 1.35 s solving, 12.7 M rays, \
+             0.097% unshot, converged, 2 pictures written"
+        );
+        let running = progress(None);
+        let line = closing_summary("cornell", &running, true, 0);
+        assert!(line.ends_with("unshot, not converged"), "{line}");
+        let dark = closing_summary("cornell", &p, false, 1);
+        assert!(dark.ends_with("nothing emits, 1 picture written"), "{dark}");
     }
 }
