@@ -1,5 +1,5 @@
-//! Camera controls for the window: orbit around the look-at point, zoom
-//! towards it, walk, and reset. Pure geometry on a [`Camera`], so it is
+//! Camera controls for the window: look around from the eye, orbit around
+//! the look-at point, zoom towards it, walk, and reset. Pure geometry on a [`Camera`], so it is
 //! tested without a window.
 
 use crate::scene::Camera;
@@ -72,6 +72,30 @@ impl CameraControl {
             Quat::from_axis_angle(right, target - current) * offset
         };
         self.camera.eye = self.camera.lookat + offset;
+    }
+
+    /// Turns the view about the eye (the eye stays where it is, so from
+    /// inside a room the view stays inside it): `yaw` radians about the up
+    /// direction (positive turns left), then `pitch` radians about the
+    /// camera's right axis (positive looks up). The look-at point keeps its
+    /// distance; a pitch that would look past straight up or down stops at
+    /// [`POLE_MARGIN`].
+    pub fn look(&mut self, yaw: f32, pitch: f32) {
+        let up = self.camera.up.normalize_or_zero();
+        if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() {
+            return;
+        }
+        let view = Quat::from_axis_angle(up, yaw) * (self.camera.lookat - self.camera.eye);
+        // Angle between the view direction and up, in [0, π].
+        let current = view.normalize().dot(up).clamp(-1.0, 1.0).acos();
+        let target = (current - pitch).clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
+        let right = up.cross(view).normalize_or_zero();
+        let view = if right == Vec3::ZERO {
+            view
+        } else {
+            Quat::from_axis_angle(right, target - current) * view
+        };
+        self.camera.lookat = self.camera.eye + view;
     }
 
     /// Multiplies the distance to the look-at point by `factor` (below 1
@@ -154,6 +178,35 @@ mod tests {
         let mut c = CameraControl::new(home());
         c.orbit(0.0, 0.5);
         assert!(c.camera().eye.y > home().eye.y);
+    }
+
+    #[test]
+    fn looking_around_keeps_the_eye_and_turns_the_view() {
+        let mut c = CameraControl::new(home());
+        let eye = c.camera().eye;
+        let d = c.distance();
+        // A quarter turn left: from looking down +z to looking down +x
+        // (the camera's right is -x).
+        c.look(std::f32::consts::FRAC_PI_2, 0.0);
+        assert_eq!(c.camera().eye, eye);
+        let view = (c.camera().lookat - eye).normalize();
+        assert!(view.distance(Vec3::X) < 1e-5, "{view}");
+        assert!((c.distance() - d).abs() < 1e-4 * d);
+        // Looking up: the view rises, and never past straight up.
+        c.look(0.0, 0.5);
+        assert!((c.camera().lookat - eye).normalize().y > 0.4);
+        c.look(0.0, 10.0);
+        let up = (c.camera().lookat - eye).normalize().dot(Vec3::Y);
+        // Stopped at the margin from straight up.
+        assert!(
+            up <= (POLE_MARGIN * 0.9).cos() && up > (POLE_MARGIN * 2.0).cos(),
+            "{up}"
+        );
+        assert_eq!(c.camera().eye, eye);
+        // Nonsense input changes nothing.
+        let before = *c.camera();
+        c.look(f32::NAN, 0.0);
+        assert_eq!(*c.camera(), before);
     }
 
     #[test]

@@ -46,6 +46,30 @@ pub const REDRAW_INTERVAL: Duration = Duration::from_millis(50);
 pub const FRAME_INTERVAL: Duration = Duration::from_millis(16);
 /// Radians of orbit per pixel of mouse drag.
 pub const ORBIT_PER_PIXEL: f32 = 0.008;
+
+/// Radians the view turns per pixel of left-drag when looking around: a
+/// drag across a 640-pixel window turns it by about 100 degrees.
+pub const LOOK_PER_PIXEL: f32 = 0.003;
+
+/// What a left-drag does in the window.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Navigation {
+    /// Turn the view about the eye (the default: from inside a room, the
+    /// view stays in the room).
+    Look,
+    /// Turn the eye around the look-at point (to inspect an object).
+    Orbit,
+}
+
+impl Navigation {
+    /// How the title and the terminal name the mode.
+    pub fn name(self) -> &'static str {
+        match self {
+            Navigation::Look => "look around",
+            Navigation::Orbit => "orbit",
+        }
+    }
+}
 /// Zoom factor per pixel of right-drag (`exp` of this times the pixels).
 pub const ZOOM_PER_PIXEL: f32 = 0.01;
 /// Zoom factor per notch of the mouse wheel.
@@ -67,8 +91,10 @@ keys:
   r                reset the camera
   h                this help
   arrows, a, d     walk (Shift+W/A/S/D too); PageUp / PageDown: up / down
+  o                switch left-drag between looking around and orbiting
 mouse:
-  left-drag        orbit around the look-at point
+  left-drag        look around from the eye (orbit around the look-at
+                   point after o)
   right-drag, wheel  zoom towards / away from the look-at point";
 
 /// Why the window could not run.
@@ -182,6 +208,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
             mesh: None,
             last_mouse: None,
             written: 0,
+            navigation: Navigation::Look,
             presses,
             pending_name: None,
         };
@@ -319,6 +346,8 @@ struct Ui<'a> {
     mesh: Option<MeshRef<'a>>,
     last_mouse: Option<(f32, f32)>,
     written: u32,
+    /// What a left-drag does; `o` switches.
+    navigation: Navigation,
     presses: Arc<Mutex<Vec<Key>>>,
     /// A `w` waiting for its file name from the terminal, with the picture
     /// as it was when `w` was pressed.
@@ -412,9 +441,10 @@ impl<'a> Ui<'a> {
                 (k, levels) => format!("refinement {}/{levels} · ", k - 1),
             };
             let new_title = format!(
-                "radiosity — {} — {refining}step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state}",
+                "radiosity — {} — {refining}step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state} · {} · h: help",
                 self.stem,
-                unshot * 100.0
+                unshot * 100.0,
+                self.navigation.name()
             );
             if new_title != title {
                 self.window.set_title(&new_title);
@@ -490,6 +520,14 @@ impl<'a> Ui<'a> {
                     dirty = true;
                 }
                 Key::H => println!("{KEY_HELP}"),
+                Key::O => {
+                    self.navigation = match self.navigation {
+                        Navigation::Look => Navigation::Orbit,
+                        Navigation::Orbit => Navigation::Look,
+                    };
+                    println!("left-drag: {}", self.navigation.name());
+                    dirty = true;
+                }
                 Key::Up | Key::W => {
                     self.camera.walk(0.0, 0.0, WALK_STEP);
                     dirty = true;
@@ -536,7 +574,10 @@ impl<'a> Ui<'a> {
             (Some((x, y)), Some((x0, y0))) if left || right => {
                 let (dx, dy) = (x - x0, y - y0);
                 if dx != 0.0 || dy != 0.0 {
-                    if left {
+                    if left && self.navigation == Navigation::Look {
+                        // Drag right turns right; drag up looks up.
+                        self.camera.look(-dx * LOOK_PER_PIXEL, -dy * LOOK_PER_PIXEL);
+                    } else if left {
                         self.camera
                             .orbit(-dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
                     } else {
