@@ -100,7 +100,15 @@ fn start_xvfb() -> Option<(Reaper, String)> {
             }
             Path::new(&socket).exists().then_some(true)
         });
-        if up == Some(true) {
+        // The socket can appear before the server takes connections (seen
+        // on a loaded machine: the program's XOpenDisplay failed): wait
+        // until a client gets an answer.
+        let answers = || {
+            wait_for(Duration::from_secs(10), || {
+                xdotool(&display, &["getdisplaygeometry"]).map(|_| ())
+            })
+        };
+        if up == Some(true) && answers().is_some() {
             return Some((xvfb, display));
         }
     }
