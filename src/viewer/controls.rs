@@ -54,24 +54,10 @@ impl CameraControl {
     /// (positive looks down from higher up). The distance is kept; a pitch
     /// that would pass over the pole stops at [`POLE_MARGIN`].
     pub fn orbit(&mut self, yaw: f32, pitch: f32) {
-        let up = self.camera.up.normalize_or_zero();
-        if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() {
-            return;
-        }
         let offset = self.camera.eye - self.camera.lookat;
-        let offset = Quat::from_axis_angle(up, yaw) * offset;
-        // Angle between the offset (lookat → eye) and up, in [0, π].
-        let current = offset.normalize().dot(up).clamp(-1.0, 1.0).acos();
-        let target = (current - pitch).clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
-        let right = up.cross(offset).normalize_or_zero();
-        let offset = if right == Vec3::ZERO {
-            offset
-        } else {
-            // About `up × offset`, a positive angle turns the offset away
-            // from `up`, increasing its angle to it by that much.
-            Quat::from_axis_angle(right, target - current) * offset
-        };
-        self.camera.eye = self.camera.lookat + offset;
+        if let Some(offset) = turn(offset, self.camera.up, yaw, pitch) {
+            self.camera.eye = self.camera.lookat + offset;
+        }
     }
 
     /// Turns the view about the eye (the eye stays where it is, so from
@@ -81,21 +67,10 @@ impl CameraControl {
     /// distance; a pitch that would look past straight up or down stops at
     /// [`POLE_MARGIN`].
     pub fn look(&mut self, yaw: f32, pitch: f32) {
-        let up = self.camera.up.normalize_or_zero();
-        if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() {
-            return;
+        let view = self.camera.lookat - self.camera.eye;
+        if let Some(view) = turn(view, self.camera.up, yaw, pitch) {
+            self.camera.lookat = self.camera.eye + view;
         }
-        let view = Quat::from_axis_angle(up, yaw) * (self.camera.lookat - self.camera.eye);
-        // Angle between the view direction and up, in [0, π].
-        let current = view.normalize().dot(up).clamp(-1.0, 1.0).acos();
-        let target = (current - pitch).clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
-        let right = up.cross(view).normalize_or_zero();
-        let view = if right == Vec3::ZERO {
-            view
-        } else {
-            Quat::from_axis_angle(right, target - current) * view
-        };
-        self.camera.lookat = self.camera.eye + view;
     }
 
     /// Multiplies the distance to the look-at point by `factor` (below 1
@@ -125,6 +100,29 @@ impl CameraControl {
             self.camera.lookat += delta;
         }
     }
+}
+
+/// `v` turned `yaw` radians about `up`, then tilted towards `up` by
+/// `pitch` radians (about `up × v`), its angle to `up` kept within
+/// [`POLE_MARGIN`] of either pole; `None` for a zero `up` or non-finite
+/// angles. The length is kept.
+fn turn(v: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Vec3> {
+    let up = up.normalize_or_zero();
+    if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() {
+        return None;
+    }
+    let v = Quat::from_axis_angle(up, yaw) * v;
+    // Angle between `v` and up, in [0, π].
+    let current = v.normalize().dot(up).clamp(-1.0, 1.0).acos();
+    let target = (current - pitch).clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
+    let right = up.cross(v).normalize_or_zero();
+    Some(if right == Vec3::ZERO {
+        v
+    } else {
+        // About `up × v`, a positive angle turns `v` away from `up`,
+        // increasing its angle to it by that much.
+        Quat::from_axis_angle(right, target - current) * v
+    })
 }
 
 #[cfg(test)]
