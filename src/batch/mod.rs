@@ -289,7 +289,7 @@ pub fn run_prepared(
         } else {
             rasterizer.inv_depth().to_vec()
         };
-        render::draw_mesh_edges(&mut picture, mesh, &view, &depth, render::MESH_COLOR);
+        render::draw_mesh_edges(&mut picture, mesh, &view, &depth, render::MESH_LINES);
         output::write_rgb8(&output, &picture).map_err(RunError::Write)?;
     } else {
         output::write_picture(&output, frame, Exposure::Fixed(exposure))

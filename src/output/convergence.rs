@@ -25,10 +25,8 @@
 use super::{write_rgb8, OutputError, PictureFormat};
 use image::RgbImage;
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
 use std::io::{self, Write};
 use std::path::Path;
-use std::sync::Once;
 
 /// The plot's size in pixels (width, height).
 pub const PLOT_SIZE: (u32, u32) = (900, 560);
@@ -36,9 +34,8 @@ pub const PLOT_SIZE: (u32, u32) = (900, 560);
 /// The CSV header line (without the line break).
 pub const LOG_HEADER: &str = "step,shooter,shooter_line,shot_power,unshot_fraction,rays,seconds";
 
-/// The font family the plot's text is drawn with.
-const FONT: &str = "sans-serif";
-static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/NotoMono-Regular.ttf");
+/// The font family the plot's text is drawn with (the bundled font).
+const FONT: &str = crate::render::text::FONT_FAMILY;
 
 /// One shooting step as logged (see the module docs for each column).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,12 +90,7 @@ pub fn check_plot_path(path: &Path) -> Result<(), OutputError> {
 /// that stops at `threshold` (a fraction of the emitted power); `title`
 /// names the scene.
 pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImage, String> {
-    static REGISTER: Once = Once::new();
-    REGISTER.call_once(|| {
-        // The bytes are a valid font, checked by the tests; a failure here
-        // only means text is not drawn.
-        let _ = register_font(FONT, FontStyle::Normal, FONT_BYTES);
-    });
+    crate::render::text::register_bundled_font();
     let (w, h) = PLOT_SIZE;
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
@@ -192,15 +184,6 @@ mod tests {
                 seconds: 0.1 * i as f64,
             })
             .collect()
-    }
-
-    #[test]
-    fn the_bundled_font_is_a_font() {
-        assert!(ab_glyph_ok(FONT_BYTES));
-    }
-
-    fn ab_glyph_ok(bytes: &'static [u8]) -> bool {
-        register_font("test-font", FontStyle::Normal, bytes).is_ok()
     }
 
     #[test]

@@ -215,6 +215,37 @@ impl View {
         Some(DVec2::new(x, y))
     }
 
+    /// The world-space direction (unit length) from the eye through the
+    /// point `(x, y)` of the picture, in pixels from its top-left corner
+    /// (a pixel's centre is at `+0.5`).
+    pub fn ray_direction(&self, x: f64, y: f64) -> Vec3 {
+        let f = self.focal_px();
+        let cx = (x - f64::from(self.width) / 2.0) / f;
+        let cy = (f64::from(self.height) / 2.0 - y) / f;
+        (self.right * cx as f32 + self.up * cy as f32 + self.forward).normalize()
+    }
+
+    /// The world-space point seen at `(x, y)` of the picture (pixels from
+    /// its top-left corner) at camera-space depth `1 / inv_depth` (the
+    /// rasterizer's depth buffer value; `z` in scene units along the view
+    /// direction, not the distance along the ray). `None` when `inv_depth`
+    /// is not finite and positive (nothing drawn there). The inverse of
+    /// [`View::project`] for a point in front of the eye.
+    pub fn unproject(&self, x: f64, y: f64, inv_depth: f64) -> Option<Vec3> {
+        if !(inv_depth.is_finite() && inv_depth > 0.0) {
+            return None;
+        }
+        let z = 1.0 / inv_depth;
+        let f = self.focal_px();
+        let cx = (x - f64::from(self.width) / 2.0) * z / f;
+        let cy = (f64::from(self.height) / 2.0 - y) * z / f;
+        let p = self.eye.as_dvec3()
+            + self.right.as_dvec3() * cx
+            + self.up.as_dvec3() * cy
+            + self.forward.as_dvec3() * z;
+        Some(p.as_vec3())
+    }
+
     /// A world-space point projected to pixel space (see the module docs).
     /// `None` when the point is not in front of the eye. Points outside the
     /// field of view give coordinates outside `[0, width] × [0, height]`.
@@ -334,5 +365,26 @@ mod tests {
         let v = View::new(&camera()).unwrap();
         assert_eq!(v.with_near(0.0), Err(ViewError::BadNear(0.0)));
         assert!((v.near() - 10.0 * DEFAULT_NEAR_FRACTION).abs() < 1e-9);
+    }
+
+    #[test]
+    fn unproject_inverts_project() {
+        let v = View::with_size(&camera(), 320, 240).unwrap();
+        for p in [
+            Vec3::new(1.0, 2.0, -1.0),
+            Vec3::new(0.3, 2.5, -6.0),
+            Vec3::new(2.2, 1.1, -20.0),
+        ] {
+            let px = v.project(p).unwrap();
+            let z = f64::from(v.to_camera(p).z);
+            let back = v
+                .unproject(f64::from(px.x), f64::from(px.y), 1.0 / z)
+                .unwrap();
+            assert!(back.distance(p) < 1e-4 * z as f32, "{back} vs {p}");
+            let ray = v.ray_direction(f64::from(px.x), f64::from(px.y));
+            assert!(ray.distance((p - v.eye()).normalize()) < 1e-5, "{ray}");
+        }
+        assert_eq!(v.unproject(10.0, 10.0, 0.0), None);
+        assert_eq!(v.unproject(10.0, 10.0, f64::NAN), None);
     }
 }

@@ -29,11 +29,12 @@ pub mod camera;
 pub mod coverage;
 pub mod overlay;
 pub mod raster;
+pub mod text;
 pub mod tonemap;
 
 pub use camera::{View, ViewError};
 pub use coverage::{PictureCoverage, DARK_PICTURE_FRACTION};
-pub use overlay::{draw_mesh_edges, MESH_COLOR};
+pub use overlay::{draw_mesh_edges, LinePalette, MESH_COLOR, MESH_COLOR_ON_LIGHT, MESH_LINES};
 pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
 pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};
 

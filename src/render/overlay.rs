@@ -3,27 +3,87 @@
 //!
 //! Edges are clipped to the near plane, projected, clipped to the picture
 //! and stepped pixel by pixel. A pixel of an edge is drawn only when the
-//! edge is not behind the surface the picture shows there (depth test
-//! against the rasterizer's `1/z` buffer, with a small bias so an edge lying
-//! on its own surface wins).
+//! edge is not behind the surface the picture shows there: a depth test
+//! against the rasterizer's `1/z` buffer with a slope-scaled offset (the
+//! farthest surface among the pixel and its eight neighbours, less a small
+//! bias), so an edge lying on a wall seen at a grazing angle, whose depth
+//! changes by more than the bias from one pixel to the next, stays a
+//! continuous line instead of breaking into dashes.
+//!
+//! Each pixel of a line takes the colour of [`MESH_LINES`] that contrasts
+//! with the picture under it: a light cyan on dark and mid-tone surfaces, a
+//! deep blue on light ones, so the mesh is readable on every wall.
 
 use super::camera::View;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
 use image::RgbImage;
 
-/// Colour of element mesh lines, in the window and in pictures: a cyan
-/// that stands out from the warm and grey tones of lit interiors.
+/// The two colours of element mesh lines, in the window and in pictures
+/// (sRGB, 8 bits a channel). A pixel of a line is drawn in `on_dark` where
+/// the picture under it has a luma (Rec. 709 weights on the 8-bit values)
+/// below `threshold`, else in `on_light`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LinePalette {
+    /// Colour over dark and mid-tone pixels.
+    pub on_dark: [u8; 3],
+    /// Colour over light pixels.
+    pub on_light: [u8; 3],
+    /// Luma, 0–255, from which a pixel counts as light.
+    pub threshold: u8,
+}
+
+impl LinePalette {
+    /// One colour everywhere.
+    pub const fn single(color: [u8; 3]) -> LinePalette {
+        LinePalette {
+            on_dark: color,
+            on_light: color,
+            threshold: 0,
+        }
+    }
+
+    /// The colour of a line pixel over the picture colour `under`.
+    pub fn over(&self, under: [u8; 3]) -> [u8; 3] {
+        if luma(under) < f32::from(self.threshold) {
+            self.on_dark
+        } else {
+            self.on_light
+        }
+    }
+}
+
+/// Luma of an 8-bit sRGB colour, 0–255 (Rec. 709 weights).
+fn luma([r, g, b]: [u8; 3]) -> f32 {
+    0.2126 * f32::from(r) + 0.7152 * f32::from(g) + 0.0722 * f32::from(b)
+}
+
+/// The element mesh's line colours: a light cyan (luma 184) that stands
+/// out from the warm and grey tones of lit interiors, and, on surfaces
+/// lighter than luma 150 (where cyan would wash out), a deep blue (luma
+/// 51). Either keeps a contrast of about 1:2.5 or more with what is under it.
+pub const MESH_LINES: LinePalette = LinePalette {
+    on_dark: MESH_COLOR,
+    on_light: MESH_COLOR_ON_LIGHT,
+    threshold: 150,
+};
+
+/// The mesh line colour on dark and mid-tone surfaces (see [`MESH_LINES`]).
 pub const MESH_COLOR: [u8; 3] = [40, 220, 255];
 
-/// An edge pixel is drawn when its `1/z` is at least the surface's times
-/// `1 − LINE_DEPTH_BIAS`: edges lie exactly on their surface, and the
-/// picture's depth is interpolated per triangle, so equality needs slack.
+/// The mesh line colour on light surfaces (see [`MESH_LINES`]).
+pub const MESH_COLOR_ON_LIGHT: [u8; 3] = [0, 50, 140];
+
+/// An edge pixel is drawn when its `1/z` is at least that of the farthest
+/// surface among the pixel and its neighbours times `1 − LINE_DEPTH_BIAS`:
+/// edges lie exactly on their surface, and the picture's depth is
+/// interpolated per triangle at pixel centres, so equality needs slack.
 pub const LINE_DEPTH_BIAS: f64 = 1e-3;
 
 /// Draws every element edge of `mesh` (sky facets left out, as the
-/// picture leaves them out) seen through `view` onto `image` in
-/// `color`, hidden where a nearer surface covers it. `inv_depth` is the
+/// picture leaves them out) seen through `view` onto `image` in the
+/// `palette` colour that contrasts with the picture under each pixel,
+/// hidden where a nearer surface covers it. `inv_depth` is the
 /// rasterizer's depth buffer for the same view ([`super::Rasterizer::inv_depth`]),
 /// one `1/z` per pixel; if its size does not match the image, nothing is drawn.
 pub fn draw_mesh_edges(
@@ -31,12 +91,21 @@ pub fn draw_mesh_edges(
     mesh: &Mesh,
     view: &View,
     inv_depth: &[f64],
-    color: [u8; 3],
+    palette: LinePalette,
 ) {
     let (w, h) = (image.width() as usize, image.height() as usize);
     if inv_depth.len() != w * h || w == 0 || h == 0 {
         return;
     }
+    // The colours are chosen against the picture as it was: an edge drawn
+    // twice (shared by two elements) must not contrast with itself.
+    let under = image.clone();
+    let farthest = farthest_neighbour_depth(inv_depth, w, h);
+    let target = Target {
+        under: &under,
+        farthest: &farthest,
+        palette,
+    };
     for (element, polygon) in mesh.elements.iter().zip(&mesh.element_polygon) {
         if mesh.polygons.get(polygon.index()).is_none_or(|pm| pm.sky) {
             continue;
@@ -51,20 +120,46 @@ pub fn draw_mesh_edges(
             };
             let ca = view.to_camera(*pa).as_dvec3();
             let cb = view.to_camera(*pb).as_dvec3();
-            draw_segment(image, view, inv_depth, ca, cb, color);
+            draw_segment(image, view, &target, ca, cb);
         }
     }
 }
 
+/// What an edge pixel is tested against and coloured by.
+struct Target<'a> {
+    /// The picture before any line was drawn.
+    under: &'a RgbImage,
+    /// Per pixel, the smallest covered `1/z` among it and its neighbours.
+    farthest: &'a [f64],
+    palette: LinePalette,
+}
+
+/// Per pixel, the smallest non-zero `1/z` (the farthest surface) among the
+/// pixel and its eight neighbours, or 0 where none of them is covered.
+/// Testing an edge against it is a slope-scaled depth offset: where the
+/// surface's depth changes fast across pixels (a grazing wall), the
+/// allowance grows with it.
+fn farthest_neighbour_depth(inv_depth: &[f64], w: usize, h: usize) -> Vec<f64> {
+    let mut out = vec![0.0; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let mut far = f64::INFINITY;
+            for ny in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+                for nx in x.saturating_sub(1)..=(x + 1).min(w - 1) {
+                    let d = inv_depth[ny * w + nx];
+                    if d > 0.0 && d < far {
+                        far = d;
+                    }
+                }
+            }
+            out[y * w + x] = if far.is_finite() { far } else { 0.0 };
+        }
+    }
+    out
+}
+
 /// One camera-space segment, clipped to the near plane and the picture.
-fn draw_segment(
-    image: &mut RgbImage,
-    view: &View,
-    inv_depth: &[f64],
-    a: DVec3,
-    b: DVec3,
-    color: [u8; 3],
-) {
+fn draw_segment(image: &mut RgbImage, view: &View, target: &Target, a: DVec3, b: DVec3) {
     let near = f64::from(view.near());
     let (mut a, mut b) = (a, b);
     if a.z < near && b.z < near {
@@ -97,8 +192,9 @@ fn draw_segment(
         }
         let (x, y) = (x as usize, y as usize);
         let inv_z = za + (zb - za) * t;
-        if inv_z >= inv_depth[y * width + x] * (1.0 - LINE_DEPTH_BIAS) {
-            image.put_pixel(x as u32, y as u32, image::Rgb(color));
+        if inv_z >= target.farthest[y * width + x] * (1.0 - LINE_DEPTH_BIAS) {
+            let under = target.under.get_pixel(x as u32, y as u32).0;
+            image.put_pixel(x as u32, y as u32, image::Rgb(target.palette.over(under)));
         }
     }
 }
@@ -187,7 +283,13 @@ mod tests {
         let frame = r.render(&m, &radiosity, &view).unwrap().clone();
         let mut img = to_srgb8(&frame, 1.0);
         let before = img.clone();
-        draw_mesh_edges(&mut img, &m, &view, r.inv_depth(), [255, 0, 0]);
+        draw_mesh_edges(
+            &mut img,
+            &m,
+            &view,
+            r.inv_depth(),
+            LinePalette::single([255, 0, 0]),
+        );
         let red = |img: &RgbImage, x: u32, y: u32| img.get_pixel(x, y).0 == [255, 0, 0];
         // The grey grid's middle vertical line (x = 0 in the world) is at
         // the picture's centre column; below the black square's edge it is
@@ -240,7 +342,7 @@ mod tests {
         .unwrap();
         let view = View::new(&s.camera).unwrap();
         let mut img = RgbImage::new(view.width(), view.height());
-        draw_mesh_edges(&mut img, &m, &view, &[], [255, 0, 0]);
+        draw_mesh_edges(&mut img, &m, &view, &[], MESH_LINES);
         assert!(img.pixels().all(|p| p.0 == [0, 0, 0]));
     }
 
@@ -254,5 +356,88 @@ mod tests {
             clip_to_rect(DVec2::new(-10.0, 50.0), DVec2::new(20.0, 50.0), 10.0, 10.0),
             None
         );
+    }
+
+    /// A floor seen at a grazing angle, lit evenly at `level`, with its
+    /// mesh lines drawn in the default palette; returns the picture, the
+    /// view and the `z` of every mesh line across the floor.
+    fn grazing_floor(level: f64) -> (RgbImage, View, Vec<f32>) {
+        let s = testutil::scene(
+            vec![testutil::polygon(
+                0,
+                &[[-4., 0., 0.], [4., 0., 0.], [4., 0., -40.], [-4., 0., -40.]],
+            )],
+            vec![testutil::grey("floor", 0.5, 0.0)],
+        );
+        let mut camera = s.camera;
+        camera.eye = glam::Vec3::new(0.05, 0.25, 1.0);
+        // Turned a little sideways, so lines across the floor are slanted.
+        camera.lookat = glam::Vec3::new(3.0, 0.0, -20.0);
+        camera.width = 400;
+        camera.height = 300;
+        let m = mesh::build(
+            &s,
+            &MeshOptions {
+                lenmax: 1.0,
+                inset: 0.0,
+            },
+        )
+        .unwrap();
+        let radiosity = vec![Rgb::splat(level); m.vertex_count()];
+        let view = View::new(&camera).unwrap();
+        let mut r = Rasterizer::new();
+        let frame = r.render(&m, &radiosity, &view).unwrap().clone();
+        let mut img = to_srgb8(&frame, 1.0);
+        draw_mesh_edges(&mut img, &m, &view, r.inv_depth(), MESH_LINES);
+        let mut rows: Vec<f32> = m.positions.iter().map(|p| p.z).collect();
+        rows.sort_by(f32::total_cmp);
+        rows.dedup();
+        (img, view, rows)
+    }
+
+    #[test]
+    fn lines_on_a_grazing_floor_stay_continuous() {
+        let (img, view, rows) = grazing_floor(0.05);
+        // The mesh lines across the floor, far from the eye, are seen at a
+        // grazing angle: each must show in every column it crosses
+        // (within a pixel above or below).
+        let mut checked = 0;
+        for z in rows.into_iter().filter(|z| (-30.0..-5.0).contains(z)) {
+            let a = view.project(glam::Vec3::new(-3.5, 0.0, z)).unwrap();
+            let b = view.project(glam::Vec3::new(3.5, 0.0, z)).unwrap();
+            let (mut columns, mut drawn) = (0, 0);
+            for x in (a.x.ceil() as u32)..(b.x.floor() as u32).min(399) {
+                let t = (x as f32 + 0.5 - a.x) / (b.x - a.x);
+                let y = (a.y + (b.y - a.y) * t).floor() as u32;
+                columns += 1;
+                if (y.saturating_sub(1)..=(y + 1).min(299))
+                    .any(|y| img.get_pixel(x, y).0 == MESH_COLOR)
+                {
+                    drawn += 1;
+                }
+            }
+            assert!(columns > 20, "{columns} columns");
+            assert_eq!(drawn, columns, "the line at z = {z} is broken");
+            checked += 1;
+        }
+        assert!(checked >= 10, "{checked} lines checked");
+    }
+
+    #[test]
+    fn line_colour_contrasts_with_the_surface() {
+        let count = |img: &RgbImage, c: [u8; 3]| img.pixels().filter(|p| p.0 == c).count();
+        // Dark floor: light cyan lines only.
+        let (dark, _, _) = grazing_floor(0.05);
+        assert!(count(&dark, MESH_COLOR) > 100);
+        assert_eq!(count(&dark, MESH_COLOR_ON_LIGHT), 0);
+        // White floor: deep blue lines (cyan only where a line pixel lies
+        // on the black background beyond the floor's far edge).
+        let (light, _, _) = grazing_floor(1.0);
+        let (blue, cyan) = (
+            count(&light, MESH_COLOR_ON_LIGHT),
+            count(&light, MESH_COLOR),
+        );
+        assert!(blue > 10 * cyan && blue > 1000, "{blue} blue, {cyan} cyan");
+        assert!(luma(MESH_COLOR) > 150.0 && luma(MESH_COLOR_ON_LIGHT) < 100.0);
     }
 }

@@ -1,6 +1,7 @@
 //! Camera controls for the window: look around from the eye, orbit around
-//! the look-at point, zoom towards it, walk, and reset. Pure geometry on a [`Camera`], so it is
-//! tested without a window.
+//! a point (the surface under the cursor, or the look-at point), move
+//! towards a point and stop in front of it, walk, and reset. Pure geometry
+//! on a [`Camera`], so it is tested without a window.
 
 use crate::scene::Camera;
 use glam::{Quat, Vec3};
@@ -54,9 +55,34 @@ impl CameraControl {
     /// (positive looks down from higher up). The distance is kept; a pitch
     /// that would pass over the pole stops at [`POLE_MARGIN`].
     pub fn orbit(&mut self, yaw: f32, pitch: f32) {
-        let offset = self.camera.eye - self.camera.lookat;
-        if let Some(offset) = turn(offset, self.camera.up, yaw, pitch) {
-            self.camera.eye = self.camera.lookat + offset;
+        self.orbit_about(self.camera.lookat, yaw, pitch);
+    }
+
+    /// Turns the whole camera (eye and look-at point) rigidly around
+    /// `pivot`, a point in scene units (in the window, the surface point
+    /// under the cursor): `yaw` radians about the up direction, then
+    /// `pitch` radians about the axis across the eye's offset from the
+    /// pivot (positive raises the eye). The eye keeps its distance to the
+    /// pivot and the pivot stays where it is in the picture. A pitch that
+    /// would carry the eye over the pivot's pole stops at [`POLE_MARGIN`];
+    /// a turn that would leave the view direction within the margin of
+    /// the up direction, or non-finite input, changes nothing.
+    pub fn orbit_about(&mut self, pivot: Vec3, yaw: f32, pitch: f32) {
+        if !pivot.is_finite() {
+            return;
+        }
+        let Some(rotation) = rotation(self.camera.eye - pivot, self.camera.up, yaw, pitch) else {
+            return;
+        };
+        let eye = pivot + rotation * (self.camera.eye - pivot);
+        let lookat = pivot + rotation * (self.camera.lookat - pivot);
+        let up = self.camera.up.normalize_or_zero();
+        let view = (lookat - eye).normalize_or_zero();
+        // An off-centre pivot turns the view direction by more than the
+        // eye's offset: keep the camera's invariant (view never along up).
+        if view.dot(up).abs() < (POLE_MARGIN * 0.5).cos() && eye.is_finite() && lookat.is_finite() {
+            self.camera.eye = eye;
+            self.camera.lookat = lookat;
         }
     }
 
@@ -87,6 +113,38 @@ impl CameraControl {
         self.camera.eye = self.camera.lookat + direction * distance;
     }
 
+    /// Moves the camera (eye and look-at point together, so the view keeps
+    /// its direction) along the line from the eye to `target`, a point in
+    /// scene units (in the window, the surface under the cursor), until
+    /// the eye's distance to it is `factor` times what it was (below 1
+    /// moves closer). Moving closer stops `stop` scene units in front of
+    /// the target, so the eye never reaches the surface it moves towards;
+    /// an eye already that close does not move closer. Moving away is
+    /// limited to [`MAX_DISTANCE_FACTOR`] scene-camera distances.
+    /// Non-finite or non-positive input changes nothing.
+    pub fn dolly(&mut self, target: Vec3, factor: f32, stop: f32) {
+        if !(factor.is_finite() && factor > 0.0 && stop.is_finite() && stop >= 0.0)
+            || !target.is_finite()
+        {
+            return;
+        }
+        let offset = target - self.camera.eye;
+        let d = offset.length();
+        if !(d.is_finite() && d > 0.0) {
+            return;
+        }
+        let wanted = if factor < 1.0 {
+            (d * factor).max(stop.min(d))
+        } else {
+            (d * factor).min(d.max(self.home_distance() * MAX_DISTANCE_FACTOR))
+        };
+        let delta = offset / d * (d - wanted);
+        if delta.is_finite() {
+            self.camera.eye += delta;
+            self.camera.lookat += delta;
+        }
+    }
+
     /// Moves eye and look-at point together: `right`, `up` and `forward`
     /// in units of the current distance to the look-at point.
     pub fn walk(&mut self, right: f32, up: f32, forward: f32) {
@@ -102,27 +160,37 @@ impl CameraControl {
     }
 }
 
-/// `v` turned `yaw` radians about `up`, then tilted towards `up` by
-/// `pitch` radians (about `up × v`), its angle to `up` kept within
-/// [`POLE_MARGIN`] of either pole; `None` for a zero `up` or non-finite
-/// angles. The length is kept.
-fn turn(v: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Vec3> {
+/// The rotation that turns `v` by `yaw` radians about `up`, then tilts it
+/// towards `up` by `pitch` radians (about `up × v`), its angle to `up`
+/// kept within [`POLE_MARGIN`] of either pole; `None` for a zero `up` or
+/// non-finite angles. Applied to `v` it gives what [`turn`] gives; applied
+/// to other points it moves them rigidly with `v`.
+fn rotation(v: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Quat> {
     let up = up.normalize_or_zero();
-    if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() {
+    if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() || !v.is_finite() {
         return None;
     }
-    let v = Quat::from_axis_angle(up, yaw) * v;
+    let spin = Quat::from_axis_angle(up, yaw);
+    let v = spin * v;
     // Angle between `v` and up, in [0, π].
-    let current = v.normalize().dot(up).clamp(-1.0, 1.0).acos();
+    let current = v.normalize_or_zero().dot(up).clamp(-1.0, 1.0).acos();
     let target = (current - pitch).clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
     let right = up.cross(v).normalize_or_zero();
     Some(if right == Vec3::ZERO {
-        v
+        spin
     } else {
         // About `up × v`, a positive angle turns `v` away from `up`,
         // increasing its angle to it by that much.
-        Quat::from_axis_angle(right, target - current) * v
+        Quat::from_axis_angle(right, target - current) * spin
     })
+}
+
+/// `v` turned `yaw` radians about `up`, then tilted towards `up` by
+/// `pitch` radians, its angle to `up` kept within [`POLE_MARGIN`] of
+/// either pole (see [`rotation`]); `None` for a zero `up` or non-finite
+/// angles. The length is kept.
+fn turn(v: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Vec3> {
+    rotation(v, up, yaw, pitch).map(|q| q * v)
 }
 
 #[cfg(test)]
@@ -249,5 +317,72 @@ mod tests {
         c.walk(0.1, 0.0, 0.0);
         let right = (home().lookat - home().eye).normalize().cross(Vec3::Y);
         assert!((c.camera().eye - home().eye).normalize().dot(right) > 0.999);
+    }
+
+    #[test]
+    fn orbiting_a_point_keeps_it_in_place_on_the_picture() {
+        let mut c = CameraControl::new(home());
+        // A point off the view's centre, as picked under the cursor.
+        let pivot = Vec3::new(1.5, 0.5, 1.0);
+        let before = crate::render::View::new(c.camera())
+            .unwrap()
+            .project(pivot)
+            .unwrap();
+        let d = c.camera().eye.distance(pivot);
+        for (yaw, pitch) in [(0.3, 0.0), (0.0, 0.2), (-0.5, -0.3), (0.2, 0.1)] {
+            c.orbit_about(pivot, yaw, pitch);
+            assert!((c.camera().eye.distance(pivot) - d).abs() < 1e-4 * d);
+            let now = crate::render::View::new(c.camera())
+                .unwrap()
+                .project(pivot)
+                .unwrap();
+            assert!(now.distance(before) < 0.01, "{now} vs {before}");
+        }
+        // Yaw moves the eye around the pivot, not around the look-at point.
+        assert_ne!(c.camera().eye, home().eye);
+        assert!((c.distance() - home().eye.distance(home().lookat)).abs() < 1e-3);
+        // A turn that would look straight down is refused, not flipped.
+        let mut c = CameraControl::new(home());
+        for _ in 0..100 {
+            c.orbit_about(pivot, 0.0, 0.3);
+            let view = (c.camera().lookat - c.camera().eye).normalize();
+            assert!(
+                view.cross(Vec3::Y).length() > 0.01,
+                "view flipped onto the pole"
+            );
+        }
+        let before = *c.camera();
+        c.orbit_about(Vec3::NAN, 0.1, 0.1);
+        c.orbit_about(pivot, f32::INFINITY, 0.1);
+        assert_eq!(*c.camera(), before);
+    }
+
+    #[test]
+    fn dolly_moves_towards_the_target_and_stops_in_front_of_it() {
+        let mut c = CameraControl::new(home());
+        let target = Vec3::new(3.0, 1.0, 1.0);
+        let view = c.camera().lookat - c.camera().eye;
+        let d = c.camera().eye.distance(target);
+        c.dolly(target, 0.5, 0.1);
+        assert!((c.camera().eye.distance(target) - d * 0.5).abs() < 1e-4 * d);
+        // The view keeps its direction: both points moved alike.
+        assert!((c.camera().lookat - c.camera().eye - view).length() < 1e-4);
+        // The eye moved along the line towards the target.
+        let moved = (c.camera().eye - home().eye).normalize();
+        assert!(moved.dot((target - home().eye).normalize()) > 0.9999);
+        // Many steps closer stop `stop` in front of the target.
+        for _ in 0..200 {
+            c.dolly(target, 0.5, 0.1);
+        }
+        assert!((c.camera().eye.distance(target) - 0.1).abs() < 1e-4);
+        // Moving away grows the distance again; nonsense changes nothing.
+        c.dolly(target, 2.0, 0.1);
+        assert!((c.camera().eye.distance(target) - 0.2).abs() < 1e-4);
+        let before = *c.camera();
+        c.dolly(target, f32::NAN, 0.1);
+        c.dolly(target, 0.0, 0.1);
+        c.dolly(Vec3::INFINITY, 0.5, 0.1);
+        c.dolly(c.camera().eye, 0.5, 0.1);
+        assert_eq!(*c.camera(), before);
     }
 }

@@ -481,7 +481,7 @@ impl<'a> Ui<'a> {
                 mesh,
                 &view,
                 self.rasterizer.inv_depth(),
-                render::MESH_COLOR,
+                render::MESH_LINES,
             );
         }
         for (out, p) in self.buffer.iter_mut().zip(self.picture.pixels()) {
