@@ -139,14 +139,17 @@ fn x_server() -> Option<(Reaper, String)> {
 /// `dir` on `display` with `extra` arguments, and waits for its window.
 /// Returns the program (stdout piped) and the window's id.
 fn open_cornell(dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
-    let scene = common::scene("cornell.sc");
-    let mut args = vec![
-        scene.to_str().unwrap(),
-        "--lenmax",
-        "80",
-        "--size",
-        "160x120",
-    ];
+    let mut args = vec!["--lenmax", "80"];
+    args.extend_from_slice(extra);
+    open_scene("cornell", dir, display, &args)
+}
+
+/// Starts the program on the bundled scene `name` (`scenes/NAME.sc`) in a
+/// 160×120 window in `dir` on `display` with `extra` arguments, and waits
+/// for its window. Returns the program (stdout piped) and the window's id.
+fn open_scene(name: &str, dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
+    let scene = common::scene(&format!("{name}.sc"));
+    let mut args = vec![scene.to_str().unwrap(), "--size", "160x120"];
     args.extend_from_slice(extra);
     let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
         .args(&args)
@@ -160,8 +163,11 @@ fn open_cornell(dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
         .unwrap();
     let mut program = Reaper(child);
     let window = wait_for(Duration::from_secs(20), || {
-        xdotool(display, &["search", "--name", "^radiosity.*cornell"])
-            .and_then(|ids| ids.lines().next().map(str::to_string))
+        xdotool(
+            display,
+            &["search", "--name", &format!("^radiosity.*{name}")],
+        )
+        .and_then(|ids| ids.lines().next().map(str::to_string))
     });
     let Some(window) = window else {
         let _ = program.0.kill();
@@ -287,7 +293,10 @@ fn window_refines_adaptively_and_shows_the_refined_mesh() {
         assert!(status.success(), "exit status {status}");
         let lines = img
             .pixels()
-            .filter(|p| p.0 == radiosity::render::MESH_COLOR)
+            .filter(|p| {
+                p.0 == radiosity::render::MESH_COLOR
+                    || p.0 == radiosity::render::MESH_COLOR_ON_LIGHT
+            })
             .count();
         (title, lines)
     };
@@ -303,4 +312,93 @@ fn window_refines_adaptively_and_shows_the_refined_mesh() {
         lines > plain_lines + plain_lines / 10,
         "mesh line pixels: {lines} refined, {plain_lines} regular"
     );
+}
+
+/// Waits until `file` exists and reads it as an 8-bit RGB picture.
+fn read_written(file: &Path) -> image::RgbImage {
+    wait_for(Duration::from_secs(10), || file.exists().then_some(()))
+        .unwrap_or_else(|| panic!("{} was not written", file.display()));
+    // The file is renamed into place when complete, so it reads whole.
+    image::open(file).unwrap().to_rgb8()
+}
+
+/// Presses `q` and checks the program exits 0 within 5 s.
+fn quit(display: &str, program: &mut Reaper) {
+    xdotool(display, &["key", "q"]).expect("key q");
+    let status = wait_for(Duration::from_secs(5), || {
+        program.0.try_wait().ok().flatten()
+    })
+    .expect("the program exits within 5 s of q");
+    assert!(status.success(), "exit status {status}");
+}
+
+/// From the camera of every bundled scene, dragging with the left button
+/// (150 px right and 80 px up, then back past the start) looks around
+/// from the eye: the view stays in the room and the picture `w` writes is
+/// not black. The state panel is on the screen but not in that picture:
+/// `p` writes the screen with it, and after `i` without it.
+#[test]
+fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
+    // A failed test poisons the lock; the next one may still run.
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let Some((_xvfb, display)) = x_server() else {
+        return;
+    };
+    for name in ["cornell", "rtable", "table_chair"] {
+        let dir = tempfile::tempdir().unwrap();
+        // A few steps, then a still picture, so the files can be compared.
+        let (mut program, window) = open_scene(
+            name,
+            dir.path(),
+            &display,
+            &["--max-steps", "4", "--lenmax", "0.5"],
+        );
+        wait_for(Duration::from_secs(60), || {
+            let title = xdotool(&display, &["getwindowname", &window])?;
+            title.contains("step limit").then_some(())
+        })
+        .unwrap_or_else(|| panic!("{name}: the solve reaches its step limit"));
+        xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus");
+        xdotool(&display, &["mousemove", "--window", &window, "80", "60"]).expect("move");
+        xdotool(&display, &["mousedown", "1"]).expect("press");
+        for (dx, dy) in [(30, -16); 5].into_iter().chain([(-40, 20); 6]) {
+            xdotool(
+                &display,
+                &["mousemove_relative", "--", &dx.to_string(), &dy.to_string()],
+            )
+            .expect("drag");
+            std::thread::sleep(Duration::from_millis(60));
+        }
+        xdotool(&display, &["mouseup", "1"]).expect("release");
+        std::thread::sleep(Duration::from_millis(200));
+        xdotool(&display, &["key", "w"]).expect("key w");
+        let picture = read_written(&dir.path().join(format!("{name}-001.tiff")));
+        let lit = picture
+            .pixels()
+            .filter(|p| p.0.iter().any(|&c| c > 30))
+            .count();
+        assert!(
+            lit > 160 * 120 / 3,
+            "{name}: after looking around the picture is mostly black ({lit} lit pixels)"
+        );
+        xdotool(&display, &["key", "p"]).expect("key p");
+        let screen = read_written(&dir.path().join(format!("{name}-002.tiff")));
+        xdotool(&display, &["key", "i"]).expect("key i");
+        std::thread::sleep(Duration::from_millis(200));
+        xdotool(&display, &["key", "p"]).expect("key p");
+        let bare = read_written(&dir.path().join(format!("{name}-003.tiff")));
+        quit(&display, &mut program);
+        // The panel covers the top-left corner of the screen only.
+        let differ: Vec<(u32, u32)> = picture
+            .enumerate_pixels()
+            .filter(|&(x, y, p)| screen.get_pixel(x, y) != p)
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        assert!(differ.len() > 200, "{name}: the panel is not on the screen");
+        assert!(
+            differ.iter().all(|&(x, y)| x < 160 && y < 60),
+            "{name}: the screen differs from the picture outside the panel"
+        );
+        assert_eq!(bare, picture, "{name}: i hides the panel");
+    }
 }

@@ -544,30 +544,9 @@ impl<'a> Progressive<'a> {
     /// missing from an unconverged solution and tends to zero as the solve
     /// converges. It is for display only: it never enters the solution.
     pub fn ambient(&self) -> Rgb {
-        let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
-        for (j, (rho, pm)) in self.reflectance.iter().zip(&self.mesh.polygons).enumerate() {
-            // The sky is no part of the scene its light is spread over;
-            // what it has not shot yet is the light's source, counted as
-            // the power it would bring (see `sky_power_weights`).
-            if pm.sky {
-                unshot += self.unshot.mean(&self.mesh, j) * pm.area * self.power_weight[j];
-                continue;
-            }
-            area += pm.area;
-            unshot += self.unshot.mean(&self.mesh, j) * pm.area;
-            reflected += *rho * pm.area;
-        }
-        if area <= 0.0 {
-            return Rgb::BLACK;
-        }
-        let rho = reflected / area;
-        // Every reflectance channel is below 1, so their mean is too.
-        let r = Rgb::new(
-            1.0 / (1.0 - rho.r),
-            1.0 / (1.0 - rho.g),
-            1.0 / (1.0 - rho.b),
-        );
-        r * (unshot / area)
+        ambient_term(&self.mesh, &self.reflectance, &self.power_weight, |j| {
+            self.unshot.mean(&self.mesh, j)
+        })
     }
 
     /// The radiosity to show: per vertex `b + ρ · ambient` (see
@@ -1628,6 +1607,73 @@ fn ray_blocked(
         }
         _ => (visibility.occluded(from, x, ends), 1),
     }
+}
+
+/// The ambient term ([`Progressive::ambient`]) of a scene whose polygon
+/// `j` (of `mesh`) has reflectance `reflectance[j]`, sky power weight
+/// `power_weight[j]` ([`sky_power_weights`]) and mean unshot radiosity
+/// `unshot_mean(j)`.
+fn ambient_term(
+    mesh: &Mesh,
+    reflectance: &[Rgb],
+    power_weight: &[f64],
+    unshot_mean: impl Fn(usize) -> Rgb,
+) -> Rgb {
+    let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
+    for (j, (rho, pm)) in reflectance.iter().zip(&mesh.polygons).enumerate() {
+        // The sky is no part of the scene its light is spread over;
+        // what it has not shot yet is the light's source, counted as
+        // the power it would bring (see `sky_power_weights`).
+        if pm.sky {
+            unshot += unshot_mean(j) * pm.area * power_weight[j];
+            continue;
+        }
+        area += pm.area;
+        unshot += unshot_mean(j) * pm.area;
+        reflected += *rho * pm.area;
+    }
+    if area <= 0.0 {
+        return Rgb::BLACK;
+    }
+    let rho = reflected / area;
+    // Every reflectance channel is below 1, so their mean is too.
+    let r = Rgb::new(
+        1.0 / (1.0 - rho.r),
+        1.0 / (1.0 - rho.g),
+        1.0 / (1.0 - rho.b),
+    );
+    r * (unshot / area)
+}
+
+/// What a solve of `scene` on `mesh` shows before its first step, per mesh
+/// vertex in the scene's radiosity units: each vertex's emission plus its
+/// reflectance times the ambient term of the unshot emission (the value of
+/// [`Progressive::radiosity_with_ambient`] for a new solver), computed
+/// without building a solver (no samples, clusters or visibility), so a
+/// window can show a lit scene at once on a model whose solver takes a
+/// while to set up.
+pub fn first_look(scene: &Scene, mesh: &Mesh) -> Vec<Rgb> {
+    let material = |p: &crate::scene::Polygon| &scene.materials[p.material.index()];
+    let emission: Vec<Rgb> = scene
+        .polygons
+        .iter()
+        .map(|p| material(p).emission())
+        .collect();
+    let reflectance: Vec<Rgb> = scene
+        .polygons
+        .iter()
+        .map(|p| material(p).reflectance())
+        .collect();
+    if emission.len() != mesh.polygons.len() {
+        return vec![Rgb::BLACK; mesh.vertex_count()];
+    }
+    let ambient = ambient_term(mesh, &reflectance, &sky_power_weights(mesh), |j| {
+        emission[j]
+    });
+    mesh.vertex_polygon
+        .iter()
+        .map(|p| emission[p.index()] + reflectance[p.index()] * ambient)
+        .collect()
 }
 
 /// Per polygon of `mesh`, the factor its unshot power counts with: 1 for

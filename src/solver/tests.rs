@@ -1409,3 +1409,35 @@ fn interpolated_receivers_match_exact_ones() {
     };
     assert!(same_bits(&threads(1), &threads(2)));
 }
+
+/// The window's first picture, made without a solver, is what a new
+/// solver would show: emission plus reflectance times the ambient term
+/// (on the bundled scenes, one of them with a sky).
+#[test]
+fn first_look_is_what_a_new_solver_shows() {
+    for name in ["cornell.sc", "rtable.sc", "table_chair.sc"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name);
+        let s = crate::scene::load(&path).unwrap();
+        let mesh = mesh::build(&s, &MeshOptions::for_scene(&s)).unwrap();
+        let vis = Visibility::new(&s);
+        let solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
+        let mut shown = Vec::new();
+        solver.radiosity_with_ambient(&mut shown);
+        let look = first_look(&s, &mesh);
+        assert_eq!(look.len(), shown.len());
+        let lit = look.iter().filter(|b| b.max_channel() > 0.0).count();
+        // Every surface that reflects shows the ambient light, not black.
+        assert!(lit > look.len() * 9 / 10, "{name}: {lit} of {}", look.len());
+        for (l, (a, b)) in look.iter().zip(&shown).enumerate() {
+            let scale = b.max_channel().max(1e-12);
+            assert!(
+                (a.r - b.r).abs() <= 1e-6 * scale
+                    && (a.g - b.g).abs() <= 1e-6 * scale
+                    && (a.b - b.b).abs() <= 1e-6 * scale,
+                "{name}: vertex {l}: {a:?} vs {b:?}"
+            );
+        }
+    }
+}

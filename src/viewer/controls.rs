@@ -41,7 +41,9 @@ impl CameraControl {
         self.camera = self.home;
     }
 
-    fn home_distance(&self) -> f32 {
+    /// The scene camera's distance from its eye to its look-at point, in
+    /// scene units: the scale movements are measured in.
+    pub fn home_distance(&self) -> f32 {
         self.home.eye.distance(self.home.lookat)
     }
 
@@ -63,24 +65,21 @@ impl CameraControl {
     /// under the cursor): `yaw` radians about the up direction, then
     /// `pitch` radians about the axis across the eye's offset from the
     /// pivot (positive raises the eye). The eye keeps its distance to the
-    /// pivot and the pivot stays where it is in the picture. A pitch that
-    /// would carry the eye over the pivot's pole stops at [`POLE_MARGIN`];
-    /// a turn that would leave the view direction within the margin of
-    /// the up direction, or non-finite input, changes nothing.
+    /// pivot and the pivot stays where it is in the picture (the pitch
+    /// turns about the camera's own right axis, so the view never rolls).
+    /// A pitch that would tilt the view direction past straight down or up
+    /// stops at [`POLE_MARGIN`]; non-finite input changes nothing.
     pub fn orbit_about(&mut self, pivot: Vec3, yaw: f32, pitch: f32) {
         if !pivot.is_finite() {
             return;
         }
-        let Some(rotation) = rotation(self.camera.eye - pivot, self.camera.up, yaw, pitch) else {
+        let view = self.camera.lookat - self.camera.eye;
+        let Some(rotation) = orbit_rotation(view, self.camera.up, yaw, pitch) else {
             return;
         };
         let eye = pivot + rotation * (self.camera.eye - pivot);
         let lookat = pivot + rotation * (self.camera.lookat - pivot);
-        let up = self.camera.up.normalize_or_zero();
-        let view = (lookat - eye).normalize_or_zero();
-        // An off-centre pivot turns the view direction by more than the
-        // eye's offset: keep the camera's invariant (view never along up).
-        if view.dot(up).abs() < (POLE_MARGIN * 0.5).cos() && eye.is_finite() && lookat.is_finite() {
+        if eye.is_finite() && lookat.is_finite() {
             self.camera.eye = eye;
             self.camera.lookat = lookat;
         }
@@ -123,8 +122,11 @@ impl CameraControl {
     /// limited to [`MAX_DISTANCE_FACTOR`] scene-camera distances.
     /// Non-finite or non-positive input changes nothing.
     pub fn dolly(&mut self, target: Vec3, factor: f32, stop: f32) {
-        if !(factor.is_finite() && factor > 0.0 && stop.is_finite() && stop >= 0.0)
-            || !target.is_finite()
+        if !(factor.is_finite()
+            && factor > 0.0
+            && stop.is_finite()
+            && stop >= 0.0
+            && target.is_finite())
         {
             return;
         }
@@ -163,8 +165,7 @@ impl CameraControl {
 /// The rotation that turns `v` by `yaw` radians about `up`, then tilts it
 /// towards `up` by `pitch` radians (about `up × v`), its angle to `up`
 /// kept within [`POLE_MARGIN`] of either pole; `None` for a zero `up` or
-/// non-finite angles. Applied to `v` it gives what [`turn`] gives; applied
-/// to other points it moves them rigidly with `v`.
+/// non-finite angles.
 fn rotation(v: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Quat> {
     let up = up.normalize_or_zero();
     if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() || !v.is_finite() {
@@ -182,6 +183,31 @@ fn rotation(v: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Quat> {
         // About `up × v`, a positive angle turns `v` away from `up`,
         // increasing its angle to it by that much.
         Quat::from_axis_angle(right, target - current) * spin
+    })
+}
+
+/// The rigid rotation of an orbit for a camera looking along `view`:
+/// `yaw` radians about `up`, then about the camera's right axis (after the
+/// yaw) so that the view direction's angle to `up` grows by `pitch`
+/// radians (positive raises the eye and looks down more), kept within
+/// [`POLE_MARGIN`] of either pole. `None` for a zero `up` or non-finite
+/// input.
+fn orbit_rotation(view: Vec3, up: Vec3, yaw: f32, pitch: f32) -> Option<Quat> {
+    let up = up.normalize_or_zero();
+    if up == Vec3::ZERO || !yaw.is_finite() || !pitch.is_finite() || !view.is_finite() {
+        return None;
+    }
+    let spin = Quat::from_axis_angle(up, yaw);
+    let v = spin * view;
+    let current = v.normalize_or_zero().dot(up).clamp(-1.0, 1.0).acos();
+    let target = (current + pitch).clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
+    let right = v.cross(up).normalize_or_zero();
+    Some(if right == Vec3::ZERO {
+        spin
+    } else {
+        // About `v × up`, a positive angle tilts `v` towards `up`,
+        // decreasing its angle to it by that much.
+        Quat::from_axis_angle(right, current - target) * spin
     })
 }
 

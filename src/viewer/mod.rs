@@ -14,11 +14,23 @@
 //! keeps showing the last converged solution (the title says which pass
 //! is running) and switches to the finer one when it converges.
 //!
-//! Keys: `q`/Escape quit · `w` write the picture as TIFF · space pause or
-//! resume · `+`/`-` exposure · `m` element mesh · `r` reset the camera ·
-//! `h` help · arrows and `a`/`d` (or Shift+W/A/S/D) walk · `PageUp`/`PageDown`
-//! up and down. Mouse: left-drag orbits around the look-at point,
-//! right-drag or the wheel zooms.
+//! Before the solver's first step the window shows the emitters lit and
+//! every other surface with the ambient term ([`crate::solver::first_look`]),
+//! never a black picture.
+//!
+//! A small state panel ([`render::text::draw_panel`]) in the top-left
+//! corner shows the step, unshot power, rays per second, whether the solve
+//! converged, the navigation mode and "h: help"; `i` hides it. It is drawn
+//! on the screen only: `w` writes the picture without it, `p` writes the
+//! screen as shown, panel included.
+//!
+//! Keys: `q`/Escape quit · `w` write the picture as TIFF · `p` write the
+//! screen · space pause or resume · `+`/`-` exposure · `m` element mesh ·
+//! `i` state panel · `r` reset the camera · `o` left-drag mode · `h` help ·
+//! arrows and `a`/`d` (or Shift+W/A/S/D) walk · `PageUp`/`PageDown` up and
+//! down. Mouse: left-drag looks around (or, after `o`, orbits around the
+//! surface point under the cursor), right-drag or the wheel moves towards
+//! or away from the surface under the cursor, stopping in front of it.
 
 pub mod controls;
 
@@ -31,6 +43,7 @@ use crate::render::{self, Exposure, Rasterizer, View};
 use crate::session::{Event, Session, SessionOptions};
 use crate::solver::StopReason;
 use controls::CameraControl;
+use glam::Vec3;
 use image::RgbImage;
 use minifb::{InputCallback, Key, MouseButton, MouseMode, Window, WindowOptions};
 use std::io::{BufRead, IsTerminal, Write};
@@ -57,7 +70,9 @@ pub enum Navigation {
     /// Turn the view about the eye (the default: from inside a room, the
     /// view stays in the room).
     Look,
-    /// Turn the eye around the look-at point (to inspect an object).
+    /// Turn the eye around the surface point under the cursor when the
+    /// drag starts (around the look-at point when the cursor is over
+    /// background), to inspect an object.
     Orbit,
 }
 
@@ -70,10 +85,16 @@ impl Navigation {
         }
     }
 }
-/// Zoom factor per pixel of right-drag (`exp` of this times the pixels).
+/// Zoom factor per pixel of right-drag (`exp` of this times the pixels):
+/// the factor by which the distance to the point under the cursor changes.
 pub const ZOOM_PER_PIXEL: f32 = 0.01;
-/// Zoom factor per notch of the mouse wheel.
-pub const ZOOM_PER_NOTCH: f32 = 0.9;
+/// Zoom factor per notch of the mouse wheel (towards the point under the
+/// cursor; its inverse away from it).
+pub const ZOOM_PER_NOTCH: f32 = 0.85;
+/// How close zooming brings the eye to the surface under the cursor, as a
+/// fraction of the scene camera's distance to its look-at point: it stops
+/// in front of the surface, never on or through it.
+pub const ZOOM_STOP_FRACTION: f32 = 0.02;
 /// Walking step per key press, as a fraction of the distance to the
 /// look-at point.
 pub const WALK_STEP: f32 = 0.05;
@@ -88,14 +109,17 @@ keys:
   space            pause / resume the solver
   + / -            exposure up / down (a third of a stop)
   m                show / hide the element mesh
+  i                show / hide the state panel (never in pictures from w)
+  p                write the screen as shown, state panel included
   r                reset the camera
   h                this help
   arrows, a, d     walk (Shift+W/A/S/D too); PageUp / PageDown: up / down
   o                switch left-drag between looking around and orbiting
 mouse:
-  left-drag        look around from the eye (orbit around the look-at
-                   point after o)
-  right-drag, wheel  zoom towards / away from the look-at point";
+  left-drag        look around from the eye (after o: orbit around the
+                   surface point under the cursor)
+  right-drag, wheel  move towards / away from the surface under the
+                   cursor (stops in front of it)";
 
 /// Why the window could not run.
 #[derive(Debug, thiserror::Error)]
@@ -200,9 +224,15 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
             exposure: config.exposure,
             exposure_scale: 1.0,
             show_mesh: false,
+            show_panel: true,
             stem: stem.clone(),
             rasterizer: Rasterizer::new(),
             picture: RgbImage::new(home.width, home.height),
+            screen: RgbImage::new(home.width, home.height),
+            panel: Vec::new(),
+            first_look: None,
+            pivot: None,
+            writes: Vec::new(),
             buffer: vec![0; w * h],
             radiosity: Vec::new(),
             mesh: None,
@@ -336,9 +366,24 @@ struct Ui<'a> {
     exposure: Exposure,
     exposure_scale: f32,
     show_mesh: bool,
+    /// Whether the state panel is drawn on the screen (`i`).
+    show_panel: bool,
     stem: String,
     rasterizer: Rasterizer,
+    /// The picture as `w` writes it: the solution, with the mesh when shown.
     picture: RgbImage,
+    /// What the window shows: the picture with the state panel.
+    screen: RgbImage,
+    /// The state panel's lines as last drawn.
+    panel: Vec<String>,
+    /// What is drawn before the solver's first publication
+    /// ([`crate::solver::first_look`]), made on the first frame.
+    first_look: Option<Vec<Rgb>>,
+    /// The point a drag turns around or moves towards, picked under the
+    /// cursor when the button went down (scene units).
+    pivot: Option<Vec3>,
+    /// Pictures asked for by keys this frame, written once it is drawn.
+    writes: Vec<Writing>,
     buffer: Vec<u32>,
     radiosity: Vec<Rgb>,
     /// The mesh [`Ui::radiosity`] belongs to (`None`: nothing published
@@ -352,6 +397,15 @@ struct Ui<'a> {
     /// A `w` waiting for its file name from the terminal, with the picture
     /// as it was when `w` was pressed.
     pending_name: Option<(std::sync::mpsc::Receiver<PathBuf>, RgbImage)>,
+}
+
+/// A picture a key asked to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Writing {
+    /// The picture (`w`): the solution, with the mesh when shown.
+    Picture,
+    /// The screen as shown (`p`): the picture with the state panel.
+    Screen,
 }
 
 /// Collects every key press as it arrives. Polling the key state once a
@@ -410,7 +464,8 @@ impl<'a> Ui<'a> {
                 break;
             };
             let fresh = version != shown_version && last_draw.elapsed() >= REDRAW_INTERVAL;
-            if fresh || dirty {
+            let drawn = fresh || dirty;
+            if drawn {
                 if let Ok(p) = progress.lock() {
                     self.radiosity.clone_from(&p.radiosity);
                     self.mesh.clone_from(&p.mesh);
@@ -440,15 +495,38 @@ impl<'a> Ui<'a> {
                 (1, _) | (_, 0) => String::new(),
                 (k, levels) => format!("refinement {}/{levels} · ", k - 1),
             };
-            let new_title = format!(
-                "radiosity — {} — {refining}step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state} · {} · h: help",
-                self.stem,
+            let status = format!(
+                "{refining}step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state}",
                 unshot * 100.0,
+            );
+            let new_title = format!(
+                "radiosity — {} — {status} · {} · h: help",
+                self.stem,
                 self.navigation.name()
             );
             if new_title != title {
                 self.window.set_title(&new_title);
                 title = new_title;
+            }
+            let panel = if self.show_panel {
+                vec![
+                    status.trim_start_matches(" · ").to_string(),
+                    format!("{} · i: hide · h: help", self.navigation.name()),
+                ]
+            } else {
+                Vec::new()
+            };
+            if drawn || panel != self.panel {
+                self.panel = panel;
+                self.compose();
+            }
+            // After the redraw, so a `w` typed right after `m` or a move
+            // writes what they asked for.
+            for write in std::mem::take(&mut self.writes) {
+                match write {
+                    Writing::Picture => self.write_picture(),
+                    Writing::Screen => self.write_screen(),
+                }
             }
             let (w, h) = (
                 self.picture.width() as usize,
@@ -466,13 +544,24 @@ impl<'a> Ui<'a> {
     /// picture and the window buffer.
     fn draw(&mut self) -> Result<(), ViewerError> {
         let view = View::new(self.camera.camera())?;
-        let mesh = self.mesh.as_deref().unwrap_or(&self.prepared.mesh);
-        if self.mesh.is_none() || self.radiosity.len() != mesh.vertex_count() {
-            // Before the solver thread's first publication: nothing yet.
-            self.buffer.fill(0);
-            return Ok(());
-        }
-        let frame = self.rasterizer.render(mesh, &self.radiosity, &view)?;
+        let published = self
+            .mesh
+            .as_deref()
+            .filter(|m| self.radiosity.len() == m.vertex_count());
+        let (mesh, radiosity) = match published {
+            Some(mesh) => (mesh, &self.radiosity),
+            // Before the solver thread's first publication (building the
+            // solver can take a while on a large model): the emitters and
+            // the ambient term, never a black window.
+            None => {
+                let prepared = self.prepared;
+                let look = self.first_look.get_or_insert_with(|| {
+                    crate::solver::first_look(&prepared.scene, &prepared.mesh)
+                });
+                (&prepared.mesh, &*look)
+            }
+        };
+        let frame = self.rasterizer.render(mesh, radiosity, &view)?;
         let exposure = self.exposure.resolve(frame) * self.exposure_scale;
         self.picture = render::to_srgb8(frame, exposure);
         if self.show_mesh {
@@ -484,11 +573,57 @@ impl<'a> Ui<'a> {
                 render::MESH_LINES,
             );
         }
-        for (out, p) in self.buffer.iter_mut().zip(self.picture.pixels()) {
+        Ok(())
+    }
+
+    /// The screen from the picture and the state panel, into the window
+    /// buffer.
+    fn compose(&mut self) {
+        self.screen.clone_from(&self.picture);
+        if !self.panel.is_empty() {
+            let lines: Vec<&str> = self.panel.iter().map(String::as_str).collect();
+            render::text::draw_panel(&mut self.screen, &lines);
+        }
+        self.buffer.resize(self.screen.pixels().len(), 0);
+        for (out, p) in self.buffer.iter_mut().zip(self.screen.pixels()) {
             let [r, g, b] = p.0;
             *out = (u32::from(r) << 16) | (u32::from(g) << 8) | u32::from(b);
         }
-        Ok(())
+    }
+
+    /// The surface point drawn at window position `(x, y)` (pixels from
+    /// the top-left corner), from the last picture's depth buffer; `None`
+    /// over background or outside the window.
+    fn pick(&self, x: f32, y: f32) -> Option<Vec3> {
+        let (w, h) = (self.picture.width(), self.picture.height());
+        if !(x >= 0.0 && y >= 0.0 && x < w as f32 && y < h as f32) {
+            return None;
+        }
+        let depth = *self
+            .rasterizer
+            .inv_depth()
+            .get(y as usize * w as usize + x as usize)?;
+        View::new(self.camera.camera()).ok()?.unproject(
+            f64::from(x.floor()) + 0.5,
+            f64::from(y.floor()) + 0.5,
+            depth,
+        )
+    }
+
+    /// The point a zoom at window position `(x, y)` moves towards: the
+    /// surface under the cursor, or over background the point on the
+    /// cursor's ray as far away as the look-at point.
+    fn zoom_target(&self, x: f32, y: f32) -> Option<Vec3> {
+        self.pick(x, y).or_else(|| {
+            let view = View::new(self.camera.camera()).ok()?;
+            let ray = view.ray_direction(f64::from(x), f64::from(y));
+            Some(view.eye() + ray * self.camera.distance())
+        })
+    }
+
+    /// How far in front of a surface zooming stops, in scene units.
+    fn zoom_stop(&self) -> f32 {
+        self.camera.home_distance() * ZOOM_STOP_FRACTION
     }
 
     /// Applies key presses; true when the picture must be redrawn.
@@ -498,7 +633,7 @@ impl<'a> Ui<'a> {
         let mut dirty = false;
         for key in keys {
             match key {
-                Key::W if !shift => self.write_picture(),
+                Key::W if !shift => self.writes.push(Writing::Picture),
                 Key::Space => {
                     let paused = !control.paused.load(Ordering::Relaxed);
                     control.paused.store(paused, Ordering::Relaxed);
@@ -515,6 +650,8 @@ impl<'a> Ui<'a> {
                     self.show_mesh = !self.show_mesh;
                     dirty = true;
                 }
+                Key::I => self.show_panel = !self.show_panel,
+                Key::P => self.writes.push(Writing::Screen),
                 Key::R => {
                     self.camera.reset();
                     dirty = true;
@@ -561,15 +698,28 @@ impl<'a> Ui<'a> {
     /// Mouse drags and the wheel; true when the camera moved.
     fn handle_mouse(&mut self) -> bool {
         let mut dirty = false;
+        let pos = self.window.get_mouse_pos(MouseMode::Pass);
         if let Some((_, dy)) = self.window.get_scroll_wheel() {
-            if dy != 0.0 {
-                self.camera.zoom(ZOOM_PER_NOTCH.powf(dy.signum()));
+            let target = pos.and_then(|(x, y)| self.zoom_target(x, y));
+            if let (true, Some(target)) = (dy != 0.0, target) {
+                let factor = ZOOM_PER_NOTCH.powf(dy.signum());
+                self.camera.dolly(target, factor, self.zoom_stop());
                 dirty = true;
             }
         }
-        let pos = self.window.get_mouse_pos(MouseMode::Pass);
         let left = self.window.get_mouse_down(MouseButton::Left);
         let right = self.window.get_mouse_down(MouseButton::Right);
+        if (left || right) && self.last_mouse.is_none() {
+            // The drag starts: what it turns around or moves towards is
+            // the surface under the cursor now, fixed for the whole drag.
+            self.pivot = pos.and_then(|(x, y)| {
+                if right {
+                    self.zoom_target(x, y)
+                } else {
+                    self.pick(x, y)
+                }
+            });
+        }
         match (pos, self.last_mouse) {
             (Some((x, y)), Some((x0, y0))) if left || right => {
                 let (dx, dy) = (x - x0, y - y0);
@@ -578,10 +728,13 @@ impl<'a> Ui<'a> {
                         // Drag right turns right; drag up looks up.
                         self.camera.look(-dx * LOOK_PER_PIXEL, -dy * LOOK_PER_PIXEL);
                     } else if left {
+                        let pivot = self.pivot.unwrap_or(self.camera.camera().lookat);
                         self.camera
-                            .orbit(-dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
-                    } else {
-                        self.camera.zoom((dy * ZOOM_PER_PIXEL).exp());
+                            .orbit_about(pivot, -dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
+                    } else if let Some(target) = self.pivot {
+                        // Drag up moves towards the point, down away.
+                        let stop = self.zoom_stop();
+                        self.camera.dolly(target, (dy * ZOOM_PER_PIXEL).exp(), stop);
                     }
                     dirty = true;
                 }
@@ -590,6 +743,13 @@ impl<'a> Ui<'a> {
         }
         self.last_mouse = if left || right { pos } else { None };
         dirty
+    }
+
+    /// Writes the screen as shown (the picture with the state panel) as
+    /// TIFF under the next automatic name.
+    fn write_screen(&mut self) {
+        let name = self.next_auto_name();
+        self.save(&name, &self.screen.clone());
     }
 
     /// Writes the picture on screen as TIFF. When stdin is a terminal it
