@@ -538,3 +538,55 @@ fn checkpoint_fingerprint_holds_method_and_resolution() {
     assert_ne!(print(hemi), print(coarse));
     assert_eq!(print(hemi), print(hemicube_options()));
 }
+
+/// A floor vertex right below an opaque black square gets no direct light
+/// from the lamp above it, while one outside its shadow does. The blocker
+/// is 1 unit from the floor and the lamp 1 unit above it, so a floor
+/// point under the blocker's centre is an element or more inside the
+/// umbra: no pixel of any hemicube may see it.
+#[test]
+fn occluder_casts_a_shadow() {
+    let s = scene(
+        vec![
+            polygon(
+                0,
+                &[[-0.5, 0., 2.], [-0.5, 1., 2.], [0.5, 1., 2.], [0.5, 0., 2.]],
+            ),
+            polygon(
+                1,
+                &[[-3., -2., 0.], [3., -2., 0.], [3., 3., 0.], [-3., 3., 0.]],
+            ),
+            polygon(
+                2,
+                &[
+                    [-1., -0.5, 1.],
+                    [1., -0.5, 1.],
+                    [1., 1.5, 1.],
+                    [-1., 1.5, 1.],
+                ],
+            ),
+        ],
+        vec![
+            grey("lamp", 1.0, 0.0),
+            grey("floor", 0.0, 0.5),
+            grey("black", 0.0, 0.0),
+        ],
+    );
+    let options = SolverOptions {
+        max_steps: Some(1),
+        ..hemicube_options()
+    };
+    let (m, b, ..) = solve(&s, 0.25, options);
+    let vertex_at = |x: f32, y: f32| {
+        m.polygons[1]
+            .vertices
+            .clone()
+            .min_by(|&p, &q| {
+                let d = |v: u32| m.positions[v as usize].distance(Vec3::new(x, y, 0.0));
+                d(p).total_cmp(&d(q))
+            })
+            .unwrap() as usize
+    };
+    assert_eq!(b[vertex_at(0.0, 0.5)], Rgb::BLACK);
+    assert!(b[vertex_at(2.5, 0.5)].r > 0.0);
+}
