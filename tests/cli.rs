@@ -224,6 +224,7 @@ fn help_documents_every_option() {
         "--max-steps",
         "--form-factor",
         "--shooter-samples",
+        "--hemicube-res",
         "--size",
         "--exposure",
         "--stats",
@@ -533,6 +534,7 @@ fn adaptive_runs_with_every_scheme_and_form_factor() {
         (&["--form-factor", "center"], 3),
         (&["--form-factor", "center", "--unshot", "polygon"], 3),
         (&["--shooter-samples", "all"], 3),
+        (&["--form-factor", "hemicube", "--hemicube-res", "32"], 3),
         // A solve cut short is not refined.
         (&["--max-steps", "3"], 1),
     ] {
@@ -557,4 +559,66 @@ fn adaptive_runs_with_every_scheme_and_form_factor() {
             "{extra:?}"
         );
     }
+}
+
+/// `--form-factor hemicube` solves and renders a bundled scene with no
+/// shadow ray; a hemicube resolution it cannot use is a usage error that
+/// names the option and the accepted range, and writes nothing.
+#[test]
+fn hemicube_runs_end_to_end_and_refuses_a_bad_resolution() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("cornell.sc");
+    let mut args = vec![
+        scene.to_str().unwrap(),
+        "-o",
+        "out.png",
+        "--lenmax",
+        "60",
+        "--form-factor",
+        "hemicube",
+        "--hemicube-res",
+        "32",
+        "--stats",
+        "stats.json",
+    ];
+    args.extend_from_slice(QUICK);
+    let out = run_in(dir.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(dir.path().join("out.png")).unwrap().to_rgb8();
+    let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
+    assert!(
+        lit > (img.width() * img.height()) as usize / 4,
+        "only {lit} lit pixels"
+    );
+    let stats: serde_json::Value = read_json(dir.path(), "stats.json");
+    assert!(stats["steps"].as_u64().unwrap() > 0);
+    assert_eq!(stats["rays"].as_u64(), Some(0), "hemicubes cast no ray");
+
+    let empty = tempfile::tempdir().unwrap();
+    for bad in ["0", "7", "100000", "many"] {
+        let out = run_in(
+            empty.path(),
+            &[
+                scene.to_str().unwrap(),
+                "-o",
+                "out.png",
+                "--form-factor",
+                "hemicube",
+                "--hemicube-res",
+                bad,
+            ],
+        );
+        assert_eq!(out.status.code(), Some(2), "{bad}: {}", stderr(&out));
+        let message = stderr(&out);
+        assert!(
+            message
+                .contains("--hemicube-res must be an even whole number of pixels from 8 to 4096"),
+            "{bad}: {message}"
+        );
+        assert!(
+            message.contains(&format!("got `{bad}`")),
+            "{bad}: {message}"
+        );
+    }
+    assert!(listing(empty.path()).is_empty());
 }

@@ -37,8 +37,8 @@ pub enum CheckpointError {
     /// The checkpoint was written for another scene, mesh or solver options.
     #[error(
         "checkpoint {} was saved for a different scene, mesh or form-factor options \
-         (give the same scene, --emit, --sky, --lenmax, --inset, --form-factor, --shooter-samples and \
-         --no-near-field as the run that saved it)",
+         (give the same scene, --emit, --sky, --lenmax, --inset, --form-factor, --hemicube-res, \
+         --shooter-samples and --no-near-field as the run that saved it)",
         path.display()
     )]
     Mismatch {

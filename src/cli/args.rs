@@ -5,12 +5,13 @@
 //! Each option's doc comment is its help: the first paragraph is the one
 //! line `-h` shows, the whole comment is what `--help` shows.
 
-use super::values::{parse_emit, parse_shooter_samples, parse_size, parse_sky};
+use super::values::{parse_emit, parse_hemicube_res, parse_shooter_samples, parse_size, parse_sky};
 use crate::color::Rgb;
 use crate::config;
 use crate::mesh::refine;
 use crate::mesh::DEFAULT_INSET;
 use crate::render::antialias;
+use crate::solver::hemicube::HemicubeRes;
 use crate::solver::{FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_THRESHOLD};
 use std::path::PathBuf;
 
@@ -82,6 +83,15 @@ pub struct Args {
     // Display for `default_value_t`); a unit test keeps the two equal.
     #[arg(long, value_name = "N|all", default_value = "64", value_parser = parse_shooter_samples)]
     pub(crate) shooter_samples: ShooterSamples,
+
+    /// Pixels across a hemicube's top face (--form-factor hemicube).
+    ///
+    /// An even number from 8 to 4096; the side faces have N × N/2 pixels.
+    /// One hemicube stands at each shooter sample (--shooter-samples).
+    // The literal is solver::hemicube::DEFAULT_HEMICUBE_RES; a unit test
+    // keeps the two equal.
+    #[arg(long, value_name = "N", default_value = "128", value_parser = parse_hemicube_res)]
+    pub(crate) hemicube_res: HemicubeRes,
 
     /// Use the disc approximation however near the receiver.
     ///

@@ -136,6 +136,7 @@ impl TryFrom<Args> for Invocation {
                 unshot: args.unshot,
                 clustering: !args.no_clustering,
                 receiver_interpolation: !args.exact_receivers,
+                hemicube_res: args.hemicube_res,
             },
             size: args.size,
             exposure,
@@ -296,6 +297,7 @@ mod tests {
                 unshot: UnshotScheme::Vertex,
                 clustering: false,
                 receiver_interpolation: false,
+                hemicube_res: crate::solver::hemicube::HemicubeRes::default(),
             }
         );
         assert_eq!(c.size, Some((32, 24)));
@@ -327,8 +329,18 @@ mod tests {
         for (name, method) in [
             ("wallace", FormFactorMethod::Wallace),
             ("center", FormFactorMethod::Center),
+            ("hemicube", FormFactorMethod::Hemicube),
         ] {
             assert_eq!(config(&["--form-factor", name]).solver.form_factor, method);
+        }
+        assert_eq!(
+            config(&["--hemicube-res", "64"]).solver.hemicube_res.get(),
+            64
+        );
+        for bad in ["0", "7", "100000", "lots"] {
+            let e = parse(&["--hemicube-res", bad]).unwrap_err();
+            assert_eq!(e.kind(), clap::error::ErrorKind::ValueValidation, "{bad}");
+            assert!(e.to_string().contains("even whole number"), "{e}");
         }
         let e = parse(&["--form-factor", "magic"]).unwrap_err();
         assert_eq!(e.kind(), clap::error::ErrorKind::InvalidValue);

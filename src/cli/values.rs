@@ -5,6 +5,7 @@
 
 use crate::color::Rgb;
 use crate::scene::MAX_EMISSION;
+use crate::solver::hemicube::HemicubeRes;
 use crate::solver::ShooterSamples;
 
 /// An option value that does not parse. clap prints the message after its
@@ -35,6 +36,21 @@ pub enum ValueError {
         max = MAX_EMISSION
     )]
     Sky(String),
+    /// `--hemicube-res` is not a whole number, or not one a hemicube can
+    /// have ([`HemicubeRes::new`]).
+    #[error("--hemicube-res must be an even whole number of pixels from {min} to {max}, got `{0}`",
+        min = crate::solver::hemicube::MIN_HEMICUBE_RES,
+        max = crate::solver::hemicube::MAX_HEMICUBE_RES)]
+    HemicubeRes(String),
+}
+
+/// Parses `--hemicube-res`: pixels across a hemicube's top face, an even
+/// whole number in the range [`HemicubeRes::new`] accepts.
+pub fn parse_hemicube_res(text: &str) -> Result<HemicubeRes, ValueError> {
+    text.parse::<u64>()
+        .ok()
+        .and_then(|n| HemicubeRes::new(n).ok())
+        .ok_or_else(|| ValueError::HemicubeRes(text.to_string()))
 }
 
 /// Parses `--size`: `WxH` (or `WXH`), width and height in pixels, both

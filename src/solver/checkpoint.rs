@@ -208,7 +208,11 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     h.word(match options.form_factor {
         FormFactorMethod::Wallace => 1,
         FormFactorMethod::Center => 2,
+        FormFactorMethod::Hemicube => 3,
     });
+    if options.form_factor == FormFactorMethod::Hemicube {
+        h.word(u64::from(options.hemicube_res.get()));
+    }
     h.word(match options.shooter_samples {
         ShooterSamples::All => u64::MAX,
         ShooterSamples::AtMost(n) => n as u64,

@@ -45,6 +45,7 @@
 pub mod checkpoint;
 pub mod cluster;
 pub mod formfactor;
+pub mod hemicube;
 pub mod receivers;
 mod unshot;
 
@@ -126,6 +127,14 @@ pub enum FormFactorMethod {
     /// cheap, with blocky shadows.
     #[value(name = "center")]
     Center,
+    /// Cohen and Greenberg's hemicube: each shooter cell projects the
+    /// scene's elements onto a hemicube of [`SolverOptions::hemicube_res`]
+    /// pixels with a z-buffer and sums the pixels' delta form factors
+    /// ([`hemicube`]). No shadow rays; aliases where elements are small
+    /// seen from the shooter. Shoots every polygon alone (no clusters,
+    /// every receiver exact); a sky facet still shoots by Wallace's rays.
+    #[value(name = "hemicube")]
+    Hemicube,
 }
 
 /// Which points of a shooter are used by [`FormFactorMethod::Wallace`].
@@ -168,6 +177,9 @@ pub struct SolverOptions {
     /// vertices where [`receivers::accept`] allows; off, every receiving
     /// vertex is evaluated exactly (the twin it is compared with).
     pub receiver_interpolation: bool,
+    /// Pixels across a hemicube's top face, for
+    /// [`FormFactorMethod::Hemicube`] (ignored by the other methods).
+    pub hemicube_res: hemicube::HemicubeRes,
 }
 
 /// Where unshot radiosity is kept between shooting steps.
@@ -197,6 +209,7 @@ impl Default for SolverOptions {
             unshot: UnshotScheme::Vertex,
             clustering: true,
             receiver_interpolation: true,
+            hemicube_res: hemicube::HemicubeRes::default(),
         }
     }
 }
@@ -376,6 +389,9 @@ pub struct Progressive<'a> {
     initial_unshot_power: f64,
     steps: u64,
     rays: u64,
+    /// The hemicube's tables and scratch, with
+    /// [`FormFactorMethod::Hemicube`].
+    hemicube: Option<hemicube::Shooting>,
 }
 
 impl<'a> Progressive<'a> {
@@ -392,8 +408,12 @@ impl<'a> Progressive<'a> {
         let mesh: &Mesh = &mesh_ref;
         let set = match (options.form_factor, options.shooter_samples) {
             (FormFactorMethod::Center, _) => SampleSet::Centre,
-            (FormFactorMethod::Wallace, ShooterSamples::All) => SampleSet::Vertices,
-            (FormFactorMethod::Wallace, ShooterSamples::AtMost(n)) => SampleSet::AtMost(n),
+            (FormFactorMethod::Wallace | FormFactorMethod::Hemicube, ShooterSamples::All) => {
+                SampleSet::Vertices
+            }
+            (FormFactorMethod::Wallace | FormFactorMethod::Hemicube, ShooterSamples::AtMost(n)) => {
+                SampleSet::AtMost(n)
+            }
         };
         let emission: Vec<Rgb> = scene
             .polygons
@@ -495,6 +515,8 @@ impl<'a> Progressive<'a> {
             initial_unshot_power: 0.0,
             steps: 0,
             rays: 0,
+            hemicube: (options.form_factor == FormFactorMethod::Hemicube)
+                .then(|| hemicube::Shooting::new(scene, mesh, options.hemicube_res)),
         };
         solver.initial_unshot_power = solver.unshot_power();
         solver
@@ -686,7 +708,12 @@ impl<'a> Progressive<'a> {
                 || self.clusters.grouped() == 0
                 || !self.emission[shooter.index()].is_black()
                 || roots >= self.samples[shooter.index()].len());
-        let gathered = if alone {
+        let by_hemicube = self.hemicube.is_some() && !self.mesh.polygons[shooter.index()].sky;
+        let gathered = if by_hemicube {
+            self.read_shooter(shooter);
+            self.mark_receivers(shooter.index());
+            self.gather_hemicube(shooter, cancel)?
+        } else if alone {
             self.read_shooter(shooter);
             self.cull(shooter);
             self.gather(shooter, cancel)?
@@ -982,6 +1009,26 @@ impl<'a> Progressive<'a> {
             cancel,
             exact,
         )
+    }
+
+    /// Phase 4 by hemicubes ([`hemicube::Shooting::gather`]): `Δrad` of
+    /// every receiving vertex into `self.delta`.
+    fn gather_hemicube(&mut self, shooter: PolygonId, cancel: &AtomicBool) -> Option<Gathered> {
+        let i = shooter.index();
+        let power = self.unshot.mean(&self.mesh, i) * self.mesh.polygons[i].area;
+        let hemicube = self.hemicube.as_mut()?;
+        let pairs = hemicube.gather(
+            &self.mesh,
+            i,
+            &self.samples[i],
+            &self.shot,
+            power,
+            &self.receives,
+            &self.reflectance,
+            &mut self.delta,
+            cancel,
+        )?;
+        Some(Gathered { pairs, rays: 0 })
     }
 
     /// Cluster step, phase 2: the cluster's cells (every member's shooter
