@@ -9,7 +9,7 @@
 //! interval and thread count) are checked here.
 
 use super::args::Args;
-use crate::config::{RunConfig, SceneSource};
+use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
 use crate::render::Exposure;
@@ -84,6 +84,59 @@ pub enum UsageError {
     /// `--threads 0`.
     #[error("--threads must be at least 1")]
     Threads,
+    /// `--falsecolor-max` is not a positive finite number.
+    #[error("--falsecolor-max must be a positive number, got {0}")]
+    FalsecolorMax(f64),
+}
+
+/// The photometric options as given, before they become a
+/// [`PhotometryConfig`].
+struct PhotometryArgs {
+    stem: String,
+    units: Option<crate::scene::Units>,
+    ies: Vec<(String, std::path::PathBuf)>,
+    illuminance_at: Option<std::path::PathBuf>,
+    illuminance_out: Option<std::path::PathBuf>,
+    workplane: Option<(f32, Option<f32>)>,
+    workplane_out: Option<std::path::PathBuf>,
+    falsecolor: Option<std::path::PathBuf>,
+    falsecolor_of: crate::render::falsecolor::Quantity,
+    falsecolor_scale: crate::render::falsecolor::Scale,
+    falsecolor_max: Option<f64>,
+}
+
+/// The photometric part of the configuration; the work plane's files are
+/// `PREFIX.csv` and `PREFIX.png`, `PREFIX` by default
+/// `<scene-stem>-workplane`.
+fn photometry(a: &PhotometryArgs) -> PhotometryConfig {
+    PhotometryConfig {
+        units: a.units,
+        ies: a.ies.clone(),
+        illuminance: a.illuminance_at.clone().zip(a.illuminance_out.clone()),
+        workplane: a.workplane.map(|(height, spacing)| {
+            let prefix = a
+                .workplane_out
+                .clone()
+                .unwrap_or_else(|| format!("{}-workplane", a.stem).into());
+            let with = |ext: &str| {
+                let mut p = prefix.clone().into_os_string();
+                p.push(ext);
+                std::path::PathBuf::from(p)
+            };
+            WorkplaneConfig {
+                height,
+                spacing,
+                csv: with(".csv"),
+                png: with(".png"),
+            }
+        }),
+        falsecolor: a.falsecolor.clone().map(|path| FalsecolorConfig {
+            path,
+            quantity: a.falsecolor_of,
+            scale: a.falsecolor_scale,
+            max: a.falsecolor_max,
+        }),
+    }
 }
 
 impl TryFrom<Args> for Invocation {
@@ -120,6 +173,28 @@ impl TryFrom<Args> for Invocation {
         let threads = match args.threads {
             None => None,
             Some(n) => Some(NonZeroUsize::new(n).ok_or(UsageError::Threads)?),
+        };
+        if let Some(max) = args.falsecolor_max {
+            if !(max.is_finite() && max > 0.0) {
+                return Err(UsageError::FalsecolorMax(max));
+            }
+        }
+        let args_photometry = PhotometryArgs {
+            stem: args
+                .scene
+                .as_ref()
+                .map_or(SceneSource::Bundled, |p| SceneSource::File(p.clone()))
+                .stem(),
+            units: args.units,
+            ies: args.ies.clone(),
+            illuminance_at: args.illuminance_at.clone(),
+            illuminance_out: args.illuminance_out.clone(),
+            workplane: args.workplane,
+            workplane_out: args.workplane_out.clone(),
+            falsecolor: args.falsecolor.clone(),
+            falsecolor_of: args.falsecolor_of,
+            falsecolor_scale: args.falsecolor_scale,
+            falsecolor_max: args.falsecolor_max,
         };
         let config = RunConfig {
             scene: args.scene.map_or(SceneSource::Bundled, SceneSource::File),
@@ -166,6 +241,7 @@ impl TryFrom<Args> for Invocation {
                 (false, false) => Sides::AsLoaded,
             },
             sky: args.sky,
+            photometry: photometry(&args_photometry),
         };
         let mode = if args.no_window
             || config.output.is_some()

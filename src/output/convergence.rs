@@ -38,7 +38,7 @@ pub const LOG_HEADER: &str = "step,shooter,shooter_line,shot_power,unshot_fracti
 
 /// The font family the plot's text is drawn with.
 const FONT: &str = "sans-serif";
-static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/NotoMono-Regular.ttf");
+use crate::render::falsecolor::FONT_BYTES;
 
 /// One shooting step as logged (see the module docs for each column).
 #[derive(Clone, Copy, Debug, PartialEq)]
