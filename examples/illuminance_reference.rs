@@ -19,12 +19,13 @@
 //!   with the near field, shaft-culled shadow rays, the luminaires'
 //!   intensity tables through the solver's distribution hook;
 //! - by Monte Carlo with nothing of that code: the direct light by
-//!   sampling uniform random points on every luminaire (its intensity
-//!   table read by [`Photometry::intensity`], `I cosθ_x / r²` and a shadow
-//!   ray), the rest by cosine-weighted directions over the hemisphere,
-//!   each traced to the nearest polygon by brute force and given the
-//!   radiosity there interpolated over the element's triangles (what the
-//!   picture shows; luminaires count as black, their light being direct).
+//!   sampling uniform random points on every emitter (a parallelogram),
+//!   `I cosθ_x / r²` with a shadow ray, `I` a luminaire's intensity table
+//!   read by `Photometry::intensity` or `e A cosθ / π` for a Lambertian
+//!   emitter; the reflected light by cosine-weighted directions over the
+//!   hemisphere, each traced to the nearest polygon by brute force and
+//!   given the radiosity there, interpolated over the element's triangles
+//!   (what the picture shows), less the emission the direct part counted.
 //!
 //! Both estimate the same quantity from the same converged solution, so
 //! the difference measures the gather (its form factors, near field and
@@ -63,12 +64,23 @@ impl Rng {
     }
 }
 
-/// The scene's polygons for brute-force ray casting, and its elements
-/// bucketed per polygon for the radiosity lookup.
+/// The scene's polygons for brute-force ray casting, and the solution for
+/// the radiosity lookup.
 struct Tracer<'a> {
     scene: &'a Scene,
     mesh: &'a Mesh,
     radiosity: &'a [Rgb],
+}
+
+/// The material of a polygon.
+trait MaterialOf {
+    fn material_of_polygon(&self, p: &radiosity::scene::Polygon) -> &radiosity::scene::Material;
+}
+
+impl MaterialOf for Scene {
+    fn material_of_polygon(&self, p: &radiosity::scene::Polygon) -> &radiosity::scene::Material {
+        &self.materials[p.material.index()]
+    }
 }
 
 impl Tracer<'_> {
@@ -206,14 +218,22 @@ fn main() {
         .collect();
     let gather_seconds = t.elapsed().as_secs_f64();
 
-    // The luminaires: polygon, its photometry, flux-free (the table is
-    // read directly), its frame.
-    let lights: Vec<(usize, &radiosity::scene::Luminaire)> = scene
+    // The emitters: IES luminaires by their tables, the others as
+    // Lambertian parallelograms of their emission (`I = e A cosθ / π`).
+    let lights: Vec<usize> = scene
         .polygons
         .iter()
         .enumerate()
-        .filter_map(|(i, p)| scene.luminaire_of(p.material).map(|l| (i, l)))
+        .filter(|(_, p)| !scene.material_of_polygon(p).emission().is_black())
+        .map(|(i, _)| i)
         .collect();
+    for &i in &lights {
+        assert_eq!(
+            scene.polygons[i].vertices.len(),
+            4,
+            "the reference samples emitters as parallelograms"
+        );
+    }
     let t = Instant::now();
     let reference: Vec<(f64, f64)> = points
         .par_iter()
@@ -224,12 +244,12 @@ fn main() {
             // Direct: uniform points on each luminaire (a parallelogram
             // v0 + s (v1 − v0) + t (v3 − v0)).
             let mut direct = 0.0;
-            for &(i, l) in &lights {
+            for &i in &lights {
                 let p = &scene.polygons[i];
                 let v: Vec<DVec3> = p.vertices.iter().map(|v| v.as_dvec3()).collect();
                 let nadir = p.normal.as_dvec3();
-                let c0 = l.c0.as_dvec3();
-                let c90 = nadir.cross(c0);
+                let luminaire = scene.luminaire_of(p.material);
+                let lambert = scene.material_of_polygon(p).emission().luminance() * p.area / PI;
                 let mut sum = 0.0;
                 for _ in 0..LIGHT_SAMPLES {
                     let q = v[0] + (v[1] - v[0]) * rng.next() + (v[3] - v[0]) * rng.next();
@@ -240,8 +260,15 @@ fn main() {
                     if cos_x <= 0.0 || cos_t <= 0.0 || tracer.blocked(q, x) {
                         continue;
                     }
-                    let phi = c90.dot(d).atan2(c0.dot(d));
-                    sum += l.photometry.intensity(cos_t.acos(), phi) * cos_x / r2;
+                    let intensity = match luminaire {
+                        Some(l) => {
+                            let c0 = l.c0.as_dvec3();
+                            let phi = nadir.cross(c0).dot(d).atan2(c0.dot(d));
+                            l.photometry.intensity(cos_t.acos(), phi)
+                        }
+                        None => lambert * cos_t,
+                    };
+                    sum += intensity * cos_x / r2;
                 }
                 direct += sum / LIGHT_SAMPLES as f64;
             }
@@ -253,14 +280,12 @@ fn main() {
                 let r = u1.sqrt();
                 let a = 2.0 * PI * u2;
                 let d = t1 * (r * a.cos()) + t2 * (r * a.sin()) + n * (1.0 - u1).sqrt();
+                // The light reflected at the hit: its radiosity less its
+                // emission, which the direct part counted.
                 let b = match tracer.hit(x, d) {
-                    Some((p, t)) if scene.luminaire_of(scene.polygons[p].material).is_none() => {
-                        let front = scene.polygons[p].normal.as_dvec3().dot(d) < 0.0;
-                        if front {
-                            tracer.radiosity_at(p, x + d * t).luminance()
-                        } else {
-                            0.0
-                        }
+                    Some((p, t)) if scene.polygons[p].normal.as_dvec3().dot(d) < 0.0 => {
+                        let e = scene.material_of_polygon(&scene.polygons[p]).emission();
+                        (tracer.radiosity_at(p, x + d * t).luminance() - e.luminance()).max(0.0)
                     }
                     _ => 0.0,
                 };
@@ -280,11 +305,12 @@ fn main() {
         .zip(&reference)
         .map(|(g, r)| (g - r.0).abs())
         .sum();
-    let worst = gathered
+    let (worst_at, worst) = gathered
         .iter()
         .zip(&reference)
         .map(|(g, r)| (g / r.0 - 1.0).abs())
-        .fold(0.0, f64::max);
+        .enumerate()
+        .fold((0, 0.0), |a, (k, d)| if d > a.1 { (k, d) } else { a });
     let se = reference.iter().map(|r| r.1).sum::<f64>() / total;
     println!(
         "{}: {} floor points, mean {:.1} lx; gather {:.3} s ({:.0} points/s), \
@@ -297,10 +323,14 @@ fn main() {
         mc_seconds
     );
     println!(
-        "relL1 {:.3} %, largest relative difference {:.2} %, Monte Carlo standard error \
-         (indirect, relative to the mean) {:.3} %",
+        "relL1 {:.3} %, largest relative difference {:.2} % (at {}: {:.1} lx vs {:.1} ± {:.1} lx), \
+         Monte Carlo standard error (indirect, relative to the mean) {:.3} %",
         100.0 * l1 / total,
         100.0 * worst,
+        points[worst_at].0,
+        gathered[worst_at],
+        reference[worst_at].0,
+        reference[worst_at].1,
         100.0 * se
     );
 }
