@@ -118,6 +118,16 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
             scene
                 .set_luminaire(name, photometry, units)
                 .map_err(|e| PrepareError::Luminaire(name.clone(), Box::new(e)))?;
+            // Said whatever `--quiet` says, as the load warnings are: the
+            // room gets less light than the file's lumens.
+            if let Some(l) = scene.luminaires.last().filter(|l| l.upward_fraction > 0.01) {
+                eprintln!(
+                    "warning: --ies {name}: {} sends {:.0} % of its light above the \
+                     luminaire's plane, which is not emitted",
+                    path.display(),
+                    100.0 * l.upward_fraction
+                );
+            }
         }
     }
     // Solids keep their outside only. Found before the cuts, which leave

@@ -452,15 +452,21 @@ impl Photometry {
     }
 
     /// Luminous flux in lumens into the cone `theta <= max_theta` around
-    /// the nadir: `∫∫ I sinθ dθ dφ` by the midpoint rule on
-    /// [`FLUX_CELLS`].
+    /// the nadir: [`Photometry::flux_between`] from 0.
     pub fn flux(&self, max_theta: f64) -> f64 {
+        self.flux_between(0.0, max_theta)
+    }
+
+    /// Luminous flux in lumens between the vertical angles `from` and `to`
+    /// (radians from the nadir): `∫∫ I sinθ dθ dφ` by the midpoint rule
+    /// on [`FLUX_CELLS`] cells over that band.
+    pub fn flux_between(&self, from: f64, to: f64) -> f64 {
         let (nt, np) = FLUX_CELLS;
-        let dt = max_theta / nt as f64;
+        let dt = (to - from) / nt as f64;
         let dp = 2.0 * PI / np as f64;
         let mut sum = 0.0;
         for i in 0..nt {
-            let t = (i as f64 + 0.5) * dt;
+            let t = from + (i as f64 + 0.5) * dt;
             // The exact integral of sinθ over the cell, not the midpoint's.
             let weight = (t - dt / 2.0).cos() - (t + dt / 2.0).cos();
             let ring: f64 = (0..np)

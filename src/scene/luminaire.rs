@@ -65,7 +65,7 @@ impl Scene {
     ) -> Result<usize, LuminaireError> {
         let members = self.polygons_named(name)?;
         let flux = photometry.flux(PI / 2.0);
-        let total = flux + photometry.flux(PI) - photometry.flux(PI / 2.0);
+        let upward = photometry.flux_between(PI / 2.0, PI);
         if !(flux > 0.0 && flux.is_finite()) {
             return Err(LuminaireError::Dark(name.to_string()));
         }
@@ -86,7 +86,7 @@ impl Scene {
                 photometry: photometry.clone(),
                 c0,
                 flux,
-                upward_fraction: if total > 0.0 { 1.0 - flux / total } else { 0.0 },
+                upward_fraction: upward / (flux + upward),
             });
         }
         Ok(members.len())
@@ -147,5 +147,68 @@ impl Scene {
         ids.sort_unstable();
         ids.dedup();
         Ok(ids)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Sides;
+    use crate::testutil;
+
+    fn cosine() -> Arc<Photometry> {
+        let text = "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n";
+        Arc::new(Photometry::parse(text, "c.ies").unwrap())
+    }
+
+    #[test]
+    fn each_named_polygon_becomes_a_luminaire_of_the_files_flux() {
+        // Two faces of material 0 ("lamp"), one of material 1.
+        let mut polygons = testutil::closed_box(2.0, [0, 1, 1, 1, 1, 0]);
+        polygons.truncate(6);
+        let mut scene = testutil::scene(
+            polygons,
+            vec![
+                testutil::grey("lamp", 1.0, 0.5),
+                testutil::grey("w", 0.0, 0.5),
+            ],
+        );
+        let p = cosine();
+        // Linear between 100 cd at 0° and 0 at 90°: ∫ 100 (1 − 2θ/π) sinθ dθ dφ.
+        let exact = 2.0 * PI * 100.0 * (1.0 - 2.0 / PI);
+        let n = scene.set_luminaire("lamp", p, Units::Cm).unwrap();
+        assert_eq!(n, 2);
+        assert_eq!(scene.luminaires.len(), 2);
+        for l in &scene.luminaires {
+            assert!((l.flux / exact - 1.0).abs() < 1e-4, "{} vs {exact}", l.flux);
+            assert_eq!(l.upward_fraction, 0.0);
+            let polygon = scene
+                .polygons
+                .iter()
+                .find(|q| q.material == l.material)
+                .unwrap();
+            let m = &scene.materials[l.material.index()];
+            assert_eq!(m.reflectance(), Rgb::BLACK);
+            // Exitance × area in m² (4 cm² here) is the flux.
+            let lumens = m.emission().r * Units::Cm.square_metres(polygon.area);
+            assert!((lumens / l.flux - 1.0).abs() < 1e-12);
+            assert!(l.c0.dot(polygon.normal).abs() < 1e-6);
+        }
+        assert!(matches!(
+            scene.set_luminaire("nothing", cosine(), Units::M),
+            Err(LuminaireError::UnknownName(_))
+        ));
+        // Two-sided: the back copies are black, the fronts still emit.
+        let mut scene = scene.with_sides(Sides::Two);
+        scene.darken_luminaire_backs();
+        for p in &scene.polygons {
+            let emits = !scene.materials[p.material.index()].emission().is_black();
+            let luminaire = scene.luminaire_of(p.material).is_some();
+            if p.surface.back_of.is_some() {
+                assert!(!emits && !luminaire);
+            } else {
+                assert_eq!(emits, luminaire);
+            }
+        }
     }
 }
