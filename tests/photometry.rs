@@ -259,3 +259,20 @@ fn the_same_room_in_millimetres_and_in_metres_gives_the_same_lux() {
     let e = scene.materials[l.material.index()].emission().mean();
     assert!((e * Units::Mm.square_metres(lamp.area) / l.flux - 1.0).abs() < 1e-9);
 }
+
+#[test]
+fn a_checkpoint_knows_the_luminaires_distribution() {
+    let (_, _, scene) = luminaire_floor(1.0, Units::M, &[(2.5, 2.5)]);
+    let mesh = mesh::build(&scene, &MeshOptions::for_scene(&scene)).unwrap();
+    let options = SolverOptions::default();
+    let print = |s: &Scene| radiosity::solver::checkpoint::fingerprint(s, &mesh, &options);
+    // The same materials and flux, another shape: the C0 and C90 rows
+    // swapped makes another shot.
+    let mut swapped = scene.clone();
+    let p = Arc::make_mut(&mut swapped.luminaires[0].photometry);
+    let n = p.vertical.len();
+    let (c0, c90) = p.candela.split_at_mut(n);
+    c0.swap_with_slice(&mut c90[..n]);
+    assert_eq!(print(&scene), print(&scene.clone()));
+    assert_ne!(print(&scene), print(&swapped));
+}

@@ -599,4 +599,76 @@ mod tests {
         }
         command.debug_assert();
     }
+
+    #[test]
+    fn photometric_options_reach_the_config() {
+        let c = config(&[
+            "room.sc",
+            "--units",
+            "mm",
+            "--ies",
+            "lamp=a.ies",
+            "--ies",
+            "x=y=b.ies",
+            "--illuminance-at",
+            "p.csv",
+            "--illuminance-out",
+            "e.csv",
+            "--workplane",
+            "750,250",
+            "--falsecolor",
+            "f.png",
+            "--falsecolor-of",
+            "illuminance",
+            "--falsecolor-scale",
+            "linear",
+            "--falsecolor-max",
+            "800",
+        ]);
+        let p = &c.photometry;
+        assert_eq!(p.units, Some(crate::scene::Units::Mm));
+        assert_eq!(
+            p.ies,
+            vec![
+                ("lamp".to_string(), PathBuf::from("a.ies")),
+                ("x=y".to_string(), PathBuf::from("b.ies"))
+            ]
+        );
+        assert_eq!(
+            p.illuminance,
+            Some((PathBuf::from("p.csv"), PathBuf::from("e.csv")))
+        );
+        let w = p.workplane.as_ref().unwrap();
+        assert_eq!((w.height, w.spacing), (750.0, Some(250.0)));
+        // The default prefix is the scene's stem.
+        assert_eq!(w.csv, PathBuf::from("room-workplane.csv"));
+        assert_eq!(w.png, PathBuf::from("room-workplane.png"));
+        let f = p.falsecolor.as_ref().unwrap();
+        assert_eq!(f.path, PathBuf::from("f.png"));
+        assert_eq!(f.quantity, crate::render::falsecolor::Quantity::Illuminance);
+        assert_eq!(f.scale, crate::render::falsecolor::Scale::Linear);
+        assert_eq!(f.max, Some(800.0));
+        assert!(c.wants_batch_outputs());
+        let prefixed = config(&["--workplane", "0.8", "--workplane-out", "out/plan"]);
+        let w = prefixed.photometry.workplane.unwrap();
+        assert_eq!((w.spacing, w.csv), (None, PathBuf::from("out/plan.csv")));
+        // glTF is in metres without --units; .sc has no unit.
+        assert_eq!(config(&["m.glb"]).units(), Some(crate::scene::Units::M));
+        assert_eq!(config(&["m.sc"]).units(), None);
+        for bad in [
+            &["--workplane", "-1"][..],
+            &["--workplane", "1,0"],
+            &["--workplane", "a"],
+            &["--ies", "=x.ies"],
+            &["--ies", "lamp="],
+            &["--units", "furlong"],
+            &["--illuminance-at", "p.csv"],
+        ] {
+            assert!(parse(bad).is_err(), "{bad:?}");
+        }
+        assert_eq!(
+            invocation(&["--falsecolor-max", "0"]),
+            Err(UsageError::FalsecolorMax(0.0))
+        );
+    }
 }
