@@ -5,8 +5,9 @@
 
 use crate::color::Rgb;
 use crate::mesh::{self, refine::RefineOptions};
+use crate::render::falsecolor::{Quantity, Scale};
 use crate::render::Exposure;
-use crate::scene::Sides;
+use crate::scene::{Sides, Units};
 use crate::solver::SolverOptions;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -125,6 +126,58 @@ pub struct RunConfig {
     /// [`crate::scene::MAX_EMISSION`]) all around the scene, added after
     /// `--emit` by [`crate::scene::Scene::add_sky`]; `None` by default.
     pub sky: Option<Rgb>,
+    /// Photometric options and outputs (`--units`, `--ies`,
+    /// `--illuminance-at`, `--workplane`, `--falsecolor`); all off by
+    /// default.
+    pub photometry: PhotometryConfig,
+}
+
+/// The photometric part of a run: what a scene unit is, the luminaires,
+/// and the photometric results to write.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PhotometryConfig {
+    /// `--units`: what one scene unit is; `None` when not given (a glTF
+    /// scene is in metres by its specification all the same, see
+    /// [`RunConfig::units`]).
+    pub units: Option<Units>,
+    /// `--ies NAME=FILE`, in order: the polygons of `NAME` emit with the
+    /// distribution of the IES file ([`crate::scene::Scene::set_luminaire`]).
+    pub ies: Vec<(String, PathBuf)>,
+    /// `--illuminance-at` and `--illuminance-out`: the points file to read
+    /// and the CSV to write.
+    pub illuminance: Option<(PathBuf, PathBuf)>,
+    /// `--workplane` and `--workplane-out`.
+    pub workplane: Option<WorkplaneConfig>,
+    /// `--falsecolor` and its options.
+    pub falsecolor: Option<FalsecolorConfig>,
+}
+
+/// A work plane to compute and write.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorkplaneConfig {
+    /// Height above the floor of the scene's bounds, scene units, `>= 0`.
+    pub height: f32,
+    /// Grid spacing in scene units (`> 0`), `None` for the default
+    /// ([`crate::output::photometry::default_spacing_metres`]).
+    pub spacing: Option<f32>,
+    /// The CSV to write (`PREFIX.csv`).
+    pub csv: PathBuf,
+    /// The plan to write (`PREFIX.png`).
+    pub png: PathBuf,
+}
+
+/// A false-colour picture of the view to write.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FalsecolorConfig {
+    /// The picture (`.png`, `.tif` or `.tiff`).
+    pub path: PathBuf,
+    /// What it shows.
+    pub quantity: Quantity,
+    /// Linear or logarithmic.
+    pub scale: Scale,
+    /// The value shown red, in the quantity's unit (`> 0`); `None` for
+    /// the picture's largest, rounded up.
+    pub max: Option<f64>,
 }
 
 impl RunConfig {
@@ -155,7 +208,30 @@ impl RunConfig {
             emit: Vec::new(),
             sides: Sides::AsLoaded,
             sky: None,
+            photometry: PhotometryConfig::default(),
         }
+    }
+
+    /// What one scene unit is: `--units`, else metres for a glTF scene
+    /// (by the format's specification), else unknown.
+    pub fn units(&self) -> Option<Units> {
+        self.photometry.units.or_else(|| match &self.scene {
+            SceneSource::File(p)
+                if p.extension().is_some_and(|e| {
+                    e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb")
+                }) =>
+            {
+                Some(Units::M)
+            }
+            _ => None,
+        })
+    }
+
+    /// True when a photometric result (illuminance, work plane, false
+    /// colour) is asked for.
+    pub fn wants_photometry(&self) -> bool {
+        let p = &self.photometry;
+        p.illuminance.is_some() || p.workplane.is_some() || p.falsecolor.is_some()
     }
 }
 
@@ -164,7 +240,11 @@ impl RunConfig {
     /// mesh export, the log, the plot or mesh lines on the picture), so no
     /// window should open.
     pub fn wants_batch_outputs(&self) -> bool {
-        self.export.is_some() || self.log.is_some() || self.plot.is_some() || self.mesh_lines
+        self.export.is_some()
+            || self.log.is_some()
+            || self.plot.is_some()
+            || self.mesh_lines
+            || self.wants_photometry()
     }
 
     /// Every file the batch run writes besides the picture.
@@ -178,6 +258,14 @@ impl RunConfig {
         ]
         .into_iter()
         .flatten()
+        .chain(self.photometry.illuminance.iter().map(|(_, out)| out))
+        .chain(
+            self.photometry
+                .workplane
+                .iter()
+                .flat_map(|w| [&w.csv, &w.png]),
+        )
+        .chain(self.photometry.falsecolor.iter().map(|f| &f.path))
     }
 }
 

@@ -11,10 +11,14 @@
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
-use crate::scene::{self, LoadError, PolygonError, Scene, SplitStats, UnknownName};
+use crate::scene::{
+    self, IesError, LoadError, LuminaireError, Photometry, PolygonError, Scene, SplitStats,
+    UnknownName,
+};
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Why a scene could not be prepared.
@@ -36,6 +40,19 @@ pub enum PrepareError {
     /// polygon may have (a scene within a tenth of that limit).
     #[error("--sky: the scene is too large to put a sky around it: {0}")]
     Sky(PolygonError),
+    /// An `--ies` file is bad or unreadable; the message reads
+    /// `FILE:LINE:COL: error: ...`.
+    #[error("{0}")]
+    Ies(#[from] IesError),
+    /// An `--ies` name is unknown, or its distribution is dark.
+    #[error("--ies {0}: {1}")]
+    Luminaire(String, Box<LuminaireError>),
+    /// `--ies` on a scene without a unit: candela need metres.
+    #[error(
+        "--ies needs --units for {0}: a luminous intensity in candela gives lux only \
+         at distances in metres (glTF scenes are in metres; OBJ and .sc have no unit)"
+    )]
+    NoUnits(String),
 }
 
 /// Seconds spent in each phase of a run.
@@ -92,6 +109,27 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
+    if !config.photometry.ies.is_empty() {
+        let units = config
+            .units()
+            .ok_or_else(|| PrepareError::NoUnits(config.scene.display_name()))?;
+        for (name, path) in &config.photometry.ies {
+            let photometry = Arc::new(Photometry::load(path)?);
+            scene
+                .set_luminaire(name, photometry, units)
+                .map_err(|e| PrepareError::Luminaire(name.clone(), Box::new(e)))?;
+            // Said whatever `--quiet` says, as the load warnings are: the
+            // room gets less light than the file's lumens.
+            if let Some(l) = scene.luminaires.last().filter(|l| l.upward_fraction > 0.01) {
+                eprintln!(
+                    "warning: --ies {name}: {} sends {:.0} % of its light above the \
+                     luminaire's plane, which is not emitted",
+                    path.display(),
+                    100.0 * l.upward_fraction
+                );
+            }
+        }
+    }
     // Solids keep their outside only. Found before the cuts, which leave
     // T-junctions on a box sunk into a floor; the pieces keep the mark.
     if let Some(warning) = scene.orient_solids(config.sides, &config.scene.display_name()) {
@@ -102,6 +140,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     // each piece gets its own.
     let split = scene.split_intersections();
     let mut scene = scene.with_sides(config.sides);
+    scene.darken_luminaire_backs();
     // Last, after everything that adds or changes polygons, so that the
     // enclosure is built around the finished scene.
     if let Some(sky) = config.sky {

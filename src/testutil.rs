@@ -80,6 +80,7 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
         camera_source: CameraSource::File,
         warnings: Vec::new(),
         groups: Vec::new(),
+        luminaires: Vec::new(),
     }
 }
 

@@ -23,6 +23,7 @@
 
 pub mod checkpoint;
 pub mod outputs;
+pub mod photometry;
 pub mod progress;
 
 pub use checkpoint::CheckpointError;
@@ -89,6 +90,10 @@ pub enum RunError {
     /// Writing a result failed.
     #[error("{0}")]
     Write(OutputError),
+    /// The `--illuminance-at` points file is bad or unreadable; the
+    /// message reads `FILE:LINE:COL: error: ...`.
+    #[error("{0}")]
+    Points(#[from] crate::scene::points::PointsError),
 }
 
 impl RunError {
@@ -121,7 +126,10 @@ impl RunError {
     pub fn is_self_describing(&self) -> bool {
         matches!(
             self,
-            RunError::Prepare(PrepareError::Load(_)) | RunError::Interrupted { .. }
+            RunError::Prepare(PrepareError::Load(_))
+                | RunError::Prepare(PrepareError::Ies(_))
+                | RunError::Points(_)
+                | RunError::Interrupted { .. }
         )
     }
 }
@@ -232,6 +240,8 @@ pub fn run_prepared(
     let output = config.output_path();
     let mut seconds = prepared.seconds;
     let view = prepared.view(config)?;
+    // Bad points or a work plane outside the scene are said before solving.
+    photometry::check(config, prepared)?;
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
@@ -324,6 +334,7 @@ pub fn run_prepared(
         )
         .map_err(RunError::Write)?;
     }
+    photometry::write(config, prepared, mesh, &solved.radiosity, frame, &view)?;
     let mut stats = RunStats {
         scene: config.scene.display_name(),
         output: output.display().to_string(),

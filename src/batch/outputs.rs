@@ -26,6 +26,16 @@ pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     if let Some(plot) = &config.plot {
         convergence::check_plot_path(plot).map_err(RunError::BadOutput)?;
     }
+    // False-colour pictures and plans are 8-bit, as the plot is.
+    let photometry = &config.photometry;
+    for picture in photometry
+        .falsecolor
+        .iter()
+        .map(|f| &f.path)
+        .chain(photometry.workplane.iter().map(|w| &w.png))
+    {
+        convergence::check_plot_path(picture).map_err(RunError::BadOutput)?;
+    }
     let outputs: Vec<&PathBuf> = std::iter::once(&output)
         .chain(config.extra_outputs())
         .collect();

@@ -5,7 +5,10 @@
 //! Each option's doc comment is its help: the first paragraph is the one
 //! line `-h` shows, the whole comment is what `--help` shows.
 
-use super::values::{parse_emit, parse_hemicube_res, parse_shooter_samples, parse_size, parse_sky};
+use super::values::{
+    parse_emit, parse_hemicube_res, parse_ies, parse_shooter_samples, parse_size, parse_sky,
+    parse_workplane,
+};
 use crate::color::Rgb;
 use crate::config;
 use crate::mesh::refine;
@@ -310,4 +313,82 @@ pub struct Args {
     /// No progress bar and no summary line.
     #[arg(short, long)]
     pub(crate) quiet: bool,
+
+    /// What one scene unit is, for photometric results: m, cm, mm, in, ft.
+    ///
+    /// With a unit, emission and radiosity are luminous exitance in lm/m²,
+    /// luminance (radiosity/π) is in cd/m² and illuminance in lux. glTF
+    /// scenes are in metres by their specification; OBJ and .sc scenes
+    /// need this for lux (without it, results are in the scene's radiosity
+    /// units) and for --ies.
+    #[arg(long, value_name = "UNIT", value_enum)]
+    pub(crate) units: Option<crate::scene::Units>,
+
+    /// Make polygons emit as an IES luminaire (repeatable).
+    ///
+    /// NAME=FILE.ies: each polygon of the material, object or group NAME
+    /// (named as for --emit) becomes one luminaire with the light
+    /// distribution of the IESNA LM-63 file (type C, TILT=NONE), its
+    /// photometric nadir along the polygon's front normal and its C0 plane
+    /// along the polygon's first edge. It emits the file's flux below its
+    /// plane and reflects nothing. Needs --units for OBJ and .sc scenes.
+    #[arg(long, value_name = "NAME=FILE", value_parser = parse_ies)]
+    pub(crate) ies: Vec<(String, PathBuf)>,
+
+    /// Compute the illuminance at the points of this CSV file.
+    ///
+    /// One point a line, `x,y,z,nx,ny,nz` (position in scene units, the
+    /// normal of the surface the light falls on), a header line allowed;
+    /// each point by a final gather over the converged solution. Written
+    /// to --illuminance-out.
+    #[arg(long, value_name = "POINTS.csv", requires = "illuminance_out")]
+    pub(crate) illuminance_at: Option<PathBuf>,
+
+    /// Where --illuminance-at writes its values (CSV).
+    ///
+    /// Header `x,y,z,nx,ny,nz,e_r,e_g,e_b,e`; `e` weights the channels by
+    /// the Rec. 709 luminance weights; lux with --units.
+    #[arg(long, value_name = "VALUES.csv", requires = "illuminance_at")]
+    pub(crate) illuminance_out: Option<PathBuf>,
+
+    /// Compute a horizontal work plane: HEIGHT[,SPACING] in scene units.
+    ///
+    /// A grid of points over the floor of the scene's bounds, HEIGHT above
+    /// it (up is the camera's up axis), SPACING apart (default
+    /// 0.2 × 5^log10(d) metres for a floor d metres long, as EN 12464-1
+    /// suggests). Writes PREFIX.csv and PREFIX.png (a false-colour plan
+    /// with isolux lines; see --workplane-out) and prints Eavg, Emin, Emax
+    /// and Emin/Eavg.
+    #[arg(long, value_name = "HEIGHT[,SPACING]", value_parser = parse_workplane)]
+    pub(crate) workplane: Option<(f32, Option<f32>)>,
+
+    /// File name prefix of the --workplane results.
+    ///
+    /// Default: <scene-name>-workplane in the current directory.
+    #[arg(long, value_name = "PREFIX", requires = "workplane")]
+    pub(crate) workplane_out: Option<PathBuf>,
+
+    /// Write the view in false colour, with a legend (.png or .tiff).
+    #[arg(long, value_name = "FILE.png")]
+    pub(crate) falsecolor: Option<PathBuf>,
+
+    /// What --falsecolor shows.
+    ///
+    /// luminance (radiosity/π of the surface seen, cd/m² with --units) or
+    /// illuminance (light falling on it: its reflected radiosity over its
+    /// reflectance, lux with --units; 0 on black surfaces).
+    #[arg(long, value_name = "QUANTITY", value_enum,
+          default_value_t = crate::render::falsecolor::Quantity::Luminance)]
+    pub(crate) falsecolor_of: crate::render::falsecolor::Quantity,
+
+    /// The scale of --falsecolor and of the --workplane plan.
+    #[arg(long, value_name = "SCALE", value_enum,
+          default_value_t = crate::render::falsecolor::Scale::Log)]
+    pub(crate) falsecolor_scale: crate::render::falsecolor::Scale,
+
+    /// The value shown red by --falsecolor and the plan.
+    ///
+    /// Default: the largest value, rounded up to 1, 2 or 5 times a power of 10.
+    #[arg(long, value_name = "V")]
+    pub(crate) falsecolor_max: Option<f64>,
 }

@@ -9,7 +9,7 @@
 //! interval and thread count) are checked here.
 
 use super::args::Args;
-use crate::config::{RunConfig, SceneSource};
+use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
 use crate::render::Exposure;
@@ -84,6 +84,59 @@ pub enum UsageError {
     /// `--threads 0`.
     #[error("--threads must be at least 1")]
     Threads,
+    /// `--falsecolor-max` is not a positive finite number.
+    #[error("--falsecolor-max must be a positive number, got {0}")]
+    FalsecolorMax(f64),
+}
+
+/// The photometric options as given, before they become a
+/// [`PhotometryConfig`].
+struct PhotometryArgs {
+    stem: String,
+    units: Option<crate::scene::Units>,
+    ies: Vec<(String, std::path::PathBuf)>,
+    illuminance_at: Option<std::path::PathBuf>,
+    illuminance_out: Option<std::path::PathBuf>,
+    workplane: Option<(f32, Option<f32>)>,
+    workplane_out: Option<std::path::PathBuf>,
+    falsecolor: Option<std::path::PathBuf>,
+    falsecolor_of: crate::render::falsecolor::Quantity,
+    falsecolor_scale: crate::render::falsecolor::Scale,
+    falsecolor_max: Option<f64>,
+}
+
+/// The photometric part of the configuration; the work plane's files are
+/// `PREFIX.csv` and `PREFIX.png`, `PREFIX` by default
+/// `<scene-stem>-workplane`.
+fn photometry(a: &PhotometryArgs) -> PhotometryConfig {
+    PhotometryConfig {
+        units: a.units,
+        ies: a.ies.clone(),
+        illuminance: a.illuminance_at.clone().zip(a.illuminance_out.clone()),
+        workplane: a.workplane.map(|(height, spacing)| {
+            let prefix = a
+                .workplane_out
+                .clone()
+                .unwrap_or_else(|| format!("{}-workplane", a.stem).into());
+            let with = |ext: &str| {
+                let mut p = prefix.clone().into_os_string();
+                p.push(ext);
+                std::path::PathBuf::from(p)
+            };
+            WorkplaneConfig {
+                height,
+                spacing,
+                csv: with(".csv"),
+                png: with(".png"),
+            }
+        }),
+        falsecolor: a.falsecolor.clone().map(|path| FalsecolorConfig {
+            path,
+            quantity: a.falsecolor_of,
+            scale: a.falsecolor_scale,
+            max: a.falsecolor_max,
+        }),
+    }
 }
 
 impl TryFrom<Args> for Invocation {
@@ -120,6 +173,28 @@ impl TryFrom<Args> for Invocation {
         let threads = match args.threads {
             None => None,
             Some(n) => Some(NonZeroUsize::new(n).ok_or(UsageError::Threads)?),
+        };
+        if let Some(max) = args.falsecolor_max {
+            if !(max.is_finite() && max > 0.0) {
+                return Err(UsageError::FalsecolorMax(max));
+            }
+        }
+        let args_photometry = PhotometryArgs {
+            stem: args
+                .scene
+                .as_ref()
+                .map_or(SceneSource::Bundled, |p| SceneSource::File(p.clone()))
+                .stem(),
+            units: args.units,
+            ies: args.ies.clone(),
+            illuminance_at: args.illuminance_at.clone(),
+            illuminance_out: args.illuminance_out.clone(),
+            workplane: args.workplane,
+            workplane_out: args.workplane_out.clone(),
+            falsecolor: args.falsecolor.clone(),
+            falsecolor_of: args.falsecolor_of,
+            falsecolor_scale: args.falsecolor_scale,
+            falsecolor_max: args.falsecolor_max,
         };
         let config = RunConfig {
             scene: args.scene.map_or(SceneSource::Bundled, SceneSource::File),
@@ -167,6 +242,7 @@ impl TryFrom<Args> for Invocation {
                 (false, false) => Sides::AsLoaded,
             },
             sky: args.sky,
+            photometry: photometry(&args_photometry),
         };
         let mode = if args.no_window
             || config.output.is_some()
@@ -534,5 +610,77 @@ mod tests {
             );
         }
         command.debug_assert();
+    }
+
+    #[test]
+    fn photometric_options_reach_the_config() {
+        let c = config(&[
+            "room.sc",
+            "--units",
+            "mm",
+            "--ies",
+            "lamp=a.ies",
+            "--ies",
+            "x=y=b.ies",
+            "--illuminance-at",
+            "p.csv",
+            "--illuminance-out",
+            "e.csv",
+            "--workplane",
+            "750,250",
+            "--falsecolor",
+            "f.png",
+            "--falsecolor-of",
+            "illuminance",
+            "--falsecolor-scale",
+            "linear",
+            "--falsecolor-max",
+            "800",
+        ]);
+        let p = &c.photometry;
+        assert_eq!(p.units, Some(crate::scene::Units::Mm));
+        assert_eq!(
+            p.ies,
+            vec![
+                ("lamp".to_string(), PathBuf::from("a.ies")),
+                ("x=y".to_string(), PathBuf::from("b.ies"))
+            ]
+        );
+        assert_eq!(
+            p.illuminance,
+            Some((PathBuf::from("p.csv"), PathBuf::from("e.csv")))
+        );
+        let w = p.workplane.as_ref().unwrap();
+        assert_eq!((w.height, w.spacing), (750.0, Some(250.0)));
+        // The default prefix is the scene's stem.
+        assert_eq!(w.csv, PathBuf::from("room-workplane.csv"));
+        assert_eq!(w.png, PathBuf::from("room-workplane.png"));
+        let f = p.falsecolor.as_ref().unwrap();
+        assert_eq!(f.path, PathBuf::from("f.png"));
+        assert_eq!(f.quantity, crate::render::falsecolor::Quantity::Illuminance);
+        assert_eq!(f.scale, crate::render::falsecolor::Scale::Linear);
+        assert_eq!(f.max, Some(800.0));
+        assert!(c.wants_batch_outputs());
+        let prefixed = config(&["--workplane", "0.8", "--workplane-out", "out/plan"]);
+        let w = prefixed.photometry.workplane.unwrap();
+        assert_eq!((w.spacing, w.csv), (None, PathBuf::from("out/plan.csv")));
+        // glTF is in metres without --units; .sc has no unit.
+        assert_eq!(config(&["m.glb"]).units(), Some(crate::scene::Units::M));
+        assert_eq!(config(&["m.sc"]).units(), None);
+        for bad in [
+            &["--workplane", "-1"][..],
+            &["--workplane", "1,0"],
+            &["--workplane", "a"],
+            &["--ies", "=x.ies"],
+            &["--ies", "lamp="],
+            &["--units", "furlong"],
+            &["--illuminance-at", "p.csv"],
+        ] {
+            assert!(parse(bad).is_err(), "{bad:?}");
+        }
+        assert_eq!(
+            invocation(&["--falsecolor-max", "0"]),
+            Err(UsageError::FalsecolorMax(0.0))
+        );
     }
 }

@@ -42,6 +42,13 @@ pub enum ValueError {
         min = crate::solver::hemicube::MIN_HEMICUBE_RES,
         max = crate::solver::hemicube::MAX_HEMICUBE_RES)]
     HemicubeRes(String),
+    /// `--ies` is not `NAME=FILE` with both parts non-empty.
+    #[error("--ies must look like NAME=FILE.ies, got `{0}`")]
+    Ies(String),
+    /// `--workplane` is not `HEIGHT` or `HEIGHT,SPACING`, a height `>= 0`
+    /// and a spacing `> 0`, both finite.
+    #[error("--workplane must look like 0.8 or 0.8,0.25 (a height >= 0, a spacing > 0, in scene units), got `{0}`")]
+    Workplane(String),
 }
 
 /// Parses `--hemicube-res`: pixels across a hemicube's top face, an even
@@ -51,6 +58,33 @@ pub fn parse_hemicube_res(text: &str) -> Result<HemicubeRes, ValueError> {
         .ok()
         .and_then(|n| HemicubeRes::new(n).ok())
         .ok_or_else(|| ValueError::HemicubeRes(text.to_string()))
+}
+
+/// Parses `--ies`: `NAME=FILE`, split at the last `=`, neither empty.
+/// Whether the scene has such a name and the file is an IES file is for
+/// the run to say.
+pub fn parse_ies(text: &str) -> Result<(String, std::path::PathBuf), ValueError> {
+    match text.rsplit_once('=') {
+        Some((name, file)) if !name.is_empty() && !file.is_empty() => {
+            Ok((name.to_string(), file.into()))
+        }
+        _ => Err(ValueError::Ies(text.to_string())),
+    }
+}
+
+/// Parses `--workplane`: `HEIGHT` or `HEIGHT,SPACING`, in scene units,
+/// the height finite and `>= 0`, the spacing finite and `> 0`.
+pub fn parse_workplane(text: &str) -> Result<(f32, Option<f32>), ValueError> {
+    let bad = || ValueError::Workplane(text.to_string());
+    let number = |s: &str| s.trim().parse::<f32>().ok().filter(|v| v.is_finite());
+    let (height, spacing) = match text.split_once(',') {
+        Some((h, s)) => (number(h).ok_or_else(bad)?, Some(number(s).ok_or_else(bad)?)),
+        None => (number(text).ok_or_else(bad)?, None),
+    };
+    if height < 0.0 || spacing.is_some_and(|s| s <= 0.0) {
+        return Err(bad());
+    }
+    Ok((height, spacing))
 }
 
 /// Parses `--size`: `WxH` (or `WXH`), width and height in pixels, both

@@ -13,6 +13,7 @@
 pub mod convergence;
 pub mod image;
 pub mod mesh_export;
+pub mod photometry;
 
 pub use self::image::{write_picture, write_rgb8, PictureFormat, SUPPORTED_EXTENSIONS};
 pub use self::mesh_export::{write_mesh, MeshFormat, MESH_EXTENSIONS};

@@ -27,6 +27,7 @@
 pub mod antialias;
 pub mod camera;
 pub mod coverage;
+pub mod falsecolor;
 pub mod overlay;
 pub mod raster;
 pub mod text;

@@ -301,7 +301,7 @@ impl Scene {
     }
 
     /// The error for a name nothing has: every name the scene has.
-    fn unknown_name(&self, name: &str) -> UnknownName {
+    pub(super) fn unknown_name(&self, name: &str) -> UnknownName {
         let of = |kind: GroupKind| {
             self.groups
                 .iter()

@@ -616,6 +616,7 @@ impl<'a> Reader<'a> {
             materials,
             warnings: self.warnings,
             groups,
+            luminaires: Vec::new(),
         };
         if let Some(warning) = scene.drop_duplicates(file) {
             scene.warnings.push(warning);

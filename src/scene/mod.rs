@@ -12,7 +12,10 @@ mod error;
 mod framing;
 pub mod gltf;
 pub mod hall;
+pub mod ies;
+mod luminaire;
 pub mod obj;
+pub mod points;
 mod polygon;
 mod sc;
 mod sides;
@@ -20,6 +23,7 @@ mod sky;
 mod solids;
 pub mod sphere_box;
 mod split;
+mod units;
 
 pub use coplanar::{
     covered_by, draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE,
@@ -34,6 +38,8 @@ pub use framing::{
     EYE_HEIGHT_FRACTIONS, FRAMING_RAYS, RAY_EDGE_TOLERANCE, RAY_PARALLEL_COSINE, ROOM_FOV_DEG,
     ROOM_MIN_FRONT_FRACTION, ROOM_PROBE_OFFSET,
 };
+pub use ies::{IesError, Photometry};
+pub use luminaire::{Luminaire, LuminaireError};
 pub use obj::load_obj;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
@@ -43,6 +49,7 @@ pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MA
 pub use sides::Sides;
 pub use sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
 pub use split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
+pub use units::{Photometric, Units};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.
@@ -205,6 +212,10 @@ pub struct Scene {
     /// that a polygon may belong to several; [`Scene::set_emission`]
     /// reads them.
     pub groups: Vec<Group>,
+    /// The luminaires `--ies` made ([`Scene::set_luminaire`]): materials
+    /// whose polygons emit with a light distribution instead of
+    /// Lambert's cosine. Empty unless asked for.
+    pub luminaires: Vec<Luminaire>,
 }
 
 impl Scene {

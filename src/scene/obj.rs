@@ -499,6 +499,7 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
         camera_source: CameraSource::AutoFramed,
         warnings,
         groups: GroupScan::finish(groups),
+        luminaires: Vec::new(),
     };
     if let Some(warning) = scene.drop_duplicates(file) {
         scene.warnings.push(warning);

@@ -190,6 +190,18 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
             h.word(c.to_bits());
         }
     }
+    // A luminaire's distribution shapes its shot (`--ies`); without
+    // luminaires the fingerprint is what it was.
+    for l in &scene.luminaires {
+        h.word(u64::from(l.material.0));
+        for c in l.c0.to_array() {
+            h.word(u64::from(c.to_bits()));
+        }
+        let p = &l.photometry;
+        for v in p.vertical.iter().chain(&p.horizontal).chain(&p.candela) {
+            h.word(v.to_bits());
+        }
+    }
     h.bytes(b"mesh");
     h.word(mesh.vertex_count() as u64);
     h.word(mesh.elements.len() as u64);

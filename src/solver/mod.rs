@@ -44,7 +44,9 @@
 
 pub mod checkpoint;
 pub mod cluster;
+pub mod distribution;
 pub mod formfactor;
+pub mod gather;
 pub mod hemicube;
 pub mod receivers;
 mod unshot;
@@ -328,6 +330,9 @@ pub struct Progressive<'a> {
     power_weight: Vec<f64>,
     /// Per polygon: shooter samples.
     samples: Vec<Vec<ShooterSample>>,
+    /// Per polygon: its light distribution when it is a luminaire (its
+    /// shot then weights directions by it, [`distribution`]).
+    directional: Vec<Option<distribution::Directional>>,
     /// Per vertex: radiosity `b`.
     radiosity: Vec<Rgb>,
     /// Unshot radiosity `Δb`: per polygon or per vertex, by
@@ -480,6 +485,7 @@ impl<'a> Progressive<'a> {
             reflectance,
             power_weight,
             samples,
+            directional: distribution::Directional::for_scene(scene),
             radiosity,
             unshot,
             shot: Vec::new(),
@@ -952,13 +958,15 @@ impl<'a> Progressive<'a> {
         let reflectance = &self.reflectance;
         let near_field = self.options.near_field;
         let shot = &self.shot;
+        let directional = self.directional[i].as_ref();
         // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
         // pairs and rays it took.
         let exact = |l: usize, j: PolygonId, _: &mut Vec<(u32, u32)>| -> (Rgb, u64, u64) {
             let x = mesh.sample_positions[l];
             let tile = tile_of[l] as usize * groups;
             let mut rays = 0u64;
-            let (f, pairs) = weighted_point_to_samples(
+            let (f, pairs) = distribution::shot_point_to_samples(
+                directional,
                 x,
                 mesh.polygons[j.index()].normal,
                 shooter_normal,
@@ -1378,7 +1386,8 @@ impl<'a> Progressive<'a> {
                         continue;
                     }
                     let shooter = PolygonId(i as u32);
-                    let (f, asked) = weighted_point_to_samples(
+                    let (f, asked) = distribution::shot_point_to_samples(
+                        self.directional[i].as_ref(),
                         x,
                         normal,
                         self.mesh.polygons[i].normal,

@@ -950,6 +950,7 @@ impl<'a> Parser<'a> {
             camera_source,
             warnings: Vec::new(),
             groups: Vec::new(),
+            luminaires: Vec::new(),
         })
     }
 

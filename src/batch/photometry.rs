@@ -1,0 +1,150 @@
+//! The photometric results of a batch run: illuminance at points
+//! (`--illuminance-at`), the work plane (`--workplane`) and the view in
+//! false colour (`--falsecolor`), from the converged solution.
+//!
+//! Each says on stderr what it computed and how long it took (unless
+//! quiet); the work plane's figures go to stdout whatever `--quiet` says,
+//! as they are a result. Without a scene unit (`--units`, or a glTF file)
+//! values are in the scene's radiosity units, not lux, and a warning says
+//! so once.
+
+use super::RunError;
+use crate::color::Rgb;
+use crate::config::RunConfig;
+use crate::mesh::Mesh;
+use crate::output::{self, photometry as out};
+use crate::prepare::Prepared;
+use crate::render::falsecolor::{self, Mapping, Quantity};
+use crate::render::{Frame, View};
+use crate::scene::points;
+use crate::scene::Photometric;
+use crate::solver::gather::{vertex_irradiance, FinalGather};
+use std::time::Instant;
+
+/// Checks what can be checked before solving: the points file parses and
+/// the work plane lies within the scene.
+pub fn check(config: &RunConfig, prepared: &Prepared) -> Result<(), RunError> {
+    let p = &config.photometry;
+    if let Some((at, _)) = &p.illuminance {
+        points::load_points(at)?;
+    }
+    if let Some(w) = &p.workplane {
+        out::workplane_grid(&prepared.scene, w.height, w.spacing, config.units())
+            .map_err(|e| RunError::Options(e.to_string()))?;
+    }
+    Ok(())
+}
+
+/// Computes and writes every photometric result `config` asks for, from
+/// `radiosity` (per vertex of `mesh`, the solution) and the picture's
+/// linear `frame` seen through `view`. Returns the seconds spent.
+pub fn write(
+    config: &RunConfig,
+    prepared: &Prepared,
+    mesh: &Mesh,
+    radiosity: &[Rgb],
+    frame: &Frame,
+    view: &View,
+) -> Result<f64, RunError> {
+    let start = Instant::now();
+    if !config.wants_photometry() {
+        return Ok(0.0);
+    }
+    let units = config.units();
+    let photometric = Photometric { units };
+    if units.is_none() {
+        eprintln!(
+            "warning: no --units: photometric results are in the scene's radiosity units, \
+             not lux; give --units m|cm|mm|in|ft to read emission as lm/m² and get lux"
+        );
+    }
+    let say = |what: String| {
+        if config.progress {
+            eprintln!("{what}");
+        }
+    };
+    let p = &config.photometry;
+    let near_field = config.solver.near_field;
+    let gather = || {
+        FinalGather::new(
+            &prepared.scene,
+            mesh,
+            &prepared.visibility,
+            radiosity,
+            near_field,
+        )
+    };
+    if let Some((at, to)) = &p.illuminance {
+        let points = points::load_points(at)?;
+        let t = Instant::now();
+        let values = gather().irradiance_at(&points);
+        say(format!(
+            "illuminance at {} points: {:.2} s",
+            points.len(),
+            t.elapsed().as_secs_f64()
+        ));
+        out::write_illuminance(to, &points, &values).map_err(RunError::Write)?;
+    }
+    if let Some(w) = &p.workplane {
+        let grid = out::workplane_grid(&prepared.scene, w.height, w.spacing, units)
+            .map_err(|e| RunError::Options(e.to_string()))?;
+        let t = Instant::now();
+        let values = gather().irradiance_at(&grid.points);
+        say(format!(
+            "work plane of {} × {} points {} apart: {:.2} s",
+            grid.nx,
+            grid.ny,
+            grid.spacing,
+            t.elapsed().as_secs_f64()
+        ));
+        let (scale, max) = p
+            .falsecolor
+            .as_ref()
+            .map_or((falsecolor::Scale::Log, None), |f| (f.scale, f.max));
+        let u = out::write_workplane(&w.csv, &w.png, &grid, &values, scale, max, photometric)
+            .map_err(RunError::Write)?;
+        println!(
+            "work plane at {}: {}",
+            w.height,
+            u.line(photometric.illuminance_unit())
+        );
+    }
+    if let Some(f) = &p.falsecolor {
+        let (values, title, unit): (Vec<Option<f64>>, &str, &str) = match f.quantity {
+            Quantity::Luminance => (
+                frame
+                    .pixels
+                    .iter()
+                    .zip(&frame.covered)
+                    .map(|(px, &c)| {
+                        let rgb = Rgb::new(px[0] as f64, px[1] as f64, px[2] as f64);
+                        c.then(|| rgb.luminance() / std::f64::consts::PI)
+                    })
+                    .collect(),
+                "luminance",
+                photometric.luminance_unit(),
+            ),
+            Quantity::Illuminance => {
+                let irradiance = vertex_irradiance(&prepared.scene, mesh, radiosity);
+                let e = crate::render::render(mesh, &irradiance, view)?;
+                (
+                    e.pixels
+                        .iter()
+                        .zip(&e.covered)
+                        .map(|(px, &c)| {
+                            let rgb = Rgb::new(px[0] as f64, px[1] as f64, px[2] as f64);
+                            c.then(|| rgb.luminance())
+                        })
+                        .collect(),
+                    "illuminance",
+                    photometric.illuminance_unit(),
+                )
+            }
+        };
+        let finite: Vec<f64> = values.iter().flatten().copied().collect();
+        let mapping = Mapping::new(&finite, f.max, f.scale);
+        let img = falsecolor::picture(&values, frame.width, frame.height, mapping, title, unit);
+        output::write_rgb8(&f.path, &img).map_err(RunError::Write)?;
+    }
+    Ok(start.elapsed().as_secs_f64())
+}

@@ -1,0 +1,204 @@
+//! The final gather: irradiance at any point of space, from a converged
+//! solution.
+//!
+//! A point `x` with unit normal `n` (a light meter's cell, a work plane,
+//! a point off every polygon) receives
+//!
+//! ```text
+//! E(x) = Σ_e B_e · F(x → e)
+//! ```
+//!
+//! over every element `e` of every polygon, `B_e` the element's radiosity
+//! (the mean of its corners' radiosities: the mean of the Gouraud-shaded
+//! values over it) and `F` the form factor from a differential area at `x`
+//! to the element, with the visibility of one ray from the element's
+//! centre. The form factor is the solver's own
+//! ([`formfactor::weighted_point_to_samples`]): each element is a cell
+//! sample, so a point within [`formfactor::NEAR_FIELD_RATIO`] cell
+//! diameters gets the cell's quadrature and within
+//! [`formfactor::EXACT_RATIO`] the exact point-to-cell form factor, and a
+//! point on a polygon's edge or in a room's corner stays finite. The rays
+//! are the solver's: shaft culling between the point and each polygon
+//! ([`Visibility::box_shaft_candidates`]), the BVH where the shaft holds
+//! many candidates.
+//!
+//! Luminaires with a light distribution ([`crate::scene::Luminaire`]) are
+//! gathered with their intensity in the direction of the point instead of
+//! Lambert's cosine ([`super::distribution`]); they reflect nothing, so
+//! their radiosity is their emission.
+//!
+//! The result is irradiance in the scene's radiosity units: lux when
+//! emission is luminous exitance in lm/m² (see [`crate::scene::Units`]).
+//! Every point is independent, so [`FinalGather::irradiance_at`] runs in
+//! parallel and gives the same bits whatever the thread count.
+
+use super::distribution::Directional;
+use super::formfactor::{weighted_point_to_samples, ShooterSample};
+use super::{LINEAR_CANDIDATES, SHAFT_MIN_VERTICES};
+use crate::color::Rgb;
+use crate::mesh::{area_centroid, Mesh};
+use crate::scene::{PolygonId, Scene};
+use crate::visibility::Visibility;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// One polygon as a source of the gather: its elements as cell samples and
+/// their radiosities.
+struct Source {
+    polygon: PolygonId,
+    normal: Vec3,
+    /// One cell sample per element, at the element's area centroid.
+    samples: Vec<ShooterSample>,
+    /// Per sample: the element's radiosity (mean of its corners), in the
+    /// scene's radiosity units.
+    radiosity: Vec<Rgb>,
+    /// The polygon's intensity distribution when it is a luminaire.
+    directional: Option<Directional>,
+}
+
+/// A converged solution made ready to be gathered at arbitrary points.
+///
+/// Invariant: `sources` hold only polygons with some non-black radiosity;
+/// every radiosity is finite and `>= 0` (as the solver's are).
+pub struct FinalGather<'a> {
+    visibility: &'a Visibility,
+    near_field: bool,
+    sources: Vec<Source>,
+}
+
+impl<'a> FinalGather<'a> {
+    /// Prepares the gather over `mesh` (built from `scene`, refined or not)
+    /// with `radiosity` one value per mesh vertex (the solver's solution,
+    /// in the scene's radiosity units). `near_field` as
+    /// [`super::SolverOptions::near_field`].
+    pub fn new(
+        scene: &Scene,
+        mesh: &Mesh,
+        visibility: &'a Visibility,
+        radiosity: &[Rgb],
+        near_field: bool,
+    ) -> FinalGather<'a> {
+        let directional = Directional::for_scene(scene);
+        let mut sources = Vec::new();
+        for (i, pm) in mesh.polygons.iter().enumerate() {
+            let elements = &mesh.elements[pm.elements.start as usize..pm.elements.end as usize];
+            let mut samples = Vec::with_capacity(elements.len());
+            let mut values = Vec::with_capacity(elements.len());
+            for e in elements {
+                let corners = e.corners();
+                let p: Vec<Vec3> = corners.iter().map(|c| mesh.positions[c.index()]).collect();
+                let b = corners
+                    .iter()
+                    .map(|c| radiosity.get(c.index()).copied().unwrap_or_default())
+                    .fold(Rgb::BLACK, |a, b| a + b)
+                    * (1.0 / corners.len() as f64);
+                let cell = [p[0], p[1], p[2], *p.get(3).unwrap_or(&p[2])];
+                samples.push(ShooterSample::cell(
+                    area_centroid(&p),
+                    mesh.element_area(e),
+                    cell,
+                ));
+                values.push(b);
+            }
+            if values.iter().all(|b| b.is_black()) {
+                continue;
+            }
+            sources.push(Source {
+                polygon: PolygonId(i as u32),
+                normal: pm.normal,
+                samples,
+                radiosity: values,
+                directional: directional.get(i).cloned().flatten(),
+            });
+        }
+        FinalGather {
+            visibility,
+            near_field,
+            sources,
+        }
+    }
+
+    /// Irradiance at `x` (scene units) on a surface of unit normal `n`, in
+    /// the scene's radiosity units (lux with luminous exitance): light
+    /// arriving from behind the surface does not count.
+    pub fn irradiance(&self, x: Vec3, n: Vec3) -> Rgb {
+        let mut candidates = Vec::new();
+        let mut sum = Rgb::BLACK;
+        let point_box = (DVec3::from(x), DVec3::from(x));
+        for source in &self.sources {
+            let id = source.polygon;
+            // A shaft is worth building only for polygons of many elements.
+            let culled = source.samples.len() >= SHAFT_MIN_VERTICES as usize;
+            if culled {
+                self.visibility
+                    .box_shaft_candidates(point_box, id, &mut candidates);
+            }
+            let visibility = self.visibility;
+            let occluded = |s: Vec3| {
+                if !culled || candidates.len() > LINEAR_CANDIDATES {
+                    visibility.occluded(s, x, (id, id))
+                } else if candidates.is_empty() {
+                    false
+                } else {
+                    visibility.occluded_among_ends(s, x, &candidates, (id, id))
+                }
+            };
+            let e = match &source.directional {
+                Some(d) => d.gather(x, n, &source.samples, &source.radiosity, |_, s| occluded(s)),
+                None => {
+                    weighted_point_to_samples(
+                        x,
+                        n,
+                        source.normal,
+                        &source.samples,
+                        |k| source.radiosity[k],
+                        self.near_field,
+                        |_, s| occluded(s),
+                    )
+                    .0
+                }
+            };
+            sum += e;
+        }
+        sum
+    }
+
+    /// [`FinalGather::irradiance`] at every `(position, unit normal)` of
+    /// `points`, in order, in parallel.
+    pub fn irradiance_at(&self, points: &[(Vec3, Vec3)]) -> Vec<Rgb> {
+        points
+            .par_iter()
+            .map(|&(x, n)| self.irradiance(x, n))
+            .collect()
+    }
+}
+
+/// The irradiance at every mesh vertex implied by its radiosity:
+/// `(b − e) / ρ` per channel, `b` the vertex's radiosity, `e` and `ρ` its
+/// polygon's emission and reflectance, in the scene's radiosity units. On
+/// a channel whose reflectance is 0 nothing is reflected, so nothing tells
+/// what arrives: the value is 0 there (a black surface, a luminaire; use
+/// [`FinalGather`] for such points). This is what the solver itself
+/// gathered at the vertex, without a second gather.
+pub fn vertex_irradiance(scene: &Scene, mesh: &Mesh, radiosity: &[Rgb]) -> Vec<Rgb> {
+    radiosity
+        .iter()
+        .zip(&mesh.vertex_polygon)
+        .map(|(&b, &p)| {
+            let m = scene.material_of(p);
+            let (e, rho) = (m.emission(), m.reflectance());
+            let channel = |b: f64, e: f64, rho: f64| {
+                if rho > 0.0 {
+                    ((b - e) / rho).max(0.0)
+                } else {
+                    0.0
+                }
+            };
+            Rgb::new(
+                channel(b.r, e.r, rho.r),
+                channel(b.g, e.g, rho.g),
+                channel(b.b, e.b, rho.b),
+            )
+        })
+        .collect()
+}
