@@ -10,6 +10,7 @@
 use super::raster::Frame;
 use crate::color::Rgb;
 use image::RgbImage;
+use rayon::prelude::*;
 
 /// Which luminance percentile of the covered pixels [`auto_exposure`] puts
 /// at [`AUTO_TARGET`]. Below one so that a few very bright pixels (the light
@@ -56,25 +57,41 @@ impl Exposure {
 /// used instead; if the frame has no covered pixel with a positive finite
 /// luminance, the result is [`FALLBACK_EXPOSURE`]. Always finite and `> 0`.
 pub fn auto_exposure(frame: &Frame) -> f32 {
-    let mut lum: Vec<f64> = frame
+    // Read twice or three times rather than collected: a frame has about a
+    // million pixels, and the selection needs only one bucket of them.
+    // A few work items a thread: each carries a table of bucket counts.
+    let chunk = frame
         .pixels
-        .iter()
-        .zip(&frame.covered)
-        .filter(|(_, &c)| c)
-        .map(|(p, _)| Rgb::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])).luminance())
-        .filter(|l| l.is_finite())
-        .collect();
-    if lum.is_empty() {
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
+        .max(MIN_EXPOSURE_CHUNK);
+    let luminances = || {
+        frame
+            .pixels
+            .par_chunks(chunk)
+            .zip(frame.covered.par_chunks(chunk))
+            .flat_map_iter(|(pixels, covered)| {
+                pixels
+                    .iter()
+                    .zip(covered)
+                    .filter(|(_, &c)| c)
+                    .map(|(p, _)| {
+                        Rgb::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])).luminance()
+                    })
+                    .filter(|l| l.is_finite())
+            })
+    };
+    let Some(at_rank) = nth_smallest(luminances, |n| {
+        // Nearest-rank percentile: the smallest value with at least that
+        // fraction of the pixels at or below it.
+        ((AUTO_PERCENTILE * n as f64).ceil() as usize).clamp(1, n) - 1
+    }) else {
         return FALLBACK_EXPOSURE;
-    }
-    // Nearest-rank percentile: the smallest value with at least that
-    // fraction of the pixels at or below it.
-    let rank = ((AUTO_PERCENTILE * lum.len() as f64).ceil() as usize).clamp(1, lum.len()) - 1;
-    let (_, &mut at_rank, _) = lum.select_nth_unstable_by(rank, f64::total_cmp);
+    };
     let reference = if at_rank > 0.0 {
         at_rank
     } else {
-        lum.iter().copied().fold(0.0, f64::max)
+        luminances().reduce(|| 0.0, f64::max)
     };
     let exposure = (AUTO_TARGET / reference) as f32;
     if reference > 0.0 && exposure.is_finite() && exposure > 0.0 {
@@ -82,6 +99,66 @@ pub fn auto_exposure(frame: &Frame) -> f32 {
     } else {
         FALLBACK_EXPOSURE
     }
+}
+
+/// Fewest pixels per parallel work item of [`auto_exposure`].
+const MIN_EXPOSURE_CHUNK: usize = 64 * 1024;
+
+/// Bits of the order key that pick a bucket in [`nth_smallest`]: sign,
+/// exponent and four mantissa bits, so a bucket spans 1/16 of an octave.
+const SELECT_BUCKET_BITS: u32 = 16;
+
+/// The `rank(n)`-th smallest (from 0) of the `n` values `values()` yields,
+/// in the order of [`f64::total_cmp`]; `None` when there are none (or the
+/// rank is not below `n`).
+///
+/// One parallel pass counts the values per bucket of their leading bits,
+/// which finds the bucket holding the rank; a second collects that bucket
+/// only, which is searched. The value is the same as a full sort's,
+/// whatever the thread count.
+fn nth_smallest<I, F>(values: F, rank: impl Fn(usize) -> usize) -> Option<f64>
+where
+    F: Fn() -> I,
+    I: ParallelIterator<Item = f64>,
+{
+    // `total_cmp`'s order as unsigned integers.
+    let key = |v: f64| {
+        let bits = v.to_bits();
+        (bits ^ ((((bits as i64) >> 63) as u64) >> 1)) ^ (1 << 63)
+    };
+    let shift = 64 - SELECT_BUCKET_BITS;
+    let bucket_of = |v: f64| (key(v) >> shift) as usize;
+    let buckets = 1usize << SELECT_BUCKET_BITS;
+    let counts = values()
+        .fold(
+            || vec![0u32; buckets],
+            |mut counts, v| {
+                counts[bucket_of(v)] += 1;
+                counts
+            },
+        )
+        .reduce_with(|mut a, b| {
+            for (a, b) in a.iter_mut().zip(&b) {
+                *a += b;
+            }
+            a
+        })?;
+    let n: usize = counts.iter().map(|&c| c as usize).sum();
+    if n == 0 {
+        return None;
+    }
+    let rank = rank(n);
+    let mut below = 0usize;
+    for (bucket, &count) in counts.iter().enumerate() {
+        let count = count as usize;
+        if rank < below + count {
+            let mut inside: Vec<f64> = values().filter(|&v| bucket_of(v) == bucket).collect();
+            let (_, &mut at, _) = inside.select_nth_unstable_by(rank - below, f64::total_cmp);
+            return Some(at);
+        }
+        below += count;
+    }
+    None
 }
 
 /// The sRGB transfer function (OETF): linear `v` in `[0, 1]` to the encoded
@@ -103,19 +180,103 @@ pub fn srgb8(v: f32, exposure: f32) -> u8 {
     (encoded * 255.0).round() as u8
 }
 
+/// Buckets of the exposed linear value in `[0, 1)` in [`Srgb8Table`]: the
+/// 8-bit code changes at most once within one, because the sRGB curve's
+/// slope never exceeds 12.92, so codes change at most `255 × 12.92 ≈ 3,295`
+/// times per unit, fewer than the buckets.
+const TABLE_BUCKETS: usize = 4096;
+
+/// [`srgb8`] as a table: the code at the start of each bucket of the
+/// exposed linear value, and where in the bucket it steps up by one. Built
+/// from [`srgb8`]'s own curve, so the codes are the same bits.
+struct Srgb8Table {
+    base: Vec<u8>,
+    /// The smallest value of the bucket whose code is `base + 1`
+    /// (infinite where the code does not change).
+    step: Vec<f64>,
+}
+
+/// The code of an exposed linear value, [`srgb8`]'s curve.
+fn code(x: f64) -> u8 {
+    (srgb_encode(x) * 255.0).round() as u8
+}
+
+impl Srgb8Table {
+    fn new() -> Srgb8Table {
+        let n = TABLE_BUCKETS as f64;
+        let mut base = Vec::with_capacity(TABLE_BUCKETS);
+        let mut step = Vec::with_capacity(TABLE_BUCKETS);
+        for i in 0..TABLE_BUCKETS {
+            let lo = i as f64 / n;
+            let b = code(lo);
+            // The last value of the bucket: positive floats are ordered as
+            // their bits, so one bit less is the next smaller value.
+            let last = f64::from_bits(((i + 1) as f64 / n).to_bits() - 1);
+            base.push(b);
+            if code(last) == b {
+                step.push(f64::INFINITY);
+                continue;
+            }
+            // Bisection over the bits for the first value with a higher code.
+            let (mut below, mut at) = (lo.to_bits(), last.to_bits());
+            while at - below > 1 {
+                let mid = below + (at - below) / 2;
+                if code(f64::from_bits(mid)) > b {
+                    at = mid;
+                } else {
+                    below = mid;
+                }
+            }
+            step.push(f64::from_bits(at));
+        }
+        Srgb8Table { base, step }
+    }
+
+    /// The shared table, built on first use (a few thousand evaluations
+    /// of the curve).
+    fn get() -> &'static Srgb8Table {
+        static TABLE: std::sync::OnceLock<Srgb8Table> = std::sync::OnceLock::new();
+        TABLE.get_or_init(Srgb8Table::new)
+    }
+
+    /// `code(x)` by lookup.
+    fn code(&self, x: f64) -> u8 {
+        // NaN and negative values are clipped to black, as `srgb_encode` does.
+        if x.is_nan() || x <= 0.0 {
+            return 0;
+        }
+        if x >= 1.0 {
+            return 255;
+        }
+        // Exact (a power of two times x), and below the bucket count.
+        let i = ((x * TABLE_BUCKETS as f64) as usize).min(TABLE_BUCKETS - 1);
+        self.base[i] + u8::from(x >= self.step[i])
+    }
+}
+
+/// Pixels per parallel work item of [`to_srgb8`].
+const TONE_MAP_CHUNK: usize = 16 * 1024;
+
 /// The frame as an 8-bit sRGB picture, each linear channel multiplied by
-/// `exposure` (dimensionless), clipped to `[0, 1]` and encoded. Rows are in
-/// the frame's order (top first). Pixels the frame lacks (a frame whose
-/// buffers are shorter than its size) are black.
+/// `exposure` (dimensionless), clipped to `[0, 1]` and encoded: per
+/// channel exactly [`srgb8`]. Rows are in the frame's order (top first).
+/// Pixels the frame lacks (a frame whose buffers are shorter than its
+/// size) are black.
 pub fn to_srgb8(frame: &Frame, exposure: f32) -> RgbImage {
     let mut img = RgbImage::new(frame.width, frame.height);
-    for (out, p) in img.pixels_mut().zip(&frame.pixels) {
-        out.0 = [
-            srgb8(p[0], exposure),
-            srgb8(p[1], exposure),
-            srgb8(p[2], exposure),
-        ];
-    }
+    let table = Srgb8Table::get();
+    let e = f64::from(exposure);
+    let bytes: &mut [u8] = &mut img;
+    bytes
+        .par_chunks_mut(3 * TONE_MAP_CHUNK)
+        .zip(frame.pixels.par_chunks(TONE_MAP_CHUNK))
+        .for_each(|(out, pixels)| {
+            for (o, p) in out.chunks_exact_mut(3).zip(pixels) {
+                for k in 0..3 {
+                    o[k] = table.code(f64::from(p[k]) * e);
+                }
+            }
+        });
     img
 }
 
@@ -188,6 +349,85 @@ mod tests {
         assert!((k - 0.3).abs() < EXPOSURE_TOLERANCE, "{k}");
         let img = to_srgb8(&black, auto_exposure(&black));
         assert!(img.pixels().all(|p| p.0 == [0, 0, 0]));
+    }
+
+    #[test]
+    fn bucketed_selection_matches_sorting() {
+        // Spread over many octaves, with repeats, zeros of both signs and
+        // negatives, so ranks fall in crowded and in sparse buckets.
+        let values: Vec<f64> = (0..5000u64)
+            .map(|k| {
+                let x = (k.wrapping_mul(2_654_435_761) % 10_007) as f64;
+                match k % 5 {
+                    0 => x * 1e-3,
+                    1 => (x / 97.0).exp2(),
+                    2 => 0.0,
+                    3 => -x,
+                    _ => 1.5,
+                }
+            })
+            .chain([-0.0])
+            .collect();
+        let mut sorted = values.clone();
+        sorted.sort_by(f64::total_cmp);
+        for rank in (0..values.len()).step_by(37).chain([values.len() - 1]) {
+            let got = nth_smallest(
+                || values.par_iter().copied(),
+                |n| {
+                    assert_eq!(n, values.len());
+                    rank
+                },
+            );
+            assert_eq!(
+                got.map(f64::to_bits),
+                Some(sorted[rank].to_bits()),
+                "rank {rank}"
+            );
+        }
+        assert_eq!(nth_smallest(|| values.par_iter().copied(), |n| n), None);
+        assert_eq!(nth_smallest(|| [].par_iter().copied(), |_| 0), None);
+    }
+
+    #[test]
+    fn the_lookup_table_gives_the_curve_bits() {
+        let table = Srgb8Table::get();
+        // At most one step per bucket, and each step exactly where the
+        // curve's code changes.
+        for (i, (&b, &at)) in table.base.iter().zip(&table.step).enumerate() {
+            let last = f64::from_bits(((i + 1) as f64 / TABLE_BUCKETS as f64).to_bits() - 1);
+            assert!(u16::from(code(last)) <= u16::from(b) + 1, "bucket {i}");
+            if at.is_finite() {
+                assert_eq!(code(at), b + 1, "bucket {i}");
+                assert_eq!(code(f64::from_bits(at.to_bits() - 1)), b, "bucket {i}");
+            }
+        }
+        // Every 997th float from 0 to past 1, and the values around each
+        // step, under a few exposures.
+        let mut values: Vec<f32> = (0..=1.5f32.to_bits())
+            .step_by(997)
+            .map(f32::from_bits)
+            .collect();
+        for &at in table.step.iter().filter(|a| a.is_finite()) {
+            let v = at as f32;
+            values.extend([v, v.next_down(), v.next_up()]);
+        }
+        values.extend([
+            -1.0,
+            -0.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+        ]);
+        for exposure in [1.0, 0.37, 3.3, 1e-3] {
+            for &v in &values {
+                assert_eq!(
+                    table.code(f64::from(v) * f64::from(exposure)),
+                    srgb8(v, exposure),
+                    "{v} at {exposure}"
+                );
+            }
+        }
     }
 
     #[test]
