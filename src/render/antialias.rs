@@ -46,6 +46,7 @@ pub fn downsample(frame: &Frame, n: u32) -> Frame {
     for y in 0..h {
         for x in 0..w {
             let mut sum = [0.0f64; 3];
+            let mut back = 0.0f64;
             let mut covered = false;
             for sy in 0..n {
                 let row = ((y * n + sy) * frame.width + x * n) as usize;
@@ -55,11 +56,13 @@ pub fn downsample(frame: &Frame, n: u32) -> Frame {
                         sum[c] += f64::from(p[c]);
                     }
                     covered |= frame.covered[k];
+                    back += f64::from(frame.back[k]);
                 }
             }
             let k = (y * w + x) as usize;
             out.pixels[k] = sum.map(|s| (s * scale) as f32);
             out.covered[k] = covered;
+            out.back[k] = (back * scale) as f32;
         }
     }
     out

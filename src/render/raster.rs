@@ -12,9 +12,12 @@
 //! nearest surface wins the depth test.
 //!
 //! Only the front of a polygon reflects or emits light: triangles seen from
-//! the back are drawn black but still hide what is behind them, unless
-//! another polygon is that back side (a two-sided face's back copy), which
-//! then draws it. Overlapping coplanar polygons are stacked by their draw
+//! the back hold no light (`0` in the linear frame, flagged in
+//! [`Frame::back`]) but still hide what is behind them, unless another
+//! polygon is that back side (a two-sided face's back copy), which then
+//! draws it. Tone mapping paints back faces in dim blue-grey diagonal
+//! stripes ([`super::back_face_color`]), never black, so an eye that
+//! walked through a wall sees where it is. Overlapping coplanar polygons are stacked by their draw
 //! layer ([`LAYER_DEPTH_BIAS`]).
 //!
 //! Work is parallel in two stages. Setup transforms and classifies every
@@ -94,8 +97,8 @@ const SUBPIXEL: i64 = 1 << SUBPIXEL_BITS;
 
 /// A rendered picture of linear radiosity.
 ///
-/// Invariants: `pixels.len() == covered.len() == width * height`, both
-/// row-major with row 0 at the top of the picture.
+/// Invariants: `pixels.len() == covered.len() == back.len() == width *
+/// height`, all row-major with row 0 at the top of the picture.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     /// Width in pixels.
@@ -103,10 +106,16 @@ pub struct Frame {
     /// Height in pixels.
     pub height: u32,
     /// Linear RGB radiosity seen at each pixel centre, in the scene's
-    /// radiosity units (exitance). Background and back faces are `0`.
+    /// radiosity units (exitance). Background and back faces are `0`: only
+    /// light is stored here (EXR and PFM pictures write it as it is).
     pub pixels: Vec<[f32; 3]>,
     /// Whether any surface (front or back) covers the pixel centre.
     pub covered: Vec<bool>,
+    /// Fraction of the pixel that shows the back of a polygon, in `[0, 1]`:
+    /// `0` or `1` as drawn, the fraction of its samples once antialiased
+    /// ([`super::antialias::downsample`]). Linear pixels hold no light
+    /// there (`0`); 8-bit pictures paint it ([`super::to_srgb8`]).
+    pub back: Vec<f32>,
 }
 
 impl Frame {
@@ -118,6 +127,7 @@ impl Frame {
             height,
             pixels: vec![[0.0; 3]; n],
             covered: vec![false; n],
+            back: vec![0.0; n],
         }
     }
 
@@ -133,7 +143,9 @@ impl Frame {
 
     /// True when the buffers have the length the size promises.
     pub fn is_consistent(&self) -> bool {
-        self.pixels.len() == self.len() && self.covered.len() == self.len()
+        self.pixels.len() == self.len()
+            && self.covered.len() == self.len()
+            && self.back.len() == self.len()
     }
 
     /// The pixel at column `x`, row `y` (row 0 at the top); `None` outside
@@ -163,6 +175,7 @@ impl Frame {
         self.height = height;
         self.pixels.resize(n, [0.0; 3]);
         self.covered.resize(n, false);
+        self.back.resize(n, 0.0);
         n
     }
 }
@@ -242,8 +255,9 @@ impl Rasterizer {
     /// its linear `radiosity` (one per mesh vertex, in the scene's radiosity
     /// units), and returns the picture, sized as the view.
     ///
-    /// Front faces show the Gouraud-interpolated radiosity, back faces are
-    /// black, uncovered pixels are black and not `covered`. Sky facets
+    /// Front faces show the Gouraud-interpolated radiosity; back faces are
+    /// `0` with [`Frame::back`] set to 1; uncovered pixels are `0` and not
+    /// `covered`. Sky facets
     /// ([`crate::mesh::PolygonMesh::sky`]) are not drawn: where the sky is
     /// seen, the picture shows background.
     pub fn render(
@@ -272,12 +286,14 @@ impl Rasterizer {
             .zip(self.frame.covered.par_chunks_mut(TILE_HEIGHT * w))
             .zip(self.inv_depth.par_chunks_mut(TILE_HEIGHT * w))
             .zip(self.front.par_chunks_mut(TILE_HEIGHT * w))
+            .zip(self.frame.back.par_chunks_mut(TILE_HEIGHT * w))
             .enumerate()
-            .for_each(|(ty, (((pixels, covered), depth), front))| {
+            .for_each(|(ty, ((((pixels, covered), depth), front), back))| {
                 pixels.fill([0.0; 3]);
                 covered.fill(false);
                 depth.fill(0.0);
                 front.fill(false);
+                back.fill(0.0);
                 let mut target = Band {
                     width: w,
                     first_row: ty * TILE_HEIGHT,
@@ -286,6 +302,7 @@ impl Rasterizer {
                     covered,
                     depth,
                     front,
+                    back,
                 };
                 for tx in 0..tiles_x {
                     let tile = ty * tiles_x + tx;
@@ -826,6 +843,7 @@ struct Band<'a> {
     covered: &'a mut [bool],
     depth: &'a mut [f64],
     front: &'a mut [bool],
+    back: &'a mut [f32],
 }
 
 impl Band<'_> {
@@ -918,7 +936,9 @@ impl Band<'_> {
         self.depth[i] = key;
         self.covered[i] = true;
         self.front[i] = t.front;
-        // Back faces are black: their radiosity is that of the other side.
+        self.back[i] = if t.front { 0.0 } else { 1.0 };
+        // Back faces hold no light: their radiosity is that of the other
+        // side. The 8-bit picture paints them (`to_srgb8`).
         self.pixels[i] = if t.front {
             let channel = |k: usize| {
                 ((l0 * a.c_over_z[k] + l1 * b.c_over_z[k] + l2 * c.c_over_z[k]) / inv_z) as f32
@@ -1096,7 +1116,7 @@ mod tests {
     }
 
     #[test]
-    fn back_face_is_black_but_occludes() {
+    fn back_face_holds_no_light_is_flagged_and_occludes() {
         let mut back = rect(10.0, 10.0, 60.0, 60.0, 2.0);
         back.reverse();
         let lit = rect(0.0, 0.0, 100.0, 100.0, 4.0);
@@ -1106,7 +1126,17 @@ mod tests {
             .render();
         assert_eq!(covered_count(&frame), 100 * 100);
         assert_eq!(frame.pixel(30, 30), Some([0.0; 3]));
+        assert_eq!(frame.back[30 * 100 + 30], 1.0);
         assert_eq!(frame.pixel(80, 80), Some([1.0; 3]));
+        assert_eq!(frame.back[80 * 100 + 80], 0.0);
+        // The 8-bit picture paints it, not black; the lit quad is as before.
+        let img = crate::render::to_srgb8(&frame, 1.0);
+        assert_eq!(
+            img.get_pixel(30, 30).0,
+            crate::render::back_face_color(30, 30)
+        );
+        assert_ne!(img.get_pixel(30, 30).0, [0, 0, 0]);
+        assert_eq!(img.get_pixel(80, 80).0, [255; 3]);
     }
 
     #[test]
@@ -1452,6 +1482,7 @@ mod tests {
             covered: &mut frame.covered,
             depth: &mut depth,
             front: &mut front,
+            back: &mut frame.back,
         };
         for t in &triangles {
             band.draw_every_pixel(t, t.v.map(|i| &local[(i & !LOCAL_VERTEX) as usize]));

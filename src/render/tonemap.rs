@@ -51,7 +51,9 @@ impl Exposure {
 }
 
 /// The exposure that maps the [`AUTO_PERCENTILE`] of the luminance (Rec. 709
-/// weights) of the covered pixels to [`AUTO_TARGET`].
+/// weights) of the covered pixels to [`AUTO_TARGET`]. Pixels wholly on back
+/// faces ([`Frame::back`] of 1) do not count: they hold no light, and a
+/// wall the eye stepped through must not darken or brighten the rest.
 ///
 /// If that percentile is zero (a mostly dark picture), the brightest pixel is
 /// used instead; if the frame has no covered pixel with a positive finite
@@ -70,12 +72,15 @@ pub fn auto_exposure(frame: &Frame) -> f32 {
             .pixels
             .par_chunks(chunk)
             .zip(frame.covered.par_chunks(chunk))
-            .flat_map_iter(|(pixels, covered)| {
+            .enumerate()
+            .flat_map_iter(move |(k, (pixels, covered))| {
+                let back = frame.back.get(k * chunk..).unwrap_or_default();
                 pixels
                     .iter()
                     .zip(covered)
-                    .filter(|(_, &c)| c)
-                    .map(|(p, _)| {
+                    .enumerate()
+                    .filter(move |&(i, (_, &c))| c && back.get(i).is_none_or(|&b| b < 1.0))
+                    .map(|(_, (p, _))| {
                         Rgb::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])).luminance()
                     })
                     .filter(|l| l.is_finite())
@@ -254,26 +259,69 @@ impl Srgb8Table {
     }
 }
 
-/// Pixels per parallel work item of [`to_srgb8`].
-const TONE_MAP_CHUNK: usize = 16 * 1024;
+/// The two 8-bit sRGB colours of pixels that show the back of a polygon,
+/// in diagonal stripes [`BACK_FACE_STRIPE`] pixels wide: a dim,
+/// desaturated blue-grey, never black and unlike any lit wall, so a user
+/// whose eye went through a wall sees where they are. Fixed, whatever the
+/// exposure.
+pub const BACK_FACE_COLORS: [[u8; 3]; 2] = [[60, 66, 84], [46, 51, 66]];
+
+/// Width of the stripes of [`BACK_FACE_COLORS`], in pixels along a row.
+pub const BACK_FACE_STRIPE: u32 = 4;
+
+/// The 8-bit colour of a back face at column `x`, row `y` of a picture:
+/// stripes running from bottom-left to top-right.
+pub fn back_face_color(x: u32, y: u32) -> [u8; 3] {
+    BACK_FACE_COLORS[((x.wrapping_add(y) / BACK_FACE_STRIPE) % 2) as usize]
+}
+
+/// The inverse of [`srgb_encode`]: an encoded value in `[0, 1]` to linear.
+fn srgb_decode(e: f64) -> f64 {
+    if e <= 12.92 * SRGB_LINEAR_LIMIT {
+        e / 12.92
+    } else {
+        ((e + 0.055) / 1.055).powf(2.4)
+    }
+}
 
 /// The frame as an 8-bit sRGB picture, each linear channel multiplied by
 /// `exposure` (dimensionless), clipped to `[0, 1]` and encoded: per
 /// channel exactly [`srgb8`]. Rows are in the frame's order (top first).
 /// Pixels the frame lacks (a frame whose buffers are shorter than its
 /// size) are black.
+///
+/// Pixels showing back faces ([`Frame::back`]) are painted
+/// [`back_face_color`]; a pixel partly a back face (antialiased) mixes
+/// that colour in linear light, in proportion, with its exposed radiosity.
 pub fn to_srgb8(frame: &Frame, exposure: f32) -> RgbImage {
     let mut img = RgbImage::new(frame.width, frame.height);
+    let w = frame.width as usize;
+    if w == 0 {
+        return img;
+    }
     let table = Srgb8Table::get();
     let e = f64::from(exposure);
+    let back_linear = BACK_FACE_COLORS.map(|c| c.map(|k| srgb_decode(f64::from(k) / 255.0)));
     let bytes: &mut [u8] = &mut img;
     bytes
-        .par_chunks_mut(3 * TONE_MAP_CHUNK)
-        .zip(frame.pixels.par_chunks(TONE_MAP_CHUNK))
-        .for_each(|(out, pixels)| {
-            for (o, p) in out.chunks_exact_mut(3).zip(pixels) {
-                for k in 0..3 {
-                    o[k] = table.code(f64::from(p[k]) * e);
+        .par_chunks_mut(3 * w)
+        .zip(frame.pixels.par_chunks(w))
+        .enumerate()
+        .for_each(|(y, (out, pixels))| {
+            let back = frame.back.get(y * w..).unwrap_or_default();
+            for (x, (o, p)) in out.chunks_exact_mut(3).zip(pixels).enumerate() {
+                let f = back.get(x).copied().unwrap_or(0.0);
+                if f <= 0.0 {
+                    for k in 0..3 {
+                        o[k] = table.code(f64::from(p[k]) * e);
+                    }
+                } else if f >= 1.0 {
+                    o.copy_from_slice(&back_face_color(x as u32, y as u32));
+                } else {
+                    let stripe = &back_linear[((x + y) / BACK_FACE_STRIPE as usize) % 2];
+                    for k in 0..3 {
+                        o[k] = table.code(f64::from(p[k]) * e + f64::from(f) * stripe[k]);
+                    }
                 }
             }
         });
@@ -428,6 +476,47 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn back_faces_are_dim_blue_grey_stripes_not_black() {
+        // A row of back-face pixels, a lit pixel, and a half back-face
+        // pixel (an antialiased edge between a back face and black).
+        let mut f = Frame::new(12, 2);
+        f.covered.fill(true);
+        f.back.fill(1.0);
+        f.back[8] = 0.0;
+        f.pixels[8] = [0.5; 3];
+        f.back[9] = 0.5;
+        let img = to_srgb8(&f, 1.0);
+        for (x, y) in [(0, 0), (3, 0), (4, 0), (7, 0), (3, 1), (11, 1)] {
+            let p = img.get_pixel(x, y).0;
+            assert_eq!(p, back_face_color(x, y), "({x}, {y})");
+            assert_ne!(p, [0, 0, 0]);
+            // Dim and bluish: blue the largest channel, all below a third.
+            assert!(p[2] > p[0] && p[2] > p[1] && p[2] < 100, "{p:?}");
+        }
+        assert_ne!(back_face_color(0, 0), back_face_color(4, 0));
+        assert_eq!(back_face_color(0, 0), back_face_color(8, 0));
+        assert_eq!(back_face_color(1, 0), back_face_color(0, 1));
+        // The exposure does not change them.
+        assert_eq!(to_srgb8(&f, 50.0).get_pixel(0, 0).0, back_face_color(0, 0));
+        assert_eq!(img.get_pixel(8, 0).0, [188; 3]);
+        // Half covered: between black and the full colour.
+        let half = img.get_pixel(9, 0).0;
+        let full = back_face_color(9, 0);
+        assert!((0..3).all(|k| half[k] > 0 && half[k] < full[k]), "{half:?}");
+    }
+
+    #[test]
+    fn auto_exposure_ignores_back_faces() {
+        // Half the covered pixels are back faces (0 in the frame): the
+        // exposure is that of the lit half alone.
+        let mut f = frame(&[2.0, 2.0, 0.0, 0.0], &[true; 4]);
+        f.back[2] = 1.0;
+        f.back[3] = 1.0;
+        let k = auto_exposure(&f);
+        assert!((k - 0.45).abs() < EXPOSURE_TOLERANCE * 0.45, "{k}");
     }
 
     #[test]
