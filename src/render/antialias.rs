@@ -6,7 +6,8 @@
 //! output pixel is their plain mean (a box filter), in linear radiosity.
 //! So a high-dynamic-range picture (`.exr`, `.pfm`) keeps exact linear
 //! values, averaged; 8-bit pictures are tone-mapped after averaging. A
-//! pixel counts as covered when any of its samples is.
+//! pixel counts as covered when any of its samples is, and its back-face
+//! fraction ([`Frame::back`]) is the fraction of its samples on back faces.
 
 use super::raster::Frame;
 
