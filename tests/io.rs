@@ -1230,6 +1230,10 @@ fn an_auto_framed_obj_room_is_seen_from_inside_and_lit() {
     let values: Vec<f64> = picture.pixels().flat_map(|p| p.0).map(f64::from).collect();
     let mean = values.iter().sum::<f64>() / values.len() as f64;
     assert!(mean > 40.0, "mean brightness {mean} of 255");
+    // Back faces are not black but striped: none may show.
+    assert!(picture
+        .enumerate_pixels()
+        .all(|(x, y, p)| p.0 != radiosity::render::back_face_color(x, y)));
 }
 
 #[test]
@@ -1268,6 +1272,13 @@ fn a_picture_of_back_faces_warns_once() {
     assert_eq!(lines.len(), 1, "{err}");
     assert!(lines[0].starts_with("warning: "), "{err}");
     assert!(lines[0].contains("backs of polygons"), "{err}");
+    // The picture shows them in the documented stripes, not black.
+    let picture = image::open(dir.path().join("box.png")).unwrap().to_rgb8();
+    for (x, y) in [(32, 24), (10, 10), (13, 10)] {
+        let p = picture.get_pixel(x, y).0;
+        assert_eq!(p, radiosity::render::back_face_color(x, y), "({x}, {y})");
+        assert_ne!(p, [0, 0, 0]);
+    }
     let stats = read_json(dir.path(), "stats.json");
     assert_eq!(stats["warnings"][0].as_str(), Some(lines[0]));
 }

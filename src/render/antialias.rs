@@ -6,7 +6,8 @@
 //! output pixel is their plain mean (a box filter), in linear radiosity.
 //! So a high-dynamic-range picture (`.exr`, `.pfm`) keeps exact linear
 //! values, averaged; 8-bit pictures are tone-mapped after averaging. A
-//! pixel counts as covered when any of its samples is.
+//! pixel counts as covered when any of its samples is, and its back-face
+//! fraction ([`Frame::back`]) is the fraction of its samples on back faces.
 
 use super::raster::Frame;
 
@@ -46,6 +47,7 @@ pub fn downsample(frame: &Frame, n: u32) -> Frame {
     for y in 0..h {
         for x in 0..w {
             let mut sum = [0.0f64; 3];
+            let mut back = 0.0f64;
             let mut covered = false;
             for sy in 0..n {
                 let row = ((y * n + sy) * frame.width + x * n) as usize;
@@ -55,11 +57,13 @@ pub fn downsample(frame: &Frame, n: u32) -> Frame {
                         sum[c] += f64::from(p[c]);
                     }
                     covered |= frame.covered[k];
+                    back += f64::from(frame.back[k]);
                 }
             }
             let k = (y * w + x) as usize;
             out.pixels[k] = sum.map(|s| (s * scale) as f32);
             out.covered[k] = covered;
+            out.back[k] = (back * scale) as f32;
         }
     }
     out

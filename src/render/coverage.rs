@@ -1,5 +1,5 @@
-//! What a picture shows, pixel by pixel: background, the black backs of
-//! polygons, front faces with no light, or lit front faces; and the one
+//! What a picture shows, pixel by pixel: background, the backs of
+//! polygons (no light; striped blue-grey in 8-bit pictures), front faces with no light, or lit front faces; and the one
 //! warning a (nearly) black picture deserves.
 //!
 //! Polygons are one-sided, so a picture can come out black for reasons the
@@ -23,7 +23,8 @@ pub struct PictureCoverage {
     pub pixels: usize,
     /// Pixels no surface covers.
     pub background: usize,
-    /// Pixels whose nearest surface is seen from the back (drawn black).
+    /// Pixels whose nearest surface is seen from the back (no light;
+    /// [`super::back_face_color`] in 8-bit pictures).
     pub back_faces: usize,
     /// Pixels whose nearest surface is a front face with no light on it
     /// (no channel above zero).
@@ -68,8 +69,8 @@ impl PictureCoverage {
         let percent = |n: usize| 100.0 * n as f64 / self.pixels as f64;
         let reason = if self.back_faces >= self.background && self.back_faces >= self.unlit_front {
             format!(
-                "{:.0}% of it shows the backs of polygons, which are black (polygons are \
-                 one-sided): the camera is probably outside a closed room, or the faces \
+                "{:.0}% of it shows the backs of polygons, which receive no light and are \
+                 drawn in dim blue-grey stripes (polygons are one-sided): the camera is probably outside a closed room, or the faces \
                  point away from it; put the eye inside with --camera FILE.sc",
                 percent(self.back_faces)
             )

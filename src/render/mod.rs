@@ -9,10 +9,14 @@
 //!    world-right is picture-right);
 //! 2. [`Rasterizer::render`] draws the element mesh with the per-vertex
 //!    radiosity, Gouraud-shaded and z-buffered, into a linear [`Frame`]
-//!    (front faces lit, back faces black, background black);
+//!    (front faces lit, back faces and background holding no light, back
+//!    faces flagged in [`Frame::back`]);
 //! 3. [`to_srgb8`] scales the frame by an exposure ([`Exposure`], automatic
 //!    with [`auto_exposure`]) and encodes it with the sRGB curve for 8-bit
-//!    pictures. High-dynamic-range outputs take the linear [`Frame`] as it is.
+//!    pictures, painting back faces in dim blue-grey stripes
+//!    ([`back_face_color`]) so an eye that walked through a wall sees where
+//!    it is. High-dynamic-range outputs take the linear [`Frame`] as it is
+//!    (back faces `0`).
 //!
 //! Written pictures are antialiased ([`antialias`]): rendered at `n × n`
 //! samples a pixel and averaged in linear radiosity.
@@ -37,7 +41,10 @@ pub use camera::{View, ViewError};
 pub use coverage::{PictureCoverage, DARK_PICTURE_FRACTION};
 pub use overlay::{draw_mesh_edges, LinePalette, MESH_COLOR, MESH_COLOR_ON_LIGHT, MESH_LINES};
 pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
-pub use tonemap::{auto_exposure, srgb8, srgb_encode, to_srgb8, Exposure};
+pub use tonemap::{
+    auto_exposure, back_face_color, srgb8, srgb_encode, to_srgb8, Exposure, BACK_FACE_COLORS,
+    BACK_FACE_STRIPE,
+};
 
 /// Renders one frame of a solution (`radiosity` per vertex of `mesh`) with
 /// a rasterizer of its own: for a single picture; a window or an animation

@@ -12,20 +12,32 @@
 //! nearest surface wins the depth test.
 //!
 //! Only the front of a polygon reflects or emits light: triangles seen from
-//! the back are drawn black but still hide what is behind them, unless
-//! another polygon is that back side (a two-sided face's back copy), which
-//! then draws it. Overlapping coplanar polygons are stacked by their draw
+//! the back hold no light (`0` in the linear frame, flagged in
+//! [`Frame::back`]) but still hide what is behind them, unless another
+//! polygon is that back side (a two-sided face's back copy), which then
+//! draws it. Tone mapping paints back faces in dim blue-grey diagonal
+//! stripes ([`super::back_face_color`]), never black, so an eye that
+//! walked through a wall sees where it is. Overlapping coplanar polygons are stacked by their draw
 //! layer ([`LAYER_DEPTH_BIAS`]).
 //!
-//! The picture is filled in bands of rows in parallel. Every band draws all
-//! triangles in mesh order, and no pixel belongs to two bands, so the result
-//! is the same bits whatever the number of threads.
+//! Work is parallel in two stages. Setup transforms and classifies every
+//! mesh vertex once (camera space, which side of each clip plane, its
+//! projection), then runs of consecutive elements are turned into screen
+//! triangles, each run sorted by a counting sort into screen tiles of
+//! `TILE_WIDTH × TILE_HEIGHT` pixels by bounding box. Drawing then fills
+//! one row of tiles per work item, each tile walking only its own
+//! triangles, runs in mesh order and each run's bin in mesh order. No
+//! pixel belongs to two tiles and every pixel sees its triangles in mesh
+//! order, so the result is the same bits whatever the number of threads,
+//! and the same bits as drawing every triangle over the whole picture (a
+//! test holds the two together).
 
 use super::camera::View;
 use crate::color::Rgb;
 use crate::mesh::{Mesh, VertexId};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use std::ops::Range;
 use thiserror::Error;
 
 /// Relative depth by which each draw layer is pulled towards the eye:
@@ -49,11 +61,36 @@ pub const SUBPIXEL_BITS: u32 = 8;
 /// while screen coordinates stay small enough for exact `i64` edge tests.
 pub const GUARD_BAND: f64 = 2.0;
 
-/// Rows of pixels per parallel work item.
-const BAND_ROWS: usize = 16;
+/// Width of the screen tiles triangles are binned into, in pixels.
+///
+/// Each tile only walks the triangles whose bounding box overlaps it.
+/// 32×32, 64×64, 64×8 and 128×8 were measured on the render bench too
+/// (`docs/performance.md`): none was clearly faster.
+const TILE_WIDTH: usize = 64;
 
-/// Most vertices a triangle can have after clipping against five planes
-/// (each plane adds at most one).
+/// Height of the screen tiles, in pixels. A row of tiles (a band of this
+/// many pixel rows) is one parallel work item, so the buffers it writes are
+/// one contiguous slice each.
+const TILE_HEIGHT: usize = 16;
+
+/// Fewest elements per parallel work item of triangle setup: below this,
+/// handing out the work costs more than it saves.
+const MIN_SETUP_CHUNK: usize = 256;
+
+/// Setup work items per thread, so that a slow chunk (many clipped
+/// triangles) does not leave the other threads idle.
+const SETUP_CHUNKS_PER_THREAD: usize = 4;
+
+/// Row spans of at least this many pixels are cut to the triangle
+/// arithmetically; shorter ones test every pixel (three integer divisions
+/// cost more than a few edge tests).
+const SPAN_MIN_WIDTH: i64 = 8;
+
+/// Clip planes: the near plane and four guard-band planes.
+const CLIP_PLANES: usize = 5;
+
+/// Most vertices a triangle can have after clipping against the
+/// [`CLIP_PLANES`] (each plane adds at most one).
 const MAX_CLIPPED: usize = 8;
 
 /// Sub-pixel grid steps per pixel.
@@ -61,8 +98,8 @@ const SUBPIXEL: i64 = 1 << SUBPIXEL_BITS;
 
 /// A rendered picture of linear radiosity.
 ///
-/// Invariants: `pixels.len() == covered.len() == width * height`, both
-/// row-major with row 0 at the top of the picture.
+/// Invariants: `pixels.len() == covered.len() == back.len() == width *
+/// height`, all row-major with row 0 at the top of the picture.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     /// Width in pixels.
@@ -70,10 +107,16 @@ pub struct Frame {
     /// Height in pixels.
     pub height: u32,
     /// Linear RGB radiosity seen at each pixel centre, in the scene's
-    /// radiosity units (exitance). Background and back faces are `0`.
+    /// radiosity units (exitance). Background and back faces are `0`: only
+    /// light is stored here (EXR and PFM pictures write it as it is).
     pub pixels: Vec<[f32; 3]>,
     /// Whether any surface (front or back) covers the pixel centre.
     pub covered: Vec<bool>,
+    /// Fraction of the pixel that shows the back of a polygon, in `[0, 1]`:
+    /// `0` or `1` as drawn, the fraction of its samples once antialiased
+    /// ([`super::antialias::downsample`]). Linear pixels hold no light
+    /// there (`0`); 8-bit pictures paint it ([`super::to_srgb8`]).
+    pub back: Vec<f32>,
 }
 
 impl Frame {
@@ -85,6 +128,7 @@ impl Frame {
             height,
             pixels: vec![[0.0; 3]; n],
             covered: vec![false; n],
+            back: vec![0.0; n],
         }
     }
 
@@ -100,7 +144,9 @@ impl Frame {
 
     /// True when the buffers have the length the size promises.
     pub fn is_consistent(&self) -> bool {
-        self.pixels.len() == self.len() && self.covered.len() == self.len()
+        self.pixels.len() == self.len()
+            && self.covered.len() == self.len()
+            && self.back.len() == self.len()
     }
 
     /// The pixel at column `x`, row `y` (row 0 at the top); `None` outside
@@ -121,14 +167,17 @@ impl Frame {
         (x < self.width && y < self.height).then(|| y as usize * self.width as usize + x as usize)
     }
 
-    fn reset(&mut self, width: u32, height: u32) {
+    /// Sets the size, keeping the buffers' contents where the length is
+    /// unchanged (the rasterizer clears them in parallel); returns the
+    /// number of pixels.
+    fn resize(&mut self, width: u32, height: u32) -> usize {
         let n = width as usize * height as usize;
         self.width = width;
         self.height = height;
-        self.pixels.clear();
         self.pixels.resize(n, [0.0; 3]);
-        self.covered.clear();
         self.covered.resize(n, false);
+        self.back.resize(n, 0.0);
+        n
     }
 }
 
@@ -149,8 +198,8 @@ pub enum RenderError {
 }
 
 /// The z-buffer rasterizer. It owns the colour, coverage and depth buffers
-/// and the triangle list, and reuses them from one picture to the next (the
-/// viewer redraws after every solver step).
+/// and the screen triangles with their tile bins, and reuses them from one
+/// picture to the next (the viewer redraws after every solver step).
 #[derive(Clone, Debug)]
 pub struct Rasterizer {
     frame: Frame,
@@ -158,7 +207,11 @@ pub struct Rasterizer {
     inv_depth: Vec<f64>,
     /// Per pixel, whether the nearest surface so far is a front face.
     front: Vec<bool>,
-    triangles: Vec<ScreenTriangle>,
+    /// Per mesh vertex, its projection in the current view.
+    vertices: Vec<ProjectedVertex>,
+    /// The screen triangles of consecutive runs of elements, in mesh order,
+    /// each run with its own tile bins.
+    batches: Vec<Batch>,
 }
 
 impl Default for Rasterizer {
@@ -174,7 +227,8 @@ impl Rasterizer {
             frame: Frame::new(0, 0),
             inv_depth: Vec::new(),
             front: Vec::new(),
-            triangles: Vec::new(),
+            vertices: Vec::new(),
+            batches: Vec::new(),
         }
     }
 
@@ -202,8 +256,9 @@ impl Rasterizer {
     /// its linear `radiosity` (one per mesh vertex, in the scene's radiosity
     /// units), and returns the picture, sized as the view.
     ///
-    /// Front faces show the Gouraud-interpolated radiosity, back faces are
-    /// black, uncovered pixels are black and not `covered`. Sky facets
+    /// Front faces show the Gouraud-interpolated radiosity; back faces are
+    /// `0` with [`Frame::back`] set to 1; uncovered pixels are `0` and not
+    /// `covered`. Sky facets
     /// ([`crate::mesh::PolygonMesh::sky`]) are not drawn: where the sky is
     /// seen, the picture shows background.
     pub fn render(
@@ -214,73 +269,232 @@ impl Rasterizer {
     ) -> Result<&Frame, RenderError> {
         check_mesh(mesh, radiosity)?;
         let (width, height) = (view.width(), view.height());
-        self.frame.reset(width, height);
-        self.inv_depth.clear();
-        self.inv_depth.resize(self.frame.len(), 0.0);
-        self.front.clear();
-        self.front.resize(self.frame.len(), false);
-
-        let setup = Setup::new(view);
-        self.triangles.clear();
-        for (e, element) in mesh.elements.iter().enumerate() {
-            // Checked by `check_mesh`: every index below is in range.
-            let polygon = &mesh.polygons[mesh.element_polygon[e].index()];
-            // The sky lights the scene; it is not part of the picture.
-            if polygon.sky {
-                continue;
-            }
-            for tri in element.triangles() {
-                let corner = |v: VertexId| ClipVertex {
-                    p: view.to_camera(mesh.positions[v.index()]).as_dvec3(),
-                    c: radiosity[v.index()].to_array(),
-                };
-                // Which side the eye is on decides lit or black: the
-                // polygon's plane is the same for all its triangles, so
-                // a polygon is never half lit.
-                let front = polygon
-                    .normal
-                    .dot(view.eye() - mesh.positions[tri[0].index()])
-                    > 0.0;
-                // Its back side is another polygon, drawn on its own.
-                if !front && polygon.has_back {
-                    continue;
-                }
-                let first = self.triangles.len();
-                setup.push(
-                    [corner(tri[0]), corner(tri[1]), corner(tri[2])],
-                    front,
-                    &mut self.triangles,
-                );
-                for t in &mut self.triangles[first..] {
-                    t.layer = polygon.layer;
-                }
-            }
-        }
+        let n = self.frame.resize(width, height);
+        // Cleared band by band below, in parallel.
+        self.inv_depth.resize(n, 0.0);
+        self.front.resize(n, false);
 
         let w = width as usize;
-        let triangles = &self.triangles;
+        let tiles_x = w.div_ceil(TILE_WIDTH);
+        let tiles = tiles_x * (height as usize).div_ceil(TILE_HEIGHT);
+        self.setup(mesh, radiosity, view, tiles_x, tiles);
+
+        let batches = &self.batches;
+        let vertices = &self.vertices;
         self.frame
             .pixels
-            .par_chunks_mut(BAND_ROWS * w)
-            .zip(self.frame.covered.par_chunks_mut(BAND_ROWS * w))
-            .zip(self.inv_depth.par_chunks_mut(BAND_ROWS * w))
-            .zip(self.front.par_chunks_mut(BAND_ROWS * w))
+            .par_chunks_mut(TILE_HEIGHT * w)
+            .zip(self.frame.covered.par_chunks_mut(TILE_HEIGHT * w))
+            .zip(self.inv_depth.par_chunks_mut(TILE_HEIGHT * w))
+            .zip(self.front.par_chunks_mut(TILE_HEIGHT * w))
+            .zip(self.frame.back.par_chunks_mut(TILE_HEIGHT * w))
             .enumerate()
-            .for_each(|(band, (((pixels, covered), depth), front))| {
+            .for_each(|(ty, ((((pixels, covered), depth), front), back))| {
+                pixels.fill([0.0; 3]);
+                covered.fill(false);
+                depth.fill(0.0);
+                front.fill(false);
+                back.fill(0.0);
                 let mut target = Band {
                     width: w,
-                    first_row: band * BAND_ROWS,
+                    first_row: ty * TILE_HEIGHT,
                     rows: pixels.len() / w,
                     pixels,
                     covered,
                     depth,
                     front,
+                    back,
                 };
-                for t in triangles {
-                    target.draw(t);
+                for tx in 0..tiles_x {
+                    let tile = ty * tiles_x + tx;
+                    let columns = tx * TILE_WIDTH..((tx + 1) * TILE_WIDTH).min(w);
+                    // Batches in mesh order, each bin in mesh order: every
+                    // pixel sees the triangles in mesh order, whatever the
+                    // tiles and threads.
+                    for batch in batches {
+                        for &i in batch.tile(tile) {
+                            let t = &batch.triangles[i as usize];
+                            target.draw(t, batch.vertices(t, vertices), columns.clone());
+                        }
+                    }
                 }
             });
         Ok(&self.frame)
+    }
+
+    /// Transforms, clips, projects and bins every element's triangles, in
+    /// parallel: first every mesh vertex (camera space, which side of each
+    /// clip plane, projection), then runs of elements, which keep mesh
+    /// order.
+    fn setup(&mut self, mesh: &Mesh, radiosity: &[Rgb], view: &View, tiles_x: usize, tiles: usize) {
+        let setup = Setup::new(view);
+        self.vertices
+            .resize(mesh.positions.len(), ProjectedVertex::default());
+        self.vertices
+            .par_iter_mut()
+            .zip(mesh.positions.par_iter().zip(radiosity.par_iter()))
+            .with_min_len(4096)
+            .for_each(|(out, (&p, c))| {
+                *out = setup.vertex(view.to_camera(p).as_dvec3(), c.to_array())
+            });
+
+        let elements = mesh.elements.len();
+        let chunk = elements
+            .div_ceil(SETUP_CHUNKS_PER_THREAD * rayon::current_num_threads())
+            .max(MIN_SETUP_CHUNK);
+        self.batches
+            .resize_with(elements.div_ceil(chunk), Batch::default);
+        let vertices = &self.vertices;
+        self.batches
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, batch)| {
+                batch.triangles.clear();
+                batch.local.clear();
+                for e in k * chunk..((k + 1) * chunk).min(elements) {
+                    // Checked by `check_mesh`: every index below is in range.
+                    let polygon = &mesh.polygons[mesh.element_polygon[e].index()];
+                    // The sky lights the scene; it is not part of the picture.
+                    if polygon.sky {
+                        continue;
+                    }
+                    for tri in mesh.elements[e].triangles() {
+                        // Which side the eye is on decides lit or black: the
+                        // polygon's plane is the same for all its triangles,
+                        // so a polygon is never half lit.
+                        let front = polygon
+                            .normal
+                            .dot(view.eye() - mesh.positions[tri[0].index()])
+                            > 0.0;
+                        // Its back side is another polygon, drawn on its own.
+                        if !front && polygon.has_back {
+                            continue;
+                        }
+                        let p = tri.map(|v| &vertices[v.index()]);
+                        // Clipping plane by plane, in order, while the triangle
+                        // is still whole: a plane with every corner inside
+                        // leaves it as it is, one with every corner outside
+                        // removes it, the first other one cuts it.
+                        let not_inside = p[0].not_inside | p[1].not_inside | p[2].not_inside;
+                        if not_inside == 0 {
+                            if p.iter().all(|p| p.valid) {
+                                let screen = [&p[0].screen, &p[1].screen, &p[2].screen];
+                                if let Some(t) =
+                                    setup.triangle(tri.map(|v| v.0), screen, front, polygon.layer)
+                                {
+                                    batch.triangles.push(t);
+                                }
+                            }
+                            continue;
+                        }
+                        let first = not_inside.trailing_zeros() as usize;
+                        if (p[0].outside & p[1].outside & p[2].outside) & (1 << first) != 0 {
+                            continue;
+                        }
+                        let corner = |v: VertexId| ClipVertex {
+                            p: view.to_camera(mesh.positions[v.index()]).as_dvec3(),
+                            c: radiosity[v.index()].to_array(),
+                        };
+                        setup.push_clipped(
+                            [corner(tri[0]), corner(tri[1]), corner(tri[2])],
+                            front,
+                            polygon.layer,
+                            first,
+                            &mut batch.local,
+                            &mut batch.triangles,
+                        );
+                    }
+                }
+                batch.sort_into_tiles(tiles_x, tiles);
+            });
+    }
+}
+
+/// Marks a [`ScreenTriangle`] vertex index as one of its batch's own
+/// vertices (made by clipping) rather than a mesh vertex.
+const LOCAL_VERTEX: u32 = 1 << 31;
+
+/// A mesh vertex in the current view.
+#[derive(Clone, Copy, Debug, Default)]
+struct ProjectedVertex {
+    /// Its projection with its radiosity; meaningful when `valid`.
+    screen: ScreenVertex,
+    /// Whether the projection is finite (the vertex is in front of the eye).
+    valid: bool,
+    /// Bit `k` set when the vertex is not inside clip plane `k`
+    /// (`!(distance >= 0)`, so NaN counts).
+    not_inside: u8,
+    /// Bit `k` set when the vertex is outside clip plane `k`
+    /// (`distance < 0`).
+    outside: u8,
+}
+
+/// The screen triangles of a run of consecutive elements, in mesh order,
+/// and which of them overlap each screen tile.
+#[derive(Clone, Debug, Default)]
+struct Batch {
+    triangles: Vec<ScreenTriangle>,
+    /// The vertices clipping made, which the triangles name with
+    /// [`LOCAL_VERTEX`] set.
+    local: Vec<ScreenVertex>,
+    /// Tile `t`'s triangles are `entries[start[t]..start[t + 1]]`,
+    /// ascending indices into `triangles`; `start` has one entry per tile
+    /// and one more.
+    start: Vec<u32>,
+    entries: Vec<u32>,
+    /// Where the next entry of each tile goes while binning.
+    cursor: Vec<u32>,
+}
+
+impl Batch {
+    /// Sorts the triangles into the tiles their pixel bounding boxes
+    /// overlap (a counting sort, so each bin keeps mesh order).
+    fn sort_into_tiles(&mut self, tiles_x: usize, tiles: usize) {
+        let tiles_of = |t: &ScreenTriangle| {
+            let (x0, x1) = (t.x0 as usize / TILE_WIDTH, t.x1 as usize / TILE_WIDTH);
+            (t.y0 as usize / TILE_HEIGHT..=t.y1 as usize / TILE_HEIGHT)
+                .flat_map(move |ty| (x0..=x1).map(move |tx| ty * tiles_x + tx))
+        };
+        self.start.clear();
+        self.start.resize(tiles + 1, 0);
+        for t in &self.triangles {
+            for tile in tiles_of(t) {
+                self.start[tile + 1] += 1;
+            }
+        }
+        for i in 1..=tiles {
+            self.start[i] += self.start[i - 1];
+        }
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.start[..tiles]);
+        self.entries.clear();
+        self.entries.resize(self.start[tiles] as usize, 0);
+        for (i, t) in self.triangles.iter().enumerate() {
+            for tile in tiles_of(t) {
+                self.entries[self.cursor[tile] as usize] = i as u32;
+                self.cursor[tile] += 1;
+            }
+        }
+    }
+
+    /// The three vertices of a triangle of this batch.
+    fn vertices<'a>(
+        &'a self,
+        t: &ScreenTriangle,
+        mesh: &'a [ProjectedVertex],
+    ) -> [&'a ScreenVertex; 3] {
+        t.v.map(|i| {
+            if i & LOCAL_VERTEX != 0 {
+                &self.local[(i & !LOCAL_VERTEX) as usize]
+            } else {
+                &mesh[i as usize].screen
+            }
+        })
+    }
+
+    /// Indices of the triangles overlapping `tile`, ascending.
+    fn tile(&self, tile: usize) -> &[u32] {
+        &self.entries[self.start[tile] as usize..self.start[tile + 1] as usize]
     }
 }
 
@@ -392,7 +606,7 @@ fn clip(poly: &ClipPolygon, distance: impl Fn(DVec3) -> f64) -> ClipPolygon {
 
 /// A projected vertex: snapped pixel position and the values interpolated
 /// linearly in screen space.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct ScreenVertex {
     /// Position in `1 / SUBPIXEL` pixels.
     x: i64,
@@ -407,21 +621,24 @@ struct ScreenVertex {
 /// per-edge fill-rule bias and a pixel bounding box inside the picture.
 #[derive(Clone, Copy, Debug)]
 struct ScreenTriangle {
-    v: [ScreenVertex; 3],
+    /// Its vertices, clockwise on screen: mesh vertex indices, or with
+    /// [`LOCAL_VERTEX`] set indices into its batch's clipped vertices.
+    v: [u32; 3],
     /// Twice the area in squared sub-pixel units, `> 0`.
     area: i64,
     /// Per edge opposite vertex `i`: `0` for top-left edges (pixel centres
     /// exactly on them are inside), `1` otherwise.
-    bias: [i64; 3],
+    bias: [u8; 3],
     /// Whether the eye sees the front of the triangle's polygon.
     front: bool,
     /// Its polygon's draw layer ([`crate::mesh::PolygonMesh::layer`]).
     layer: u8,
-    /// Inclusive pixel bounds: columns `x0..=x1`, rows `y0..=y1`.
-    x0: usize,
-    x1: usize,
-    y0: usize,
-    y1: usize,
+    /// Inclusive pixel bounds: columns `x0..=x1`, rows `y0..=y1` (a picture
+    /// side is at most [`crate::camera::MAX_PICTURE_SIDE`]).
+    x0: u32,
+    x1: u32,
+    y0: u32,
+    y1: u32,
 }
 
 /// Edge function of the edge `a → b` at `(px, py)`: twice the signed area of
@@ -439,8 +656,7 @@ fn is_top_left(a: &ScreenVertex, b: &ScreenVertex) -> bool {
 }
 
 /// Per-view constants of triangle setup.
-struct Setup<'v> {
-    view: &'v View,
+struct Setup {
     near: f64,
     /// Guard-band half sizes in pixels times `z / focal` (see `push`).
     guard_x: f64,
@@ -450,12 +666,11 @@ struct Setup<'v> {
     height: f64,
 }
 
-impl<'v> Setup<'v> {
-    fn new(view: &'v View) -> Self {
+impl Setup {
+    fn new(view: &View) -> Self {
         let width = f64::from(view.width());
         let height = f64::from(view.height());
         Setup {
-            view,
             near: f64::from(view.near()),
             guard_x: GUARD_BAND * width / 2.0,
             guard_y: GUARD_BAND * height / 2.0,
@@ -465,35 +680,80 @@ impl<'v> Setup<'v> {
         }
     }
 
-    /// Clips, projects and snaps one camera-space triangle and appends the
-    /// resulting screen triangles (none if it is invisible).
-    fn push(&self, tri: [ClipVertex; 3], front: bool, out: &mut Vec<ScreenTriangle>) {
+    /// Signed distance of camera-space `p` to clip plane `k`, scaled,
+    /// positive inside: the near plane, then the four guard-band planes
+    /// through the eye, `|f x / z| <= gx` and `|f y / z| <= gy` multiplied
+    /// by `z > 0`.
+    fn distance(&self, k: usize, p: DVec3) -> f64 {
+        let (f, gx, gy) = (self.focal, self.guard_x, self.guard_y);
+        match k {
+            0 => p.z - self.near,
+            1 => gx * p.z - f * p.x,
+            2 => gx * p.z + f * p.x,
+            3 => gy * p.z - f * p.y,
+            _ => gy * p.z + f * p.y,
+        }
+    }
+
+    /// A mesh vertex at camera-space `p` with radiosity `c`: which side of
+    /// each clip plane it lies, and its projection.
+    fn vertex(&self, p: DVec3, c: [f64; 3]) -> ProjectedVertex {
+        let (mut not_inside, mut outside) = (0, 0);
+        for k in 0..CLIP_PLANES {
+            let d = self.distance(k, p);
+            if d.is_nan() || d < 0.0 {
+                not_inside |= 1 << k;
+            }
+            if d < 0.0 {
+                outside |= 1 << k;
+            }
+        }
+        let screen = self.project(&ClipVertex { p, c }, true);
+        ProjectedVertex {
+            screen: screen.unwrap_or_default(),
+            valid: screen.is_some(),
+            not_inside,
+            outside,
+        }
+    }
+
+    /// Clips one camera-space triangle against the planes from `first` on
+    /// (the earlier ones keep it whole), projects and snaps the result, and
+    /// appends its screen triangles (none if it is invisible), their new
+    /// vertices to `local`.
+    fn push_clipped(
+        &self,
+        tri: [ClipVertex; 3],
+        front: bool,
+        layer: u8,
+        first: usize,
+        local: &mut Vec<ScreenVertex>,
+        out: &mut Vec<ScreenTriangle>,
+    ) {
         let mut poly = ClipPolygon {
             v: [ClipVertex::default(); MAX_CLIPPED],
             len: 3,
         };
         poly.v[..3].copy_from_slice(&tri);
-        let (near, f, gx, gy) = (self.near, self.focal, self.guard_x, self.guard_y);
-        // Near plane, then the four guard-band planes through the eye:
-        // `|f x / z| <= gx` and `|f y / z| <= gy`, multiplied by z > 0.
-        poly = clip(&poly, |p| p.z - near);
-        poly = clip(&poly, |p| gx * p.z - f * p.x);
-        poly = clip(&poly, |p| gx * p.z + f * p.x);
-        poly = clip(&poly, |p| gy * p.z - f * p.y);
-        poly = clip(&poly, |p| gy * p.z + f * p.y);
+        for k in first..CLIP_PLANES {
+            poly = clip(&poly, |p| self.distance(k, p));
+        }
         if poly.len < 3 {
             return;
         }
         let mut screen = [None; MAX_CLIPPED];
         for (s, v) in screen.iter_mut().zip(&poly.v[..poly.len]) {
-            *s = self.project(v, front);
+            if let Some(p) = self.project(v, front) {
+                *s = Some((local.len() as u32 | LOCAL_VERTEX, p));
+                local.push(p);
+            }
         }
         // A fan from the first vertex: its inner edges are shared by
         // neighbouring fan triangles with identical endpoints, so the fill
         // rule covers them once as well.
         for i in 1..poly.len - 1 {
             if let (Some(a), Some(b), Some(c)) = (screen[0], screen[i], screen[i + 1]) {
-                if let Some(t) = self.triangle(a, b, c, front) {
+                if let Some(t) = self.triangle([a.0, b.0, c.0], [&a.1, &b.1, &c.1], front, layer) {
                     out.push(t);
                 }
             }
@@ -501,7 +761,14 @@ impl<'v> Setup<'v> {
     }
 
     fn project(&self, v: &ClipVertex, front: bool) -> Option<ScreenVertex> {
-        let pixel = self.view.camera_to_pixel(v.p)?;
+        // `View::camera_to_pixel` with the focal length computed once.
+        if v.p.z.is_nan() || v.p.z <= 0.0 {
+            return None;
+        }
+        let pixel = DVec2::new(
+            self.width / 2.0 + self.focal * v.p.x / v.p.z,
+            self.height / 2.0 - self.focal * v.p.y / v.p.z,
+        );
         let snap = |x: f64| (x * SUBPIXEL as f64).round();
         let (x, y) = (snap(pixel.x), snap(pixel.y));
         if !(x.is_finite() && y.is_finite()) {
@@ -520,17 +787,19 @@ impl<'v> Setup<'v> {
         })
     }
 
+    /// The screen triangle of vertices `v` named `index`, wound clockwise;
+    /// `None` when it is degenerate or covers no pixel centre.
     fn triangle(
         &self,
-        a: ScreenVertex,
-        b: ScreenVertex,
-        c: ScreenVertex,
+        index: [u32; 3],
+        v: [&ScreenVertex; 3],
         front: bool,
+        layer: u8,
     ) -> Option<ScreenTriangle> {
-        let area = edge(&a, &b, c.x, c.y);
-        let v = match area.signum() {
-            1 => [a, b, c],
-            -1 => [a, c, b],
+        let area = edge(v[0], v[1], v[2].x, v[2].y);
+        let (v, index) = match area.signum() {
+            1 => (v, index),
+            -1 => ([v[0], v[2], v[1]], [index[0], index[2], index[1]]),
             // Degenerate (edge-on or collapsed by snapping): covers nothing.
             _ => return None,
         };
@@ -548,20 +817,20 @@ impl<'v> Setup<'v> {
             return None;
         }
         Some(ScreenTriangle {
-            v,
+            v: index,
             area: area.abs(),
             bias: [
-                i64::from(!is_top_left(&v[1], &v[2])),
-                i64::from(!is_top_left(&v[2], &v[0])),
-                i64::from(!is_top_left(&v[0], &v[1])),
+                u8::from(!is_top_left(v[1], v[2])),
+                u8::from(!is_top_left(v[2], v[0])),
+                u8::from(!is_top_left(v[0], v[1])),
             ],
             front,
-            layer: 0,
+            layer,
             // Non-negative and inside the picture after the clamps above.
-            x0: x0 as usize,
-            x1: x1 as usize,
-            y0: y0 as usize,
-            y1: y1 as usize,
+            x0: x0 as u32,
+            x1: x1 as u32,
+            y0: y0 as u32,
+            y1: y1 as u32,
         })
     }
 }
@@ -575,47 +844,128 @@ struct Band<'a> {
     covered: &'a mut [bool],
     depth: &'a mut [f64],
     front: &'a mut [bool],
+    back: &'a mut [f32],
 }
 
 impl Band<'_> {
-    fn draw(&mut self, t: &ScreenTriangle) {
-        let y0 = t.y0.max(self.first_row);
-        let y1 = t.y1.min(self.first_row + self.rows - 1);
-        if y0 > y1 {
+    /// Draws the part of `t` (with vertices `v`) in this band's rows and in
+    /// `columns`.
+    ///
+    /// Rows wider than [`SPAN_MIN_WIDTH`] are cut to the run of pixels
+    /// whose centres pass all three edge tests, solved exactly in integers
+    /// from the edge functions' per-pixel steps; narrower ones test each
+    /// pixel. Either way the pixels drawn are exactly those the edge tests
+    /// accept.
+    fn draw(&mut self, t: &ScreenTriangle, v: [&ScreenVertex; 3], columns: Range<usize>) {
+        let y0 = (t.y0 as usize).max(self.first_row);
+        let y1 = (t.y1 as usize).min(self.first_row + self.rows - 1);
+        let x0 = (t.x0 as usize).max(columns.start);
+        let x1 = (t.x1 as usize).min(columns.end.saturating_sub(1));
+        if y0 > y1 || x0 > x1 {
             return;
         }
-        let [a, b, c] = &t.v;
+        let [a, b, c] = v;
+        let bias = t.bias.map(i64::from);
+        // How each edge function changes from one pixel to the next right.
+        let step = [
+            (b.y - c.y) * SUBPIXEL,
+            (c.y - a.y) * SUBPIXEL,
+            (a.y - b.y) * SUBPIXEL,
+        ];
+        let last = (x1 - x0) as i64;
+        let px0 = x0 as i64 * SUBPIXEL + SUBPIXEL / 2;
+        for y in y0..=y1 {
+            let py = y as i64 * SUBPIXEL + SUBPIXEL / 2;
+            let start = [
+                edge(b, c, px0, py),
+                edge(c, a, px0, py),
+                edge(a, b, px0, py),
+            ];
+            let row = (y - self.first_row) * self.width;
+            if last < SPAN_MIN_WIDTH {
+                let mut w = start;
+                for x in x0..=x1 {
+                    if w[0] >= bias[0] && w[1] >= bias[1] && w[2] >= bias[2] {
+                        self.shade(t, v, w, row + x);
+                    }
+                    w = [w[0] + step[0], w[1] + step[1], w[2] + step[2]];
+                }
+                continue;
+            }
+            // The pixels `x0 + k` with `start[i] + k * step[i] >= bias[i]`
+            // for every edge `i`.
+            let (mut lo, mut hi) = (0, last);
+            for i in 0..3 {
+                let need = bias[i] - start[i];
+                match step[i].signum() {
+                    1 => lo = lo.max((need + step[i] - 1).div_euclid(step[i])),
+                    -1 => hi = hi.min((-need).div_euclid(-step[i])),
+                    _ if need > 0 => hi = -1,
+                    _ => {}
+                }
+            }
+            if lo > hi {
+                continue;
+            }
+            let mut w = [0; 3];
+            for i in 0..3 {
+                w[i] = start[i] + lo * step[i];
+            }
+            for x in x0 + lo as usize..=x0 + hi as usize {
+                self.shade(t, v, w, row + x);
+                w = [w[0] + step[0], w[1] + step[1], w[2] + step[2]];
+            }
+        }
+    }
+
+    /// Depth-tests and shades pixel `i` of the band, inside `t` with edge
+    /// functions `w` at its centre.
+    #[inline(always)]
+    fn shade(&mut self, t: &ScreenTriangle, v: [&ScreenVertex; 3], w: [i64; 3], i: usize) {
+        let [a, b, c] = v;
         let area = t.area as f64;
+        let (l0, l1, l2) = (w[0] as f64 / area, w[1] as f64 / area, w[2] as f64 / area);
+        let inv_z = l0 * a.inv_z + l1 * b.inv_z + l2 * c.inv_z;
+        // A higher layer is pulled nearer by a hair, so of two overlapping
+        // coplanar polygons it wins wherever rounding would have split them.
+        let key = inv_z * (1.0 + f64::from(t.layer) * LAYER_DEPTH_BIAS);
+        // Strictly nearer: on equal depth the first triangle drawn (in mesh
+        // order, in every tile) keeps the pixel.
+        if key.is_nan() || key <= self.depth[i] {
+            return;
+        }
+        self.depth[i] = key;
+        self.covered[i] = true;
+        self.front[i] = t.front;
+        self.back[i] = if t.front { 0.0 } else { 1.0 };
+        // Back faces hold no light: their radiosity is that of the other
+        // side. The 8-bit picture paints them (`to_srgb8`).
+        self.pixels[i] = if t.front {
+            let channel = |k: usize| {
+                ((l0 * a.c_over_z[k] + l1 * b.c_over_z[k] + l2 * c.c_over_z[k]) / inv_z) as f32
+            };
+            [channel(0), channel(1), channel(2)]
+        } else {
+            [0.0; 3]
+        };
+    }
+
+    /// The brute-force twin of [`Band::draw`]: every pixel of the
+    /// triangle's bounding box, each tested against the three edges.
+    #[cfg(test)]
+    fn draw_every_pixel(&mut self, t: &ScreenTriangle, v: [&ScreenVertex; 3]) {
+        let y0 = (t.y0 as usize).max(self.first_row);
+        let y1 = (t.y1 as usize).min(self.first_row + self.rows - 1);
+        let [a, b, c] = v;
         for y in y0..=y1 {
             let py = y as i64 * SUBPIXEL + SUBPIXEL / 2;
             let row = (y - self.first_row) * self.width;
-            for x in t.x0..=t.x1 {
+            for x in t.x0 as usize..=t.x1 as usize {
                 let px = x as i64 * SUBPIXEL + SUBPIXEL / 2;
-                let w0 = edge(b, c, px, py);
-                let w1 = edge(c, a, px, py);
-                let w2 = edge(a, b, px, py);
-                if w0 < t.bias[0] || w1 < t.bias[1] || w2 < t.bias[2] {
-                    continue;
+                let w = [edge(b, c, px, py), edge(c, a, px, py), edge(a, b, px, py)];
+                if (0..3).all(|k| w[k] >= i64::from(t.bias[k])) {
+                    self.shade(t, v, w, row + x);
                 }
-                let (l0, l1, l2) = (w0 as f64 / area, w1 as f64 / area, w2 as f64 / area);
-                let inv_z = l0 * a.inv_z + l1 * b.inv_z + l2 * c.inv_z;
-                // A higher layer is pulled nearer by a hair, so of two
-                // overlapping coplanar polygons it wins wherever rounding
-                // would have split them.
-                let key = inv_z * (1.0 + f64::from(t.layer) * LAYER_DEPTH_BIAS);
-                let i = row + x;
-                // Strictly nearer: on equal depth the first triangle drawn
-                // keeps the pixel, which is the same in every band.
-                if key.is_nan() || key <= self.depth[i] {
-                    continue;
-                }
-                self.depth[i] = key;
-                self.covered[i] = true;
-                self.front[i] = t.front;
-                let channel = |k: usize| {
-                    ((l0 * a.c_over_z[k] + l1 * b.c_over_z[k] + l2 * c.c_over_z[k]) / inv_z) as f32
-                };
-                self.pixels[i] = [channel(0), channel(1), channel(2)];
             }
         }
     }
@@ -767,7 +1117,7 @@ mod tests {
     }
 
     #[test]
-    fn back_face_is_black_but_occludes() {
+    fn back_face_holds_no_light_is_flagged_and_occludes() {
         let mut back = rect(10.0, 10.0, 60.0, 60.0, 2.0);
         back.reverse();
         let lit = rect(0.0, 0.0, 100.0, 100.0, 4.0);
@@ -777,7 +1127,17 @@ mod tests {
             .render();
         assert_eq!(covered_count(&frame), 100 * 100);
         assert_eq!(frame.pixel(30, 30), Some([0.0; 3]));
+        assert_eq!(frame.back[30 * 100 + 30], 1.0);
         assert_eq!(frame.pixel(80, 80), Some([1.0; 3]));
+        assert_eq!(frame.back[80 * 100 + 80], 0.0);
+        // The 8-bit picture paints it, not black; the lit quad is as before.
+        let img = crate::render::to_srgb8(&frame, 1.0);
+        assert_eq!(
+            img.get_pixel(30, 30).0,
+            crate::render::back_face_color(30, 30)
+        );
+        assert_ne!(img.get_pixel(30, 30).0, [0, 0, 0]);
+        assert_eq!(img.get_pixel(80, 80).0, [255; 3]);
     }
 
     #[test]
@@ -1070,6 +1430,116 @@ mod tests {
         assert!(covered_count(&one) > 0);
         assert_eq!(one, run(4));
         assert_eq!(one, run(7));
+    }
+
+    /// The brute-force twin of [`Rasterizer::render`]: serial setup with
+    /// every plane clipped, then every triangle tested at every pixel of
+    /// its bounding box over the whole picture, in mesh order. Returns the
+    /// frame, `1 / z` and the front-face flags.
+    fn render_brute_force(
+        mesh: &Mesh,
+        radiosity: &[Rgb],
+        view: &View,
+    ) -> (Frame, Vec<f64>, Vec<bool>) {
+        let setup = Setup::new(view);
+        let mut triangles = Vec::new();
+        let mut local = Vec::new();
+        for (e, element) in mesh.elements.iter().enumerate() {
+            let polygon = &mesh.polygons[mesh.element_polygon[e].index()];
+            if polygon.sky {
+                continue;
+            }
+            for tri in element.triangles() {
+                let front = polygon
+                    .normal
+                    .dot(view.eye() - mesh.positions[tri[0].index()])
+                    > 0.0;
+                if !front && polygon.has_back {
+                    continue;
+                }
+                let corner = |v: VertexId| ClipVertex {
+                    p: view.to_camera(mesh.positions[v.index()]).as_dvec3(),
+                    c: radiosity[v.index()].to_array(),
+                };
+                setup.push_clipped(
+                    [corner(tri[0]), corner(tri[1]), corner(tri[2])],
+                    front,
+                    polygon.layer,
+                    0,
+                    &mut local,
+                    &mut triangles,
+                );
+            }
+        }
+        let (w, h) = (view.width() as usize, view.height() as usize);
+        let mut frame = Frame::new(view.width(), view.height());
+        let mut depth = vec![0.0; w * h];
+        let mut front = vec![false; w * h];
+        let mut band = Band {
+            width: w,
+            first_row: 0,
+            rows: h,
+            pixels: &mut frame.pixels,
+            covered: &mut frame.covered,
+            depth: &mut depth,
+            front: &mut front,
+            back: &mut frame.back,
+        };
+        for t in &triangles {
+            band.draw_every_pixel(t, t.v.map(|i| &local[(i & !LOCAL_VERTEX) as usize]));
+        }
+        (frame, depth, front)
+    }
+
+    #[test]
+    fn binned_tiles_match_drawing_every_triangle_everywhere() {
+        // Triangles from a few pixels to far beyond the picture, crossing
+        // tile borders, the near plane and each other, some seen from the
+        // back, some on higher draw layers, on a picture whose size is no
+        // multiple of the tile size.
+        let mut b = Builder::default();
+        for k in 0..300 {
+            let t = k as f32 * 0.618;
+            let size = 0.05 + (k % 13) as f32 * (k % 5) as f32 * 0.15;
+            let c = Vec3::new(
+                (t * 1.3).sin() * 3.0,
+                (t * 0.7).cos() * 2.0,
+                -0.5 - (k % 11) as f32 * 0.7,
+            );
+            let mut tri = [
+                c,
+                c + Vec3::new(size, 0.3 * size, 0.4 * size * t.cos()),
+                c + Vec3::new(0.2 * size, size, -0.6 * size),
+            ];
+            if k % 7 == 0 {
+                tri.reverse();
+            }
+            b.polygon(&tri, &[k as f64, 1.0, 0.5]);
+        }
+        let mut mesh = b.mesh.clone().unwrap();
+        for (k, p) in mesh.polygons.iter_mut().enumerate() {
+            p.layer = (k % 3) as u8;
+        }
+        let camera = Camera {
+            eye: Vec3::ZERO,
+            lookat: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::Y,
+            fov_y: 1.2,
+            width: 333,
+            height: 177,
+        };
+        let view = View::new(&camera).unwrap();
+        let (want, want_depth, want_front) = render_brute_force(&mesh, &b.radiosity, &view);
+        assert!(covered_count(&want) > 333 * 177 / 2);
+        assert!(
+            want_front.iter().any(|&f| f)
+                && want_front.iter().zip(&want.covered).any(|(&f, &c)| c && !f)
+        );
+        let mut r = Rasterizer::new();
+        let got = r.render(&mesh, &b.radiosity, &view).unwrap().clone();
+        assert_eq!(got, want);
+        assert_eq!(r.inv_depth(), &want_depth[..]);
+        assert_eq!(r.front_faces(), &want_front[..]);
     }
 
     #[test]

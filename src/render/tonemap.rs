@@ -10,6 +10,7 @@
 use super::raster::Frame;
 use crate::color::Rgb;
 use image::RgbImage;
+use rayon::prelude::*;
 
 /// Which luminance percentile of the covered pixels [`auto_exposure`] puts
 /// at [`AUTO_TARGET`]. Below one so that a few very bright pixels (the light
@@ -50,31 +51,52 @@ impl Exposure {
 }
 
 /// The exposure that maps the [`AUTO_PERCENTILE`] of the luminance (Rec. 709
-/// weights) of the covered pixels to [`AUTO_TARGET`].
+/// weights) of the covered pixels to [`AUTO_TARGET`]. Pixels wholly on back
+/// faces ([`Frame::back`] of 1) do not count: they hold no light, and a
+/// wall the eye stepped through must not darken or brighten the rest.
 ///
 /// If that percentile is zero (a mostly dark picture), the brightest pixel is
 /// used instead; if the frame has no covered pixel with a positive finite
 /// luminance, the result is [`FALLBACK_EXPOSURE`]. Always finite and `> 0`.
 pub fn auto_exposure(frame: &Frame) -> f32 {
-    let mut lum: Vec<f64> = frame
+    // Read twice or three times rather than collected: a frame has about a
+    // million pixels, and the selection needs only one bucket of them.
+    // A few work items a thread: each carries a table of bucket counts.
+    let chunk = frame
         .pixels
-        .iter()
-        .zip(&frame.covered)
-        .filter(|(_, &c)| c)
-        .map(|(p, _)| Rgb::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])).luminance())
-        .filter(|l| l.is_finite())
-        .collect();
-    if lum.is_empty() {
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
+        .max(MIN_EXPOSURE_CHUNK);
+    let luminances = || {
+        frame
+            .pixels
+            .par_chunks(chunk)
+            .zip(frame.covered.par_chunks(chunk))
+            .enumerate()
+            .flat_map_iter(move |(k, (pixels, covered))| {
+                let back = frame.back.get(k * chunk..).unwrap_or_default();
+                pixels
+                    .iter()
+                    .zip(covered)
+                    .enumerate()
+                    .filter(move |&(i, (_, &c))| c && back.get(i).is_none_or(|&b| b < 1.0))
+                    .map(|(_, (p, _))| {
+                        Rgb::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])).luminance()
+                    })
+                    .filter(|l| l.is_finite())
+            })
+    };
+    let Some(at_rank) = nth_smallest(luminances, |n| {
+        // Nearest-rank percentile: the smallest value with at least that
+        // fraction of the pixels at or below it.
+        ((AUTO_PERCENTILE * n as f64).ceil() as usize).clamp(1, n) - 1
+    }) else {
         return FALLBACK_EXPOSURE;
-    }
-    // Nearest-rank percentile: the smallest value with at least that
-    // fraction of the pixels at or below it.
-    let rank = ((AUTO_PERCENTILE * lum.len() as f64).ceil() as usize).clamp(1, lum.len()) - 1;
-    let (_, &mut at_rank, _) = lum.select_nth_unstable_by(rank, f64::total_cmp);
+    };
     let reference = if at_rank > 0.0 {
         at_rank
     } else {
-        lum.iter().copied().fold(0.0, f64::max)
+        luminances().reduce(|| 0.0, f64::max)
     };
     let exposure = (AUTO_TARGET / reference) as f32;
     if reference > 0.0 && exposure.is_finite() && exposure > 0.0 {
@@ -82,6 +104,66 @@ pub fn auto_exposure(frame: &Frame) -> f32 {
     } else {
         FALLBACK_EXPOSURE
     }
+}
+
+/// Fewest pixels per parallel work item of [`auto_exposure`].
+const MIN_EXPOSURE_CHUNK: usize = 64 * 1024;
+
+/// Bits of the order key that pick a bucket in [`nth_smallest`]: sign,
+/// exponent and four mantissa bits, so a bucket spans 1/16 of an octave.
+const SELECT_BUCKET_BITS: u32 = 16;
+
+/// The `rank(n)`-th smallest (from 0) of the `n` values `values()` yields,
+/// in the order of [`f64::total_cmp`]; `None` when there are none (or the
+/// rank is not below `n`).
+///
+/// One parallel pass counts the values per bucket of their leading bits,
+/// which finds the bucket holding the rank; a second collects that bucket
+/// only, which is searched. The value is the same as a full sort's,
+/// whatever the thread count.
+fn nth_smallest<I, F>(values: F, rank: impl Fn(usize) -> usize) -> Option<f64>
+where
+    F: Fn() -> I,
+    I: ParallelIterator<Item = f64>,
+{
+    // `total_cmp`'s order as unsigned integers.
+    let key = |v: f64| {
+        let bits = v.to_bits();
+        (bits ^ ((((bits as i64) >> 63) as u64) >> 1)) ^ (1 << 63)
+    };
+    let shift = 64 - SELECT_BUCKET_BITS;
+    let bucket_of = |v: f64| (key(v) >> shift) as usize;
+    let buckets = 1usize << SELECT_BUCKET_BITS;
+    let counts = values()
+        .fold(
+            || vec![0u32; buckets],
+            |mut counts, v| {
+                counts[bucket_of(v)] += 1;
+                counts
+            },
+        )
+        .reduce_with(|mut a, b| {
+            for (a, b) in a.iter_mut().zip(&b) {
+                *a += b;
+            }
+            a
+        })?;
+    let n: usize = counts.iter().map(|&c| c as usize).sum();
+    if n == 0 {
+        return None;
+    }
+    let rank = rank(n);
+    let mut below = 0usize;
+    for (bucket, &count) in counts.iter().enumerate() {
+        let count = count as usize;
+        if rank < below + count {
+            let mut inside: Vec<f64> = values().filter(|&v| bucket_of(v) == bucket).collect();
+            let (_, &mut at, _) = inside.select_nth_unstable_by(rank - below, f64::total_cmp);
+            return Some(at);
+        }
+        below += count;
+    }
+    None
 }
 
 /// The sRGB transfer function (OETF): linear `v` in `[0, 1]` to the encoded
@@ -103,19 +185,146 @@ pub fn srgb8(v: f32, exposure: f32) -> u8 {
     (encoded * 255.0).round() as u8
 }
 
+/// Buckets of the exposed linear value in `[0, 1)` in [`Srgb8Table`]: the
+/// 8-bit code changes at most once within one, because the sRGB curve's
+/// slope never exceeds 12.92, so codes change at most `255 × 12.92 ≈ 3,295`
+/// times per unit, fewer than the buckets.
+const TABLE_BUCKETS: usize = 4096;
+
+/// [`srgb8`] as a table: the code at the start of each bucket of the
+/// exposed linear value, and where in the bucket it steps up by one. Built
+/// from [`srgb8`]'s own curve, so the codes are the same bits.
+struct Srgb8Table {
+    base: Vec<u8>,
+    /// The smallest value of the bucket whose code is `base + 1`
+    /// (infinite where the code does not change).
+    step: Vec<f64>,
+}
+
+/// The code of an exposed linear value, [`srgb8`]'s curve.
+fn code(x: f64) -> u8 {
+    (srgb_encode(x) * 255.0).round() as u8
+}
+
+impl Srgb8Table {
+    fn new() -> Srgb8Table {
+        let n = TABLE_BUCKETS as f64;
+        let mut base = Vec::with_capacity(TABLE_BUCKETS);
+        let mut step = Vec::with_capacity(TABLE_BUCKETS);
+        for i in 0..TABLE_BUCKETS {
+            let lo = i as f64 / n;
+            let b = code(lo);
+            // The last value of the bucket: positive floats are ordered as
+            // their bits, so one bit less is the next smaller value.
+            let last = f64::from_bits(((i + 1) as f64 / n).to_bits() - 1);
+            base.push(b);
+            if code(last) == b {
+                step.push(f64::INFINITY);
+                continue;
+            }
+            // Bisection over the bits for the first value with a higher code.
+            let (mut below, mut at) = (lo.to_bits(), last.to_bits());
+            while at - below > 1 {
+                let mid = below + (at - below) / 2;
+                if code(f64::from_bits(mid)) > b {
+                    at = mid;
+                } else {
+                    below = mid;
+                }
+            }
+            step.push(f64::from_bits(at));
+        }
+        Srgb8Table { base, step }
+    }
+
+    /// The shared table, built on first use (a few thousand evaluations
+    /// of the curve).
+    fn get() -> &'static Srgb8Table {
+        static TABLE: std::sync::OnceLock<Srgb8Table> = std::sync::OnceLock::new();
+        TABLE.get_or_init(Srgb8Table::new)
+    }
+
+    /// `code(x)` by lookup.
+    fn code(&self, x: f64) -> u8 {
+        // NaN and negative values are clipped to black, as `srgb_encode` does.
+        if x.is_nan() || x <= 0.0 {
+            return 0;
+        }
+        if x >= 1.0 {
+            return 255;
+        }
+        // Exact (a power of two times x), and below the bucket count.
+        let i = ((x * TABLE_BUCKETS as f64) as usize).min(TABLE_BUCKETS - 1);
+        self.base[i] + u8::from(x >= self.step[i])
+    }
+}
+
+/// The two 8-bit sRGB colours of pixels that show the back of a polygon,
+/// in diagonal stripes [`BACK_FACE_STRIPE`] pixels wide: a dim,
+/// desaturated blue-grey, never black and unlike any lit wall, so a user
+/// whose eye went through a wall sees where they are. Fixed, whatever the
+/// exposure.
+pub const BACK_FACE_COLORS: [[u8; 3]; 2] = [[60, 66, 84], [46, 51, 66]];
+
+/// Width of the stripes of [`BACK_FACE_COLORS`], in pixels along a row.
+pub const BACK_FACE_STRIPE: u32 = 4;
+
+/// The 8-bit colour of a back face at column `x`, row `y` of a picture:
+/// stripes running from bottom-left to top-right.
+pub fn back_face_color(x: u32, y: u32) -> [u8; 3] {
+    BACK_FACE_COLORS[((x.wrapping_add(y) / BACK_FACE_STRIPE) % 2) as usize]
+}
+
+/// The inverse of [`srgb_encode`]: an encoded value in `[0, 1]` to linear.
+fn srgb_decode(e: f64) -> f64 {
+    if e <= 12.92 * SRGB_LINEAR_LIMIT {
+        e / 12.92
+    } else {
+        ((e + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// The frame as an 8-bit sRGB picture, each linear channel multiplied by
-/// `exposure` (dimensionless), clipped to `[0, 1]` and encoded. Rows are in
-/// the frame's order (top first). Pixels the frame lacks (a frame whose
-/// buffers are shorter than its size) are black.
+/// `exposure` (dimensionless), clipped to `[0, 1]` and encoded: per
+/// channel exactly [`srgb8`]. Rows are in the frame's order (top first).
+/// Pixels the frame lacks (a frame whose buffers are shorter than its
+/// size) are black.
+///
+/// Pixels showing back faces ([`Frame::back`]) are painted
+/// [`back_face_color`]; a pixel partly a back face (antialiased) mixes
+/// that colour in linear light, in proportion, with its exposed radiosity.
 pub fn to_srgb8(frame: &Frame, exposure: f32) -> RgbImage {
     let mut img = RgbImage::new(frame.width, frame.height);
-    for (out, p) in img.pixels_mut().zip(&frame.pixels) {
-        out.0 = [
-            srgb8(p[0], exposure),
-            srgb8(p[1], exposure),
-            srgb8(p[2], exposure),
-        ];
+    let w = frame.width as usize;
+    if w == 0 {
+        return img;
     }
+    let table = Srgb8Table::get();
+    let e = f64::from(exposure);
+    let back_linear = BACK_FACE_COLORS.map(|c| c.map(|k| srgb_decode(f64::from(k) / 255.0)));
+    let bytes: &mut [u8] = &mut img;
+    bytes
+        .par_chunks_mut(3 * w)
+        .zip(frame.pixels.par_chunks(w))
+        .enumerate()
+        .for_each(|(y, (out, pixels))| {
+            let back = frame.back.get(y * w..).unwrap_or_default();
+            for (x, (o, p)) in out.chunks_exact_mut(3).zip(pixels).enumerate() {
+                let f = back.get(x).copied().unwrap_or(0.0);
+                if f <= 0.0 {
+                    for k in 0..3 {
+                        o[k] = table.code(f64::from(p[k]) * e);
+                    }
+                } else if f >= 1.0 {
+                    o.copy_from_slice(&back_face_color(x as u32, y as u32));
+                } else {
+                    let stripe = &back_linear[((x + y) / BACK_FACE_STRIPE as usize) % 2];
+                    for k in 0..3 {
+                        o[k] = table.code(f64::from(p[k]) * e + f64::from(f) * stripe[k]);
+                    }
+                }
+            }
+        });
     img
 }
 
@@ -188,6 +397,126 @@ mod tests {
         assert!((k - 0.3).abs() < EXPOSURE_TOLERANCE, "{k}");
         let img = to_srgb8(&black, auto_exposure(&black));
         assert!(img.pixels().all(|p| p.0 == [0, 0, 0]));
+    }
+
+    #[test]
+    fn bucketed_selection_matches_sorting() {
+        // Spread over many octaves, with repeats, zeros of both signs and
+        // negatives, so ranks fall in crowded and in sparse buckets.
+        let values: Vec<f64> = (0..5000u64)
+            .map(|k| {
+                let x = (k.wrapping_mul(2_654_435_761) % 10_007) as f64;
+                match k % 5 {
+                    0 => x * 1e-3,
+                    1 => (x / 97.0).exp2(),
+                    2 => 0.0,
+                    3 => -x,
+                    _ => 1.5,
+                }
+            })
+            .chain([-0.0])
+            .collect();
+        let mut sorted = values.clone();
+        sorted.sort_by(f64::total_cmp);
+        for rank in (0..values.len()).step_by(37).chain([values.len() - 1]) {
+            let got = nth_smallest(
+                || values.par_iter().copied(),
+                |n| {
+                    assert_eq!(n, values.len());
+                    rank
+                },
+            );
+            assert_eq!(
+                got.map(f64::to_bits),
+                Some(sorted[rank].to_bits()),
+                "rank {rank}"
+            );
+        }
+        assert_eq!(nth_smallest(|| values.par_iter().copied(), |n| n), None);
+        assert_eq!(nth_smallest(|| [].par_iter().copied(), |_| 0), None);
+    }
+
+    #[test]
+    fn the_lookup_table_gives_the_curve_bits() {
+        let table = Srgb8Table::get();
+        // At most one step per bucket, and each step exactly where the
+        // curve's code changes.
+        for (i, (&b, &at)) in table.base.iter().zip(&table.step).enumerate() {
+            let last = f64::from_bits(((i + 1) as f64 / TABLE_BUCKETS as f64).to_bits() - 1);
+            assert!(u16::from(code(last)) <= u16::from(b) + 1, "bucket {i}");
+            if at.is_finite() {
+                assert_eq!(code(at), b + 1, "bucket {i}");
+                assert_eq!(code(f64::from_bits(at.to_bits() - 1)), b, "bucket {i}");
+            }
+        }
+        // Every 997th float from 0 to past 1, and the values around each
+        // step, under a few exposures.
+        let mut values: Vec<f32> = (0..=1.5f32.to_bits())
+            .step_by(997)
+            .map(f32::from_bits)
+            .collect();
+        for &at in table.step.iter().filter(|a| a.is_finite()) {
+            let v = at as f32;
+            values.extend([v, v.next_down(), v.next_up()]);
+        }
+        values.extend([
+            -1.0,
+            -0.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+        ]);
+        for exposure in [1.0, 0.37, 3.3, 1e-3] {
+            for &v in &values {
+                assert_eq!(
+                    table.code(f64::from(v) * f64::from(exposure)),
+                    srgb8(v, exposure),
+                    "{v} at {exposure}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn back_faces_are_dim_blue_grey_stripes_not_black() {
+        // A row of back-face pixels, a lit pixel, and a half back-face
+        // pixel (an antialiased edge between a back face and black).
+        let mut f = Frame::new(12, 2);
+        f.covered.fill(true);
+        f.back.fill(1.0);
+        f.back[8] = 0.0;
+        f.pixels[8] = [0.5; 3];
+        f.back[9] = 0.5;
+        let img = to_srgb8(&f, 1.0);
+        for (x, y) in [(0, 0), (3, 0), (4, 0), (7, 0), (3, 1), (11, 1)] {
+            let p = img.get_pixel(x, y).0;
+            assert_eq!(p, back_face_color(x, y), "({x}, {y})");
+            assert_ne!(p, [0, 0, 0]);
+            // Dim and bluish: blue the largest channel, all below a third.
+            assert!(p[2] > p[0] && p[2] > p[1] && p[2] < 100, "{p:?}");
+        }
+        assert_ne!(back_face_color(0, 0), back_face_color(4, 0));
+        assert_eq!(back_face_color(0, 0), back_face_color(8, 0));
+        assert_eq!(back_face_color(1, 0), back_face_color(0, 1));
+        // The exposure does not change them.
+        assert_eq!(to_srgb8(&f, 50.0).get_pixel(0, 0).0, back_face_color(0, 0));
+        assert_eq!(img.get_pixel(8, 0).0, [188; 3]);
+        // Half covered: between black and the full colour.
+        let half = img.get_pixel(9, 0).0;
+        let full = back_face_color(9, 0);
+        assert!((0..3).all(|k| half[k] > 0 && half[k] < full[k]), "{half:?}");
+    }
+
+    #[test]
+    fn auto_exposure_ignores_back_faces() {
+        // Half the covered pixels are back faces (0 in the frame): the
+        // exposure is that of the lit half alone.
+        let mut f = frame(&[2.0, 2.0, 0.0, 0.0], &[true; 4]);
+        f.back[2] = 1.0;
+        f.back[3] = 1.0;
+        let k = auto_exposure(&f);
+        assert!((k - 0.45).abs() < EXPOSURE_TOLERANCE * 0.45, "{k}");
     }
 
     #[test]
