@@ -49,6 +49,7 @@ mod common;
 #[path = "support/gltf.rs"]
 mod gltf_doc;
 
+use common::Rng;
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::render::View;
 use radiosity::scene::{self, gltf, obj, Diagnostic, Scene, MAX_COORDINATE};
@@ -195,31 +196,8 @@ fn targets() -> Vec<Target> {
 
 // ------------------------------------------------------------------ rng --
 
-/// SplitMix64: tiny, fast, and the same sequence on every machine.
-struct Rng(u64);
-
+/// The fuzzer's own draws on top of the shared SplitMix64 generator.
 impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `0..n` (`n > 0`).
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-
-    fn chance(&mut self, percent: u64) -> bool {
-        self.next() % 100 < percent
-    }
-
-    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
-        &items[self.below(items.len())]
-    }
-
     /// Mostly a number in `lo..hi`, sometimes anything ([`Rng::number`]).
     fn sane(&mut self, lo: f64, hi: f64) -> String {
         if self.chance(85) {

@@ -16,6 +16,9 @@
 //! `RADIOSITY_FUZZ_CASES` overrides the number of cases and
 //! `RADIOSITY_FUZZ_SEED` the seed.
 
+mod common;
+
+use common::Rng;
 use radiosity::scene::Photometry;
 use std::panic::{self, AssertUnwindSafe};
 
@@ -26,21 +29,6 @@ const CASES: u64 = 200_000;
 const DEFAULT_SEED: u64 = 0x1e5_f022;
 
 const FILE: &str = "fuzz.ies";
-
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 fn seeds() -> Vec<String> {
     vec![
