@@ -441,6 +441,34 @@ impl Visibility {
         })
     }
 
+    /// The nearest polygon that the ray from `origin` along `direction`
+    /// (any non-zero length) crosses, beyond [`SEGMENT_END_EPSILON`] scene
+    /// units, and the distance to it in scene units; `None` when the ray
+    /// leaves the scene or `direction` is zero or not finite.
+    pub fn first_hit(&self, origin: Vec3, direction: Vec3) -> Option<(PolygonId, f32)> {
+        let bvh = self.bvh.as_ref()?;
+        let d = direction.normalize_or_zero();
+        if d == Vec3::ZERO || !origin.is_finite() {
+            return None;
+        }
+        let ray = Ray::new(
+            origin.into(),
+            without_negative_zeros(d).into(),
+            SEGMENT_END_EPSILON,
+            f32::INFINITY,
+        );
+        let mut hit = obvhs::ray::RayHit::none();
+        bvh.ray_traverse(ray, &mut hit, |ray, id| {
+            self.blockers[bvh.primitive_indices[id] as usize].intersect(ray)
+        })
+        .then(|| {
+            (
+                PolygonId(bvh.primitive_indices[hit.primitive_id as usize]),
+                hit.t,
+            )
+        })
+    }
+
     /// The same answer as [`Visibility::occluded`] by testing every
     /// polygon: the reference the BVH is checked against.
     pub fn occluded_brute_force(&self, a: Vec3, b: Vec3, ends: (PolygonId, PolygonId)) -> bool {
@@ -453,10 +481,20 @@ impl Visibility {
     }
 }
 
+/// `v` with every `-0.0` component made `+0.0`. The wide BVH's box test
+/// takes the sign of a direction component to pick the near slab, and a
+/// negative zero (its reciprocal is `-inf`, met by `+inf` from the other
+/// slab) makes it miss every box: a ray along `-x` written `(-1, -0, -0)`
+/// would cross the whole scene unseen.
+fn without_negative_zeros(v: Vec3) -> Vec3 {
+    // IEEE 754: -0.0 + 0.0 == +0.0, and x + 0.0 == x for every other x.
+    v + Vec3::ZERO
+}
+
 /// The segment as a ray with `t = 0` at `a` and `t = 1` at `b`; `None` for
 /// a zero-length segment.
 fn segment_ray(a: Vec3, b: Vec3) -> Option<Ray> {
-    let d = b - a;
+    let d = without_negative_zeros(b - a);
     (d != Vec3::ZERO).then(|| {
         Ray::new(
             a.into(),
@@ -518,6 +556,30 @@ mod tests {
             Vec3::new(0.5, 0.5, 1.0),
             (PolygonId(1), PolygonId(1))
         ));
+    }
+
+    /// A direction with negative-zero components (a segment from `+0.0`
+    /// to `-0.0`, a mirrored exporter's coordinates) still meets what is
+    /// in its way, in both ray queries.
+    #[test]
+    fn negative_zero_directions_find_their_blockers() {
+        let s = scene(vec![
+            square(-1.0, 2.0, (-1.0, -1.0)),
+            square(1.0, 2.0, (-1.0, -1.0)),
+            square(3.0, 2.0, (5.0, 5.0)),
+        ]);
+        let v = Visibility::new(&s);
+        let none = (PolygonId(99), PolygonId(99));
+        let (a, b) = (Vec3::ZERO, Vec3::new(-0.0, -0.0, -2.0));
+        assert!((b - a).x.is_sign_negative());
+        assert!(v.occluded(a, b, none));
+        let down = v.first_hit(Vec3::ZERO, Vec3::new(-0.0, -0.0, -1.0));
+        assert_eq!(down.map(|(p, _)| p), Some(PolygonId(0)));
+        assert!((down.unwrap().1 - 1.0).abs() < 1e-5);
+        let up = v.first_hit(Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0));
+        assert_eq!(up.map(|(p, _)| p), Some(PolygonId(1)));
+        assert_eq!(v.first_hit(Vec3::ZERO, Vec3::X), None);
+        assert_eq!(v.first_hit(Vec3::ZERO, Vec3::ZERO), None);
     }
 
     #[test]
