@@ -91,6 +91,57 @@ fn illuminance_points_and_a_work_plane_are_written_in_lux_with_units() {
     assert!(dir.path().join("plan.csv").exists() && dir.path().join("plan.png").exists());
 }
 
+/// A work plane through a crate on the floor: the points inside it are
+/// counted, read 0, and leave the figures alone.
+#[test]
+fn work_plane_points_inside_a_solid_are_left_out_of_the_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    // A crate over the four grid points nearest the corner (0, 0).
+    let room = write(
+        dir.path(),
+        "room.sc",
+        &format!("{ROOM}box wall 0.1 0 0.1  0.9 0.9 0.9\n"),
+    );
+    let out = run_in(
+        dir.path(),
+        &[
+            room.to_str().unwrap(),
+            "-q",
+            "--lenmax",
+            LENMAX,
+            "--units",
+            "m",
+            "--workplane",
+            "0.5,0.5",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("(4 of 16 points inside solid objects left out"),
+        "{stdout}"
+    );
+    let emin: f64 = stdout
+        .split("Emin ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no Emin in {stdout}"));
+    assert!(emin > 1.0, "{stdout}");
+    let plane = std::fs::read_to_string(dir.path().join("room-workplane.csv")).unwrap();
+    let zeros: Vec<&str> = plane
+        .lines()
+        .skip(1)
+        .filter(|l| l.rsplit(',').next().unwrap().parse::<f64>().unwrap() == 0.0)
+        .collect();
+    assert_eq!(zeros.len(), 4, "{plane}");
+    // Cell centres 0.25 and 0.75 on both floor axes.
+    for l in &zeros {
+        let xz: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        assert!(xz[0] < 0.9 && xz[2] < 0.9, "{l}");
+    }
+}
+
 #[test]
 fn bad_points_files_are_refused_with_their_position_before_solving() {
     let dir = tempfile::tempdir().unwrap();

@@ -89,7 +89,8 @@ pub fn write(
         let grid = out::workplane_grid(&prepared.scene, w.height, w.spacing, units)
             .map_err(|e| RunError::Options(e.to_string()))?;
         let t = Instant::now();
-        let values = gather().irradiance_at(&grid.points);
+        let plane = gather();
+        let values = plane.irradiance_at(&grid.points);
         say(format!(
             "work plane of {} × {} points {} apart: {:.2} s",
             grid.nx,
@@ -101,10 +102,36 @@ pub fn write(
             .falsecolor
             .as_ref()
             .map_or((falsecolor::Scale::Log, None), |f| (f.scale, f.max));
-        let u = out::write_workplane(&w.csv, &w.png, &grid, &values, scale, max, photometric)
-            .map_err(RunError::Write)?;
+        let inside: Vec<bool> = grid
+            .points
+            .iter()
+            .map(|&(x, n)| plane.inside_solid(x, n))
+            .collect();
+        let hidden = inside.iter().filter(|&&i| i).count();
+        let u = out::write_workplane(
+            &w.csv,
+            &w.png,
+            &grid,
+            &values,
+            &inside,
+            scale,
+            max,
+            photometric,
+        )
+        .map_err(RunError::Write)?;
+        // Printed whatever -q says, with the points left out, so the
+        // figures are never read without knowing what they cover.
+        let left_out = if hidden > 0 {
+            format!(
+                " ({hidden} of {} points inside solid objects left out; they read 0 in the CSV \
+                 and are grey in the plan)",
+                grid.points.len()
+            )
+        } else {
+            String::new()
+        };
         println!(
-            "work plane at {}: {}",
+            "work plane at {}: {}{left_out}",
             w.height,
             u.line(photometric.illuminance_unit())
         );

@@ -225,26 +225,39 @@ impl Uniformity {
 }
 
 /// Writes a work plane: `PREFIX.csv` (as [`write_illuminance`]) and
-/// `PREFIX.png`, its plan in false colour with isolux lines and a legend;
-/// returns its [`Uniformity`].
+/// `PREFIX.png`, its plan in false colour with isolux lines and a legend
+/// (points inside a solid drawn grey);
+/// returns its [`Uniformity`] over the points not `inside` a solid object
+/// (one flag per grid point; a point inside a cabinet gets no light and
+/// is no part of the area being lit). When every point is inside, the
+/// figures are those of all the points.
+#[allow(clippy::too_many_arguments)]
 pub fn write_workplane(
     csv: &Path,
     png: &Path,
     grid: &WorkplaneGrid,
     values: &[Rgb],
+    inside: &[bool],
     scale: Scale,
     max: Option<f64>,
     photometric: Photometric,
 ) -> Result<Uniformity, OutputError> {
     write_illuminance(csv, &grid.points, values)?;
     let e: Vec<f64> = values.iter().map(|v| v.luminance()).collect();
-    let mapping = Mapping::new(&e, max, scale);
     let steps = grid.nx.max(grid.ny).max(2) as u32 - 1;
     let pixels = (PLAN_PIXELS / steps)
         .max(PLAN_MIN_PIXELS.div_ceil(steps))
         .max(1);
+    let known: Vec<Option<f64>> = e
+        .iter()
+        .zip(inside.iter().chain(std::iter::repeat(&false)))
+        .map(|(&v, &inside)| (!inside).then_some(v))
+        .collect();
+    let open: Vec<f64> = known.iter().flatten().copied().collect();
+    let lit = if open.is_empty() { &e } else { &open };
+    let mapping = Mapping::new(lit, max, scale);
     let img = falsecolor::plan(
-        &e,
+        &known,
         grid.nx,
         grid.ny,
         pixels,
@@ -253,7 +266,7 @@ pub fn write_workplane(
         photometric.illuminance_unit(),
     );
     write_rgb8(png, &img)?;
-    Ok(Uniformity::of(&e))
+    Ok(Uniformity::of(lit))
 }
 
 #[cfg(test)]

@@ -241,13 +241,23 @@ pub fn draw_legend(img: &mut RgbImage, mapping: Mapping, title: &str, unit: &str
     let _ = root.present();
 }
 
+/// Colour of a plan's points that lie inside a solid object (no value):
+/// a neutral grey, outside every band of the palette.
+pub const PLAN_INSIDE_COLOR: [u8; 3] = [96, 96, 96];
+
+/// Colour of a plan's isolux lines.
+pub const PLAN_LINE_COLOR: [u8; 3] = [20, 20, 20];
+
 /// A plan of a work plane in false colour: `values` on a grid of `nx × ny`
 /// points (row `j` at index `j * nx`, `j = 0` the row nearest the plan's
 /// bottom edge), drawn `scale` pixels a grid step, interpolated
 /// bilinearly, with the isolux lines of the legend's band edges drawn dark
-/// and the legend on the left.
+/// and the legend on the left. A `None` value is a point inside a solid
+/// object: the area nearest it is drawn [`PLAN_INSIDE_COLOR`], and its
+/// neighbours interpolate among the points that have values, so a cabinet
+/// on the plane is a grey block, not a pool of darkness bleeding around it.
 pub fn plan(
-    values: &[f64],
+    values: &[Option<f64>],
     nx: usize,
     ny: usize,
     pixels_per_step: u32,
@@ -258,22 +268,39 @@ pub fn plan(
     let w = ((nx.max(2) - 1) as u32 * pixels_per_step).max(1);
     let h = ((ny.max(2) - 1) as u32 * pixels_per_step).max(1);
     let at = |i: usize, j: usize| values[j.min(ny - 1) * nx + i.min(nx - 1)];
-    let sample = |px: f64, py: f64| {
+    let sample = |px: f64, py: f64| -> Option<f64> {
         // Pixel centres to grid coordinates, row 0 of the picture on top.
         let gx = (px / pixels_per_step as f64).min((nx - 1) as f64);
         let gy = ((h as f64 - py) / pixels_per_step as f64).clamp(0.0, (ny - 1) as f64);
         let (i, j) = (gx.floor() as usize, gy.floor() as usize);
         let (fx, fy) = (gx - i as f64, gy - j as f64);
-        let lo = at(i, j) * (1.0 - fx) + at(i + 1, j) * fx;
-        let hi = at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx;
-        lo * (1.0 - fy) + hi * fy
+        at(gx.round() as usize, gy.round() as usize)?;
+        let corners = [
+            (at(i, j), (1.0 - fx) * (1.0 - fy)),
+            (at(i + 1, j), fx * (1.0 - fy)),
+            (at(i, j + 1), (1.0 - fx) * fy),
+            (at(i + 1, j + 1), fx * fy),
+        ];
+        let (sum, weight) = corners
+            .iter()
+            .filter_map(|&(v, wt)| v.map(|v| (v * wt, wt)))
+            .fold((0.0, 0.0), |(s, t), (v, wt)| (s + v, t + wt));
+        // The nearest corner has a value, so some weight is positive
+        // unless the pixel sits exactly on it with weight 0 elsewhere.
+        Some(if weight > 0.0 {
+            sum / weight
+        } else {
+            at(gx.round() as usize, gy.round() as usize).unwrap_or(0.0)
+        })
     };
-    let band = |v: f64| {
-        (mapping.position(v) * LEGEND_STEPS as f64)
-            .floor()
-            .min(LEGEND_STEPS as f64 - 1.0) as i32
+    let band = |v: Option<f64>| {
+        v.map(|v| {
+            (mapping.position(v) * LEGEND_STEPS as f64)
+                .floor()
+                .min(LEGEND_STEPS as f64 - 1.0) as i32
+        })
     };
-    let mut field = vec![0.0; (w * h) as usize];
+    let mut field = vec![None; (w * h) as usize];
     for y in 0..h {
         for x in 0..w {
             field[(y * w + x) as usize] = sample(x as f64 + 0.5, y as f64 + 0.5);
@@ -285,13 +312,18 @@ pub fn plan(
         for x in 0..w {
             let v = field[(y * w + x) as usize];
             let b = band(v);
-            // An isolux line where the band changes to the right or below.
-            let edge = (x + 1 < w && band(field[(y * w + x + 1) as usize]) != b)
-                || (y + 1 < h && band(field[((y + 1) * w + x) as usize]) != b);
-            let c = if edge {
-                [20, 20, 20]
-            } else {
-                mapping.colour(v)
+            // An isolux line where the band changes to the right or below,
+            // between two points that both have values.
+            let changes = |other: Option<f64>| {
+                let o = band(other);
+                b.is_some() && o.is_some() && o != b
+            };
+            let edge = (x + 1 < w && changes(field[(y * w + x + 1) as usize]))
+                || (y + 1 < h && changes(field[((y + 1) * w + x) as usize]));
+            let c = match v {
+                _ if edge => PLAN_LINE_COLOR,
+                Some(v) => mapping.colour(v),
+                None => PLAN_INSIDE_COLOR,
             };
             img.put_pixel(LEGEND_WIDTH + x, y, image::Rgb(c));
         }
@@ -344,10 +376,36 @@ mod tests {
             .flat_map(|_| (0..nx).map(|i| i as f64 * 10.0))
             .collect();
         let m = Mapping::new(&values, Some(100.0), Scale::Linear);
-        let img = plan(&values, nx, ny, 10, m, "E", "lx");
-        let dark = |x: u32| img.get_pixel(LEGEND_WIDTH + x, 5).0 == [20, 20, 20];
+        let known: Vec<Option<f64>> = values.iter().copied().map(Some).collect();
+        let img = plan(&known, nx, ny, 10, m, "E", "lx");
+        let dark = |x: u32| img.get_pixel(LEGEND_WIDTH + x, 5).0 == PLAN_LINE_COLOR;
         let lines = (0..100).filter(|&x| dark(x)).count();
         // Band edges at 12.5, 25, ..., 87.5: seven lines.
         assert_eq!(lines, LEGEND_STEPS - 1);
+    }
+
+    #[test]
+    fn points_inside_solids_are_grey_and_do_not_darken_their_neighbours() {
+        // A uniform 500 with the middle point of a 5 × 5 grid inside.
+        let (nx, ny) = (5, 5);
+        let mut values = vec![Some(500.0); nx * ny];
+        values[2 * nx + 2] = None;
+        let m = Mapping::new(&[500.0], Some(1000.0), Scale::Linear);
+        let img = plan(&values, nx, ny, 10, m, "E", "lx");
+        let px = |x: u32, y: u32| img.get_pixel(LEGEND_WIDTH + x, y).0;
+        // The grid point (2, 2) is at pixel (20, 20).
+        assert_eq!(px(20, 20), PLAN_INSIDE_COLOR);
+        // Everything else is 500's colour: no darker ring, no isolux line.
+        let mut other = 0;
+        for y in 0..40 {
+            for x in 0..40 {
+                let c = px(x, y);
+                if c != PLAN_INSIDE_COLOR {
+                    assert_eq!(c, m.colour(500.0), "pixel ({x}, {y})");
+                    other += 1;
+                }
+            }
+        }
+        assert!(other > 1400, "{other}");
     }
 }
