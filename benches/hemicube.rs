@@ -43,7 +43,9 @@ fn bench_hemicube(c: &mut Criterion) {
         let mut out = Vec::new();
         group.bench_function(format!("rtable lamp, N = {n}"), |b| {
             b.iter(|| {
-                cube.form_factors(&deltas, &mesh, &corners, &roles, eye, f, 1e-6, &mut out);
+                cube.form_factors(
+                    &deltas, &mesh, &corners, &roles, eye, f, 1e-6, None, &mut out,
+                );
                 out.len()
             })
         });

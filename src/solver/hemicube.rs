@@ -34,6 +34,7 @@
 //! its cell's area and unshot radiosity, and spreads what the elements
 //! receive to their vertices ([`spread_to_vertices`]).
 
+use super::distribution::Directional;
 use crate::mesh::Mesh;
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
@@ -301,6 +302,12 @@ impl Hemicube {
     /// into `out` (cleared first), sorted by element, each `F > 0`; their
     /// sum is at most 1. `near` is the near clipping distance in scene
     /// units (see [`NEAR_FRACTION`]).
+    ///
+    /// `weight`, when given, multiplies each pixel's delta form factor by
+    /// its value at the pixel centre's direction (in the hemicube's
+    /// frame: `u`, `v`, `n` components, any length): a luminaire's shot
+    /// ([`luminaire_weight`]) then counts each direction by its candela
+    /// table instead of Lambert's cosine.
     #[allow(clippy::too_many_arguments)]
     pub fn form_factors(
         &mut self,
@@ -311,6 +318,7 @@ impl Hemicube {
         eye: Vec3,
         frame: Frame,
         near: f32,
+        weight: Option<&dyn Fn(DVec3) -> f64>,
         out: &mut Vec<(u32, f64)>,
     ) {
         let n = deltas.res as usize;
@@ -391,9 +399,32 @@ impl Hemicube {
                 }
             }
             let table = if side { &deltas.side } else { &deltas.top };
-            for (&id, &df) in self.ids[..pixels].iter().zip(table) {
+            for (pixel, (&id, &df)) in self.ids[..pixels].iter().zip(table).enumerate() {
                 if id == EMPTY || roles[mesh.element_polygon[id as usize].index()] != Role::Receiver
                 {
+                    continue;
+                }
+                let df = match weight {
+                    Some(weight) => {
+                        // The pixel centre on its face (`w = 1`), back to
+                        // the frame's axes (each axis's sign is its own
+                        // inverse).
+                        let (c, r) = (pixel % n, pixel / n);
+                        let a = -1.0 + 2.0 * (c as f64 + 0.5) / n as f64;
+                        let b = if side {
+                            2.0 * (r as f64 + 0.5) / n as f64
+                        } else {
+                            -1.0 + 2.0 * (r as f64 + 0.5) / n as f64
+                        };
+                        let mut local = DVec3::ZERO;
+                        for (&(axis, sign), value) in axes.iter().zip([a, b, 1.0]) {
+                            local[axis] = value * sign as f64;
+                        }
+                        df * weight(local)
+                    }
+                    None => df,
+                };
+                if df <= 0.0 {
                     continue;
                 }
                 let s = &mut self.sum[id as usize];
@@ -606,6 +637,26 @@ pub fn spread_to_vertices(
     }
 }
 
+/// The weight that turns a hemicube's Lambertian delta form factors into
+/// a luminaire's share of flux per pixel: a pixel of delta `ΔF ≈ cosθ dω
+/// / π` in the direction `d` (in `frame`'s axes) receives `I(d) dω / Φ`
+/// of the luminaire's flux, so its weight is `π (I(d) / Φ) / cosθ`
+/// ([`Directional::relative_intensity`]). With a cosine distribution
+/// (`I / Φ = cosθ / π`) the weight is 1; the weighted deltas of a whole
+/// hemicube sum to the table's flux below the plane over `Φ`, 1 to the
+/// accuracy of one sample per pixel.
+pub fn luminaire_weight(directional: &Directional, frame: Frame) -> impl Fn(DVec3) -> f64 + '_ {
+    let (u, v, n) = (frame.u.as_dvec3(), frame.v.as_dvec3(), frame.n.as_dvec3());
+    move |local: DVec3| {
+        let len = local.length();
+        if local.z <= 0.0 || len <= 0.0 {
+            return 0.0;
+        }
+        let world = u * local.x + v * local.y + n * local.z;
+        PI * directional.relative_intensity(world) * len / local.z
+    }
+}
+
 /// What a hemicube step needs beyond the solver's own state: the delta
 /// form factors, every polygon's corners, and scratch. Built once per
 /// solve ([`super::Progressive::new`] with [`super::FormFactorMethod::Hemicube`]).
@@ -650,12 +701,15 @@ impl Shooting {
     /// are rendered in parallel and summed in sample order, so the bits
     /// do not depend on the thread count. Returns the sample–element
     /// pairs with a non-zero form factor, or `None` (with only scratch
-    /// written) once `cancel` is set.
+    /// written) once `cancel` is set. A shooter with a light distribution
+    /// (`directional`, an `--ies` luminaire) weights each pixel by it
+    /// ([`luminaire_weight`]).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn gather(
         &mut self,
         mesh: &Mesh,
         shooter: usize,
+        directional: Option<&Directional>,
         samples: &[super::formfactor::ShooterSample],
         shot: &[crate::color::Rgb],
         power: crate::color::Rgb,
@@ -695,14 +749,17 @@ impl Shooting {
                     }));
                     let seed = ((shooter as u64) << 32) ^ k as u64;
                     let near = NEAR_FRACTION * (sample.area as f32).sqrt();
+                    let frame = frame(normal, seed);
+                    let weight = directional.map(|d| luminaire_weight(d, frame));
                     cube.form_factors(
                         deltas,
                         mesh,
                         corners,
                         roles,
                         eye,
-                        frame(normal, seed),
+                        frame,
                         near,
+                        weight.as_ref().map(|w| w as &dyn Fn(DVec3) -> f64),
                         &mut out,
                     );
                     out

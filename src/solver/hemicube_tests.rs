@@ -110,6 +110,7 @@ fn point_form_factor(
         eye,
         frame(s.polygons[0].normal, seed),
         1e-6,
+        None,
         &mut out,
     );
     let mut per_polygon = vec![0.0; s.polygons.len()];

@@ -1028,6 +1028,7 @@ impl<'a> Progressive<'a> {
         let pairs = hemicube.gather(
             &self.mesh,
             i,
+            self.directional[i].as_ref(),
             &self.samples[i],
             &self.shot,
             power,
