@@ -365,7 +365,11 @@ fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
         .unwrap_or_else(|| panic!("{name}: the solve reaches its step limit"));
         xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus");
         xdotool(&display, &["mousemove", "--window", &window, "80", "60"]).expect("move");
+        // Each event given time to arrive on its own: a press that lands
+        // together with the first motion may start the drag a step late.
+        std::thread::sleep(Duration::from_millis(100));
         xdotool(&display, &["mousedown", "1"]).expect("press");
+        std::thread::sleep(Duration::from_millis(100));
         for (dx, dy) in [(30, -16); 5].into_iter().chain([(-40, 20); 6]) {
             xdotool(
                 &display,
@@ -386,10 +390,15 @@ fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
                 p.0.iter().any(|&c| c > 30) && p.0 != radiosity::render::back_face_color(x, y)
             })
             .count();
-        assert!(
-            lit > 160 * 120 / 3,
-            "{name}: after looking around the picture is mostly black ({lit} lit pixels)"
-        );
+        if lit <= 160 * 120 / 3 {
+            let keep = std::env::temp_dir().join(format!("viewer-{name}-looked-around.png"));
+            let _ = picture.save(&keep);
+            panic!(
+                "{name}: after looking around the picture is mostly black ({lit} lit pixels; \
+                 kept as {})",
+                keep.display()
+            );
+        }
         xdotool(&display, &["key", "p"]).expect("key p");
         let screen = read_written(&dir.path().join(format!("{name}-002.tiff")));
         xdotool(&display, &["key", "i"]).expect("key i");
