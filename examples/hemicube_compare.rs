@@ -10,8 +10,10 @@
 //! Solves the scene with Wallace's estimate on a mesh of half the default
 //! `lenmax` (the reference: the finest that solves in well under a minute
 //! on two cores), then on the default mesh with each estimate: Wallace,
-//! hemicubes of 256, 128 (the default), 64 and 32 pixels, and the centre
-//! estimate, all to the default threshold. Prints per solve the steps,
+//! hemicubes of 256, 128 (the default), 64 and 32 pixels, 128 pixels
+//! with every step shooting from all its cells (`--no-clustering`: weak
+//! steps' cells not merged) and with 256 cells (`--shooter-samples 256`),
+//! and the centre estimate, all to the default threshold. Prints per solve the steps,
 //! solve seconds, seconds per step, and the picture's relative L1 error
 //! against the reference (mean absolute luminance difference over mean
 //! luminance, over the pixels the camera shows, lamps excluded), at
@@ -26,7 +28,7 @@ use radiosity::prepare;
 use radiosity::render::Frame;
 use radiosity::session::{Session, SessionOptions};
 use radiosity::solver::hemicube::HemicubeRes;
-use radiosity::solver::FormFactorMethod;
+use radiosity::solver::{FormFactorMethod, ShooterSamples};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -83,6 +85,14 @@ fn main() {
         c.solver.hemicube_res = HemicubeRes::new(res).expect("a valid resolution");
         c
     };
+    // The two hemicube variants beside the resolutions: every step from
+    // all its cells (no merging of weak steps' cells), and 256 cells.
+    let variant = |clustering: bool, cells: u32| {
+        let mut c = with(FormFactorMethod::Hemicube, 128, lenmax);
+        c.solver.clustering = clustering;
+        c.solver.shooter_samples = ShooterSamples::AtMost(cells);
+        c
+    };
     let (reference, lamps, steps, seconds) =
         solve(&with(FormFactorMethod::Wallace, 128, lenmax / 2.0));
     println!("# {}: default lenmax {lenmax}", scene.display());
@@ -92,17 +102,25 @@ fn main() {
         seconds / steps.max(1) as f64
     );
     let runs = [
-        ("Wallace", FormFactorMethod::Wallace, 128),
-        ("hemicube 256", FormFactorMethod::Hemicube, 256),
-        ("hemicube 128", FormFactorMethod::Hemicube, 128),
-        ("hemicube 64", FormFactorMethod::Hemicube, 64),
-        ("hemicube 32", FormFactorMethod::Hemicube, 32),
-        ("centre", FormFactorMethod::Center, 128),
+        ("Wallace", with(FormFactorMethod::Wallace, 128, lenmax)),
+        (
+            "hemicube 256",
+            with(FormFactorMethod::Hemicube, 256, lenmax),
+        ),
+        (
+            "hemicube 128",
+            with(FormFactorMethod::Hemicube, 128, lenmax),
+        ),
+        ("hemicube 128, every cell every step", variant(false, 64)),
+        ("hemicube 128, 256 cells", variant(true, 256)),
+        ("hemicube 64", with(FormFactorMethod::Hemicube, 64, lenmax)),
+        ("hemicube 32", with(FormFactorMethod::Hemicube, 32, lenmax)),
+        ("centre", with(FormFactorMethod::Center, 128, lenmax)),
     ];
     let exposure = radiosity::render::tonemap::auto_exposure(&reference);
     let mut composite = RgbImage::new(SIZE.0 * 2, SIZE.1 * 2);
-    for (name, method, res) in runs {
-        let (frame, _, steps, seconds) = solve(&with(method, res, lenmax));
+    for (name, config) in runs {
+        let (frame, _, steps, seconds) = solve(&config);
         let (mut diff, mut total) = (0.0, 0.0);
         for k in 0..frame.pixels.len() {
             if !reference.covered[k] || lamps.pixels[k][0] > 0.0 {

@@ -31,8 +31,10 @@
 //!
 //! The solver ([`super::Progressive`]) places one hemicube at each of the
 //! shooter's grid samples (its `--shooter-samples` cells), each carrying
-//! its cell's area and unshot radiosity, and spreads what the elements
-//! receive to their vertices ([`spread_to_vertices`]).
+//! its cell's area and unshot radiosity (a weak step merges its cells
+//! into fewer runs, one hemicube each: `Progressive::hemicube_points`),
+//! and spreads what the elements receive to their vertices
+//! ([`spread_to_vertices`]).
 
 use super::distribution::Directional;
 use crate::mesh::Mesh;
@@ -45,8 +47,9 @@ use std::f64::consts::PI;
 /// pixels and 0.016 % at 128; the pictures of `rtable` and `cornell` are
 /// 3.0 % from the reference at 64, 2.4 to 2.8 % at 128 and 2.3 to 2.8 %
 /// at 256, while a solve at 128 takes 1.2 to 1.4 times as long as at 64
-/// and one at 256 about twice as long again on `rtable`. 128 buys most
-/// of what more pixels give.
+/// and one at 256 1.6 to 1.7 times as long again. 128 buys most of what
+/// more pixels give; past it the error is mostly the shooter's
+/// quadrature (more cells, `--shooter-samples`, reduce it).
 pub const DEFAULT_HEMICUBE_RES: u32 = 128;
 
 /// Smallest resolution accepted: with fewer pixels a side face has under

@@ -591,3 +591,63 @@ fn occluder_casts_a_shadow() {
     assert_eq!(b[vertex_at(0.0, 0.5)], Rgb::BLACK);
     assert!(b[vertex_at(2.5, 0.5)].r > 0.0);
 }
+
+/// A weak step merges its shooter's cells into fewer hemicubes
+/// ([`Progressive::hemicube_points`]): at most the number asked, on the
+/// shooter, together standing for its whole area and carrying exactly
+/// the power its cells carry, per channel. A strong step, or one under
+/// `--no-clustering`, keeps one hemicube per cell.
+#[test]
+fn weak_steps_merge_cells_into_fewer_hemicubes_with_the_same_power() {
+    let s = glowing_box();
+    let m = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.1,
+            inset: mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(&s);
+    let mut solver = Progressive::new(&s, &m, &vis, hemicube_options());
+    // After the ceiling's shot every wall holds unshot light.
+    solver.step().unwrap();
+    let shooter = solver.next_shooter().unwrap();
+    let i = shooter.index();
+    solver.read_shooter(shooter);
+    let cells = solver.samples[i].len();
+    assert_eq!(cells, crate::solver::DEFAULT_SHOOTER_SAMPLES as usize);
+    assert!(solver.hemicube_points(shooter, cells).is_none());
+    let polygon = &s.polygons[i];
+    let (lo, hi) = polygon.vertices.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &v| (lo.min(v), hi.max(v)),
+    );
+    let carried = |samples: &[crate::solver::formfactor::ShooterSample], shot: &[Rgb]| {
+        samples
+            .iter()
+            .zip(shot)
+            .fold(Rgb::BLACK, |sum, (sample, &u)| sum + u * sample.area)
+    };
+    let all = carried(&solver.samples[i], &solver.shot);
+    for k in [1, 8, 20] {
+        let (points, shot) = solver.hemicube_points(shooter, k).unwrap();
+        assert!(
+            !points.is_empty() && points.len() <= k,
+            "{k}: {}",
+            points.len()
+        );
+        let area: f64 = points.iter().map(|p| p.area).sum();
+        assert!((area / polygon.area - 1.0).abs() < 1e-9, "{k}: area {area}");
+        let power = carried(&points, &shot);
+        for (got, want) in [(power.r, all.r), (power.g, all.g), (power.b, all.b)] {
+            assert!((got / want - 1.0).abs() < 1e-9, "{k}: {got} vs {want}");
+        }
+        for p in &points {
+            let on_plane = (p.position - polygon.vertices[0]).dot(polygon.normal);
+            assert!(on_plane.abs() < 1e-5, "{k}: {on_plane} off the plane");
+            let inside = p.position.cmpge(lo - 1e-5).all() && p.position.cmple(hi + 1e-5).all();
+            assert!(inside, "{k}: {} outside the shooter", p.position);
+        }
+    }
+}

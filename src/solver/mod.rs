@@ -718,7 +718,12 @@ impl<'a> Progressive<'a> {
         let gathered = if by_hemicube {
             self.read_shooter(shooter);
             self.mark_receivers(shooter.index());
-            self.gather_hemicube(shooter, cancel)?
+            let hemicubes = if self.options.clustering {
+                roots
+            } else {
+                usize::MAX
+            };
+            self.gather_hemicube(shooter, hemicubes, cancel)?
         } else if alone {
             self.read_shooter(shooter);
             self.cull(shooter);
@@ -1020,17 +1025,28 @@ impl<'a> Progressive<'a> {
     }
 
     /// Phase 4 by hemicubes ([`hemicube::Shooting::gather`]): `Δrad` of
-    /// every receiving vertex into `self.delta`.
-    fn gather_hemicube(&mut self, shooter: PolygonId, cancel: &AtomicBool) -> Option<Gathered> {
+    /// every receiving vertex into `self.delta`, from at most `hemicubes`
+    /// hemicubes ([`Progressive::hemicube_points`]).
+    fn gather_hemicube(
+        &mut self,
+        shooter: PolygonId,
+        hemicubes: usize,
+        cancel: &AtomicBool,
+    ) -> Option<Gathered> {
         let i = shooter.index();
         let power = self.unshot.mean(&self.mesh, i) * self.mesh.polygons[i].area;
+        let merged = self.hemicube_points(shooter, hemicubes);
+        let (samples, shot) = match &merged {
+            Some((samples, shot)) => (&samples[..], &shot[..]),
+            None => (&self.samples[i][..], &self.shot[..]),
+        };
         let hemicube = self.hemicube.as_mut()?;
         let pairs = hemicube.gather(
             &self.mesh,
             i,
             self.directional[i].as_ref(),
-            &self.samples[i],
-            &self.shot,
+            samples,
+            shot,
             power,
             &self.receives,
             &self.reflectance,
@@ -1038,6 +1054,76 @@ impl<'a> Progressive<'a> {
             cancel,
         )?;
         Some(Gathered { pairs, rays: 0 })
+    }
+
+    /// Where a hemicube step of `shooter` places its hemicubes when it may
+    /// use at most `hemicubes` ([`Progressive::step_roots`]: fewer the
+    /// weaker the step's light): `None` when the shooter's own samples
+    /// are few enough (one hemicube each, carrying `self.shot`). Else its
+    /// cells are merged into that many runs, the cut of their
+    /// [`Strata`] as a cluster's weak step takes it, each a hemicube at
+    /// the run's power-weighted centroid (on the polygon, which is
+    /// convex) carrying the run's area and its mean unshot radiosity: the
+    /// same power, from fewer points. A run is a coarser quadrature of
+    /// the shooter, which only receivers within a few runs' widths notice,
+    /// and a weak step carries too little light for that to show.
+    fn hemicube_points(
+        &self,
+        shooter: PolygonId,
+        hemicubes: usize,
+    ) -> Option<(Vec<ShooterSample>, Vec<Rgb>)> {
+        let i = shooter.index();
+        let samples = &self.samples[i];
+        if hemicubes >= samples.len() {
+            return None;
+        }
+        let normal = self.mesh.polygons[i].normal;
+        let cells: Vec<Cell> = samples
+            .iter()
+            .zip(&self.shot)
+            .enumerate()
+            .map(|(k, (sample, &unshot))| Cell {
+                polygon: shooter,
+                sample: k as u32,
+                unshot,
+                area: sample.area,
+                normal,
+                power: unshot.mean() * sample.area,
+            })
+            .filter(|c| c.power > 0.0)
+            .collect();
+        let strata = Strata::build(&cells, hemicubes, |c| {
+            let sample = &samples[cells[c].sample as usize];
+            sample
+                .cell
+                .map_or((sample.position, sample.position), |corners| {
+                    corners
+                        .iter()
+                        .fold((sample.position, sample.position), |(lo, hi), &c| {
+                            (lo.min(c), hi.max(c))
+                        })
+                })
+        });
+        let mut points = Vec::with_capacity(strata.roots.len());
+        let mut shot = Vec::with_capacity(strata.roots.len());
+        for &r in &strata.roots {
+            let node = &strata.nodes[r as usize];
+            let run = node.cells.start as usize..node.cells.end as usize;
+            let area: f64 = cells[run].iter().map(|c| c.area).sum();
+            if area <= 0.0 {
+                continue;
+            }
+            points.push(ShooterSample {
+                position: node.centroid,
+                area,
+                cell: None,
+                near_r2: 0.0,
+                exact_r2: 0.0,
+                ..samples[cells[node.representative as usize].sample as usize]
+            });
+            shot.push(node.power / area);
+        }
+        Some((points, shot))
     }
 
     /// Cluster step, phase 2: the cluster's cells (every member's shooter
