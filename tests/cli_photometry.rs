@@ -118,7 +118,7 @@ fn work_plane_points_inside_a_solid_are_left_out_of_the_figures() {
     assert!(out.status.success(), "{}", stderr(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("(4 of 16 points inside solid objects left out"),
+        stdout.contains("(4 of 16 points inside solid objects or outside the walls left out"),
         "{stdout}"
     );
     let emin: f64 = stdout

@@ -102,18 +102,18 @@ pub fn write(
             .falsecolor
             .as_ref()
             .map_or((falsecolor::Scale::Log, None), |f| (f.scale, f.max));
-        let inside: Vec<bool> = grid
+        let behind: Vec<bool> = grid
             .points
             .iter()
-            .map(|&(x, n)| plane.inside_solid(x, n))
+            .map(|&(x, n)| plane.behind_surfaces(x, n))
             .collect();
-        let hidden = inside.iter().filter(|&&i| i).count();
+        let hidden = behind.iter().filter(|&&i| i).count();
         let u = out::write_workplane(
             &w.csv,
             &w.png,
             &grid,
             &values,
-            &inside,
+            &behind,
             scale,
             max,
             photometric,
@@ -123,8 +123,8 @@ pub fn write(
         // figures are never read without knowing what they cover.
         let left_out = if hidden > 0 {
             format!(
-                " ({hidden} of {} points inside solid objects left out; they read 0 in the CSV \
-                 and are grey in the plan)",
+                " ({hidden} of {} points inside solid objects or outside the walls left out; \
+                 they read 0 in the CSV and are grey in the plan)",
                 grid.points.len()
             )
         } else {

@@ -228,9 +228,9 @@ impl Uniformity {
 /// `PREFIX.png`, its plan in false colour with isolux lines and a legend
 /// (points inside a solid drawn grey);
 /// returns its [`Uniformity`] over the points not `inside` a solid object
-/// (one flag per grid point; a point inside a cabinet gets no light and
-/// is no part of the area being lit). When every point is inside, the
-/// figures are those of all the points.
+/// or outside the walls (one flag per grid point: such a point gets no
+/// light and is no part of the area being lit). When every point is
+/// flagged, the figures are those of all the points.
 #[allow(clippy::too_many_arguments)]
 pub fn write_workplane(
     csv: &Path,

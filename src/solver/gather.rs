@@ -65,7 +65,7 @@ pub struct FinalGather<'a> {
     near_field: bool,
     sources: Vec<Source>,
     /// Per polygon, its unit normal and whether its back is another
-    /// polygon (a two-sided face): what [`FinalGather::inside_solid`]
+    /// polygon (a two-sided face): what [`FinalGather::behind_surfaces`]
     /// needs to tell the back of a surface.
     faces: Vec<(Vec3, bool)>,
 }
@@ -127,27 +127,33 @@ impl<'a> FinalGather<'a> {
         }
     }
 
-    /// Whether `x` lies inside a solid object, such as a work-plane point
-    /// inside a cabinet: looking from `x` along `n` and four directions
-    /// square to it, every ray meets the back of a single-sided surface.
-    /// A point under a table top sees the walls' fronts sideways and is
-    /// not inside; a ray that leaves the scene means not enclosed either.
+    /// Whether `x` lies behind the scene's surfaces: inside a solid object
+    /// (a work-plane point inside a cabinet) or outside the walls (a grid
+    /// over a room's bounds reaching past a leaning wall). Looking from
+    /// `x` along `n` and four directions square to it, every ray meets
+    /// the back of a single-sided surface or leaves the scene, and at
+    /// least one meets a back. A point under a table top sees the walls'
+    /// fronts sideways and is not behind; one in open space meets no back.
+    /// Two-sided surfaces have no back, so nothing inside them is found.
     /// Such points receive no light, and a lighting designer leaves them
     /// out of a work plane's figures.
-    pub fn inside_solid(&self, x: Vec3, n: Vec3) -> bool {
+    pub fn behind_surfaces(&self, x: Vec3, n: Vec3) -> bool {
         let n = n.normalize_or_zero();
         if n == Vec3::ZERO {
             return false;
         }
         let (t1, t2) = n.any_orthonormal_pair();
-        [n, t1, -t1, t2, -t2].iter().all(|&d| {
-            self.visibility
-                .first_hit(x, d)
-                .is_some_and(|(p, _)| match self.faces.get(p.index()) {
-                    Some(&(normal, has_back)) => normal.dot(d) > 0.0 && !has_back,
-                    None => false,
-                })
-        })
+        let mut backs = 0;
+        for d in [n, t1, -t1, t2, -t2] {
+            match self.visibility.first_hit(x, d) {
+                None => {}
+                Some((p, _)) => match self.faces.get(p.index()) {
+                    Some(&(normal, false)) if normal.dot(d) > 0.0 => backs += 1,
+                    _ => return false,
+                },
+            }
+        }
+        backs > 0
     }
 
     /// Irradiance at `x` (scene units) on a surface of unit normal `n`, in
@@ -242,7 +248,7 @@ mod tests {
     /// The bundled office: a cabinet (a one-sided box) against the back
     /// wall, a desk on four legs, open floor.
     #[test]
-    fn points_inside_a_box_are_inside_a_solid_and_points_under_a_desk_are_not() {
+    fn points_inside_a_box_are_behind_surfaces_and_points_under_a_desk_are_not() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/office.sc");
         let s = crate::scene::load(&path).unwrap();
         let mesh = crate::mesh::build(&s, &crate::mesh::MeshOptions::for_scene(&s)).unwrap();
@@ -250,13 +256,19 @@ mod tests {
         let radiosity = vec![Rgb::splat(1.0); mesh.vertex_count()];
         let g = FinalGather::new(&s, &mesh, &vis, &radiosity, true);
         // Cabinet: 0.3..1.5 × 0..0.7 × 3.5..3.98.
-        assert!(g.inside_solid(Vec3::new(0.9, 0.3, 3.7), Vec3::Y));
-        assert!(g.inside_solid(Vec3::new(0.31, 0.69, 3.51), Vec3::Y));
+        assert!(g.behind_surfaces(Vec3::new(0.9, 0.3, 3.7), Vec3::Y));
+        assert!(g.behind_surfaces(Vec3::new(0.31, 0.69, 3.51), Vec3::Y));
         // Under the desk top (0.72 high), between its legs.
-        assert!(!g.inside_solid(Vec3::new(2.5, 0.3, 2.0), Vec3::Y));
+        assert!(!g.behind_surfaces(Vec3::new(2.5, 0.3, 2.0), Vec3::Y));
         // Open floor, and just outside the cabinet's front.
-        assert!(!g.inside_solid(Vec3::new(1.0, 0.3, 1.0), Vec3::Y));
-        assert!(!g.inside_solid(Vec3::new(0.9, 0.3, 3.45), Vec3::Y));
-        assert!(!g.inside_solid(Vec3::new(0.9, 0.3, 3.7), Vec3::ZERO));
+        assert!(!g.behind_surfaces(Vec3::new(1.0, 0.3, 1.0), Vec3::Y));
+        assert!(!g.behind_surfaces(Vec3::new(0.9, 0.3, 3.45), Vec3::Y));
+        assert!(!g.behind_surfaces(Vec3::new(0.9, 0.3, 3.7), Vec3::ZERO));
+        // Outside the room, beside its wall at x = 0: the wall's back one
+        // way, nothing the other ways.
+        assert!(g.behind_surfaces(Vec3::new(-0.5, 0.3, 2.0), Vec3::Y));
+        assert!(g.behind_surfaces(Vec3::new(-0.5, 1.5, 2.0), Vec3::Y));
+        // Above the ceiling, in open space: no ray meets anything.
+        assert!(!g.behind_surfaces(Vec3::new(2.0, 3.5, 2.0), Vec3::Y));
     }
 }
