@@ -185,3 +185,15 @@ pub fn shadowed_box() -> Scene {
     ));
     scene(polygons, glowing_box().materials)
 }
+
+/// Area-weighted mean radiosity of polygon `p` of mesh `m`, from
+/// `radiosity` per mesh vertex.
+pub fn mean_radiosity(m: &crate::mesh::Mesh, radiosity: &[Rgb], p: usize) -> Rgb {
+    let areas = m.vertex_areas();
+    let pm = &m.polygons[p];
+    let mut sum = Rgb::BLACK;
+    for l in pm.vertices.clone() {
+        sum += radiosity[l as usize] * areas[l as usize];
+    }
+    sum / pm.area
+}

@@ -276,7 +276,7 @@ fn spreading_to_vertices_keeps_the_power() {
 
 use crate::color::Rgb;
 use crate::solver::{FormFactorMethod, Progressive, SolverOptions, UnshotScheme};
-use crate::testutil::{closed_box, glowing_box};
+use crate::testutil::{closed_box, glowing_box, mean_radiosity};
 use crate::visibility::Visibility;
 
 /// Hemicube solver options at the default resolution.
@@ -313,17 +313,6 @@ fn solve(
         solver.unshot_power(),
     );
     (m, out.0, out.1, out.2, out.3)
-}
-
-/// Area-weighted mean radiosity of polygon `p`.
-fn mean_radiosity(m: &Mesh, radiosity: &[Rgb], p: usize) -> Rgb {
-    let areas = m.vertex_areas();
-    let pm = &m.polygons[p];
-    let mut sum = Rgb::BLACK;
-    for l in pm.vertices.clone() {
-        sum += radiosity[l as usize] * areas[l as usize];
-    }
-    sum / pm.area
 }
 
 /// One hemicube step from an emitting unit square (`e = 1`) to a unit

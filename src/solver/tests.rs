@@ -2,7 +2,9 @@
 
 use super::*;
 use crate::mesh::{self, MeshOptions};
-use crate::testutil::{closed_box, glowing_box, grey, polygon, scene, shadowed_box};
+use crate::testutil::{
+    closed_box, glowing_box, grey, mean_radiosity, polygon, scene, shadowed_box,
+};
 
 /// Exact form factor between two coaxial parallel unit squares one unit
 /// apart (Howell's catalogue, C-11).
@@ -74,17 +76,6 @@ fn refined_across(s: &Scene, lenmax: f32, cut: f32) -> Mesh {
     }
     assert!(m.polygons.iter().any(|p| p.levels == 2));
     m
-}
-
-/// Area-weighted mean radiosity of polygon `p`.
-fn mean_radiosity(m: &Mesh, radiosity: &[Rgb], p: usize) -> Rgb {
-    let areas = m.vertex_areas();
-    let pm = &m.polygons[p];
-    let mut sum = Rgb::BLACK;
-    for l in pm.vertices.clone() {
-        sum += radiosity[l as usize] * areas[l as usize];
-    }
-    sum / pm.area
 }
 
 /// Form factor from polygon 1 to emitter 0 measured through one shooting
