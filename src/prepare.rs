@@ -118,16 +118,6 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
             scene
                 .set_luminaire(name, photometry, units)
                 .map_err(|e| PrepareError::Luminaire(name.clone(), Box::new(e)))?;
-            // Said whatever `--quiet` says, as the load warnings are: the
-            // room gets less light than the file's lumens.
-            if let Some(l) = scene.luminaires.last().filter(|l| l.upward_fraction > 0.01) {
-                eprintln!(
-                    "warning: --ies {name}: {} sends {:.0} % of its light above the \
-                     luminaire's plane, which is not emitted",
-                    path.display(),
-                    100.0 * l.upward_fraction
-                );
-            }
         }
     }
     // Solids keep their outside only. Found before the cuts, which leave
@@ -140,7 +130,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     // each piece gets its own.
     let split = scene.split_intersections();
     let mut scene = scene.with_sides(config.sides);
-    scene.darken_luminaire_backs();
+    scene.light_luminaire_backs();
     // Last, after everything that adds or changes polygons, so that the
     // enclosure is built around the finished scene.
     if let Some(sky) = config.sky {

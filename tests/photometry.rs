@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use radiosity::mesh::{self, MeshOptions};
-use radiosity::scene::{parse_str, Photometry, Scene, Units};
+use radiosity::scene::{parse_str, Photometry, Scene, Sides, Units};
 use radiosity::solver::gather::{vertex_irradiance, FinalGather};
 use radiosity::solver::{FormFactorMethod, Progressive, SolverOptions};
 use radiosity::visibility::Visibility;
@@ -351,4 +351,126 @@ fn a_checkpoint_knows_the_luminaires_distribution() {
     c0.swap_with_slice(&mut c90[..n]);
     assert_eq!(print(&scene), print(&scene.clone()));
     assert_ne!(print(&scene), print(&swapped));
+}
+
+/// [`ies_text`] with light upwards too: 0 to 180° in 5° steps, the same
+/// below the horizontal and `1000 − 600 sin(θ − 90°)` cd above it (1000
+/// at the horizontal, 400 at the zenith), C90 × 0.5 throughout.
+fn uplight_ies_text() -> String {
+    let vertical: Vec<f64> = (0..=36).map(|k| k as f64 * 5.0).collect();
+    let candela = |d: f64| {
+        if d <= 90.0 {
+            1000.0 + 500.0 * (2.0 * d.to_radians()).sin()
+        } else {
+            1000.0 - 600.0 * (d - 90.0).to_radians().sin()
+        }
+    };
+    let row = |scale: f64| -> String {
+        vertical
+            .iter()
+            .map(|&d| format!("{:.3}", scale * candela(d)))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    format!(
+        "IESNA:LM-63-2002\n[TEST] uplight test table\nTILT=NONE\n\
+         1 -1 1 {} 2 1 2 0.1 0.1 0\n1 1 0\n{}\n0 90\n{}\n{}\n",
+        vertical.len(),
+        vertical
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join(" "),
+        row(1.0),
+        row(0.5)
+    )
+}
+
+/// A pendant's uplight leaves the luminaire's back with the table's upper
+/// half: a 2 cm luminaire 2 m under a ceiling of reflectance 0.5 (nothing
+/// else in the scene, so the ceiling gets direct light only) gives the
+/// ceiling `E = I(θ) cos³ψ / h²` lux (θ from the nadir, past 90°; ψ from
+/// the zenith) within 1 %, by the final gather and at the solver's
+/// ceiling vertices; the floor-facing front still emits the lower half.
+#[test]
+fn a_luminaires_uplight_leaves_its_back_with_the_upper_half_of_the_table() {
+    let text = "material lamp color 1 1 1 k_emission 1 end\n\
+         material ceiling color 1 1 1 k_diffrefl 0.5 end\n\
+         polygon ceiling\n vertex 0 4 0\n vertex 5 4 0\n vertex 5 4 5\n vertex 0 4 5\nend\n\
+         polygon lamp\n vertex 2.49 2 2.49\n vertex 2.51 2 2.49\n vertex 2.51 2 2.51\n vertex 2.49 2 2.51\nend\n";
+    let mut scene = load(text);
+    let photometry = Arc::new(Photometry::parse(&uplight_ies_text(), "up.ies").unwrap());
+    assert_eq!(
+        scene
+            .set_luminaire("lamp", photometry.clone(), Units::M)
+            .unwrap(),
+        1
+    );
+    let mut scene = scene.with_sides(Sides::AsLoaded);
+    scene.light_luminaire_backs();
+    // The front and its new back, each a luminaire of its half's flux.
+    assert_eq!(scene.polygons.len(), 3);
+    assert_eq!(scene.luminaires.len(), 2);
+    let (down, up) = (&scene.luminaires[0], &scene.luminaires[1]);
+    assert!(!down.upper && up.upper);
+    let lower = photometry.flux(PI / 2.0);
+    let upper = photometry.flux_between(PI / 2.0, PI);
+    assert!((down.flux / lower - 1.0).abs() < 1e-9 && (up.flux / upper - 1.0).abs() < 1e-9);
+    let back = &scene.polygons[2];
+    assert_eq!(back.normal, Vec3::Y);
+    let emitted = scene.materials[back.material.index()].emission().mean() * back.area;
+    assert!(
+        (emitted / upper - 1.0).abs() < 1e-9,
+        "{emitted} lm vs {upper} lm"
+    );
+
+    let mut options = MeshOptions::for_scene(&scene);
+    options.lenmax = 0.25;
+    let mesh = mesh::build(&scene, &options).unwrap();
+    let visibility = Visibility::new(&scene);
+    let mut solver = Progressive::new(&scene, &mesh, &visibility, SolverOptions::default());
+    while solver.step().is_some() {}
+    let gather = FinalGather::new(&scene, &mesh, &visibility, solver.radiosity(), true);
+    let irradiance = vertex_irradiance(&scene, &mesh, solver.radiosity());
+    let h = 2.0;
+    let exact = |x: f64, z: f64| {
+        let (dx, dz) = (x - 2.5, z - 2.5);
+        let d = (dx * dx + dz * dz + h * h).sqrt();
+        let cos_psi = h / d;
+        // From the nadir (down): past 90°. C90 = nadir × C0 = -y × x = +z.
+        photometry.intensity(PI - cos_psi.acos(), dz.atan2(dx)) * cos_psi.powi(3) / (h * h)
+    };
+    for (x, z) in [
+        (2.5, 2.5),
+        (3.0, 2.5),
+        (4.0, 2.5),
+        (2.5, 3.5),
+        (2.5, 4.5),
+        (3.5, 3.5),
+    ] {
+        let p = Vec3::new(x as f32, 4.0, z as f32);
+        let got = gather.irradiance_at(&[(p, -Vec3::Y)])[0].mean();
+        let l = (0..mesh.vertex_count())
+            .filter(|&l| mesh.vertex_polygon[l].0 == 0)
+            .min_by(|&a, &b| {
+                mesh.positions[a]
+                    .distance(p)
+                    .total_cmp(&mesh.positions[b].distance(p))
+            })
+            .unwrap();
+        let at = mesh.positions[l];
+        for (what, got, exact) in [
+            ("gathered", got, exact(x, z)),
+            (
+                "solver vertex",
+                irradiance[l].mean(),
+                exact(f64::from(at.x), f64::from(at.z)),
+            ),
+        ] {
+            assert!(
+                (got / exact - 1.0).abs() < 0.01,
+                "{what} near ({x}, {z}): {got} lx vs I cos³ψ / h² = {exact} lx"
+            );
+        }
+    }
 }

@@ -8,10 +8,11 @@
 //! (C90 = nadir × C0). Each polygon gets a material of its own that emits
 //! the distribution's downward flux spread over the polygon's area (so the
 //! solver's power bookkeeping holds) and reflects nothing: the luminous
-//! opening of a luminaire, like Radiance's `light` material. Only the
-//! light below the polygon's plane (θ ≤ 90°) is emitted; what the file
-//! sends upwards is dropped, and [`Luminaire::upward_fraction`] says how
-//! much that is.
+//! opening of a luminaire, like Radiance's `light` material. The light
+//! below the polygon's plane (θ ≤ 90°) leaves its front; what the file
+//! sends upwards (a pendant's uplight) leaves its back, a polygon of its
+//! own ([`Scene::light_luminaire_backs`]) with the upper half of the same
+//! distribution.
 
 use super::emit::UnknownName;
 use super::ies::Photometry;
@@ -34,12 +35,21 @@ pub struct Luminaire {
     pub photometry: Arc<Photometry>,
     /// The direction of the C0 plane, in scene space (unit).
     pub c0: Vec3,
-    /// Luminous flux emitted below the polygon's plane (θ ≤ 90°), lumens.
+    /// Luminous flux its polygons emit, lumens: below the luminaire's
+    /// plane (θ ≤ 90°) from a front, above it (θ > 90°) from a back.
     pub flux: f64,
     /// The fraction of the file's whole flux that is sent upwards (θ >
-    /// 90°) and so not emitted.
+    /// 90°), from the luminaire's back.
     pub upward_fraction: f64,
+    /// True for the back of a luminaire: its polygons face up, away from
+    /// the photometric nadir (which stays the front's normal, so angles
+    /// are read as the file gives them), and emit the upper half.
+    pub upper: bool,
 }
+
+/// Uplight below this fraction of a file's flux is not emitted: a table
+/// that ends at 90° still integrates to a few rounding lumens above it.
+pub const MIN_UPWARD_FRACTION: f64 = 1e-6;
 
 /// Why `--ies` could not be applied.
 #[derive(Debug, thiserror::Error)]
@@ -87,6 +97,7 @@ impl Scene {
                 c0,
                 flux,
                 upward_fraction: upward / (flux + upward),
+                upper: false,
             });
         }
         Ok(members.len())
@@ -97,29 +108,110 @@ impl Scene {
         self.luminaires.iter().find(|l| l.material == material)
     }
 
-    /// Gives the back copies of luminaires ([`Scene::with_sides`]) a black
-    /// material of their own: a luminaire emits from its front only.
-    pub fn darken_luminaire_backs(&mut self) {
+    /// Gives every luminaire polygon's back side its light: the upper
+    /// half of the distribution when the file sends light upwards (above
+    /// [`MIN_UPWARD_FRACTION`]), emitted by a material of its own of
+    /// exitance `front exitance × upward / downward flux` (the same area),
+    /// with a [`Luminaire`] marked [`Luminaire::upper`]; else a black
+    /// material (a luminaire without uplight emits from its front only).
+    /// A front without a back (a one-sided scene) gets a back copy here,
+    /// as [`Scene::with_sides`] makes them. Run after
+    /// [`Scene::with_sides`]. A back that is another face of the file (the
+    /// face written the other way round) is left as it is.
+    pub fn light_luminaire_backs(&mut self) {
         if self.luminaires.is_empty() {
             return;
         }
         let mut black = None;
-        for i in 0..self.polygons.len() {
-            let p = &self.polygons[i];
-            if p.surface.back_of.is_none() || self.luminaire_of(p.material).is_none() {
-                continue;
+        let fronts: Vec<Luminaire> = self
+            .luminaires
+            .iter()
+            .filter(|l| !l.upper)
+            .cloned()
+            .collect();
+        for l in fronts {
+            let uplight = l.upward_fraction > MIN_UPWARD_FRACTION;
+            let members: Vec<usize> = (0..self.polygons.len())
+                .filter(|&i| {
+                    let p = &self.polygons[i];
+                    p.material == l.material && p.surface.back_of.is_none()
+                })
+                .collect();
+            let mut upper_material = None;
+            for i in members {
+                let back = match self.polygons[i].surface.back {
+                    Some(b)
+                        if self.polygons[b.index()].surface.back_of
+                            == Some(PolygonId(i as u32)) =>
+                    {
+                        b
+                    }
+                    Some(_) => continue,
+                    // A face of a closed solid would send its uplight into
+                    // the solid.
+                    None if uplight && !self.polygons[i].surface.solid => self.add_back_copy(i),
+                    None => continue,
+                };
+                let material = if uplight {
+                    *upper_material.get_or_insert_with(|| {
+                        let front = &self.materials[l.material.index()];
+                        let upward = l.flux * l.upward_fraction / (1.0 - l.upward_fraction);
+                        self.materials.push(Material {
+                            name: format!("{} (uplight)", front.name),
+                            color: Rgb::WHITE,
+                            k_diffrefl: 0.0,
+                            k_emission: front.k_emission * upward / l.flux,
+                        });
+                        let material = MaterialId(self.materials.len() as u32 - 1);
+                        self.luminaires.push(Luminaire {
+                            material,
+                            flux: upward,
+                            upper: true,
+                            ..l.clone()
+                        });
+                        material
+                    })
+                } else {
+                    *black.get_or_insert_with(|| {
+                        self.materials.push(Material {
+                            name: "luminaire back".into(),
+                            color: Rgb::BLACK,
+                            k_diffrefl: 0.0,
+                            k_emission: 0.0,
+                        });
+                        MaterialId(self.materials.len() as u32 - 1)
+                    })
+                };
+                self.polygons[back.index()].material = material;
             }
-            let id = *black.get_or_insert_with(|| {
-                self.materials.push(Material {
-                    name: "luminaire back".into(),
-                    color: Rgb::BLACK,
-                    k_diffrefl: 0.0,
-                    k_emission: 0.0,
-                });
-                MaterialId(self.materials.len() as u32 - 1)
-            });
-            self.polygons[i].material = id;
         }
+    }
+
+    /// Adds the back copy of polygon `i` (its vertices reversed from the
+    /// second on, as [`Scene::with_sides`] makes them), linked both ways
+    /// and in its front's groups; returns its id.
+    fn add_back_copy(&mut self, i: usize) -> PolygonId {
+        let id = PolygonId(self.polygons.len() as u32);
+        let p = &self.polygons[i];
+        let mut vertices = Vec::with_capacity(p.vertices.len());
+        vertices.push(p.vertices[0]);
+        vertices.extend(p.vertices[1..].iter().rev());
+        let mut back = super::Polygon {
+            vertices,
+            normal: -p.normal,
+            ..p.clone()
+        };
+        back.surface.back = None;
+        back.surface.back_of = Some(PolygonId(i as u32));
+        self.polygons[i].surface.back = Some(id);
+        self.polygons.push(back);
+        // The new id is above every other, so the groups stay ascending.
+        for group in &mut self.groups {
+            if group.polygons.binary_search(&PolygonId(i as u32)).is_ok() {
+                group.polygons.push(id);
+            }
+        }
+        id
     }
 
     /// The polygons named `name`, as [`Scene::set_emission`] matches
@@ -200,7 +292,7 @@ mod tests {
         ));
         // Two-sided: the back copies are black, the fronts still emit.
         let mut scene = scene.with_sides(Sides::Two);
-        scene.darken_luminaire_backs();
+        scene.light_luminaire_backs();
         for p in &scene.polygons {
             let emits = !scene.materials[p.material.index()].emission().is_black();
             let luminaire = scene.luminaire_of(p.material).is_some();
@@ -210,5 +302,45 @@ mod tests {
                 assert_eq!(emits, luminaire);
             }
         }
+    }
+
+    /// A table with light above the horizontal: the back copy that
+    /// `--two-sided` made emits the upper half (no second copy), the
+    /// front the lower half, and their exitances are in the ratio of the
+    /// two fluxes.
+    #[test]
+    fn an_existing_back_copy_emits_the_uplight() {
+        // 100 cd at 0°, 0 at 90°, 50 at 180°.
+        let text = "TILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0 90 180\n0\n100 0 50\n";
+        let photometry = Arc::new(Photometry::parse(text, "u.ies").unwrap());
+        let mut scene = testutil::scene(
+            vec![testutil::polygon(
+                0,
+                &[[0., 1., 0.], [0.1, 1., 0.], [0.1, 1., 0.1], [0., 1., 0.1]],
+            )],
+            vec![testutil::grey("lamp", 1.0, 0.5)],
+        );
+        scene
+            .set_luminaire("lamp", photometry.clone(), Units::M)
+            .unwrap();
+        let mut scene = scene.with_sides(Sides::Two);
+        assert_eq!(scene.polygons.len(), 2);
+        scene.light_luminaire_backs();
+        assert_eq!(scene.polygons.len(), 2, "the existing copy is used");
+        let (front, back) = (&scene.polygons[0], &scene.polygons[1]);
+        let (lf, lb) = (
+            scene.luminaire_of(front.material).unwrap(),
+            scene.luminaire_of(back.material).unwrap(),
+        );
+        assert!(!lf.upper && lb.upper);
+        let up = photometry.flux_between(PI / 2.0, PI);
+        assert!((lb.flux / up - 1.0).abs() < 1e-9);
+        assert!((lf.upward_fraction - up / (up + lf.flux)).abs() < 1e-12);
+        let e = |p: &crate::scene::Polygon| scene.materials[p.material.index()].emission().r;
+        assert!((e(back) / e(front) - up / lf.flux).abs() < 1e-9);
+        assert_eq!(
+            scene.materials[back.material.index()].reflectance(),
+            Rgb::BLACK
+        );
     }
 }

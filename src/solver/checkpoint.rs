@@ -194,6 +194,7 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     // luminaires the fingerprint is what it was.
     for l in &scene.luminaires {
         h.word(u64::from(l.material.0));
+        h.word(u64::from(l.upper));
         for c in l.c0.to_array() {
             h.word(u64::from(c.to_bits()));
         }

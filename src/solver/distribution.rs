@@ -32,9 +32,13 @@ use std::sync::Arc;
 pub struct Directional {
     photometry: Arc<Photometry>,
     flux: f64,
+    /// The photometric nadir: the luminaire front's normal.
     nadir: DVec3,
     c0: DVec3,
     c90: DVec3,
+    /// The polygon is the luminaire's back ([`crate::scene::Luminaire::
+    /// upper`]): it emits away from the nadir, the table's θ > 90°.
+    upper: bool,
 }
 
 impl Directional {
@@ -46,7 +50,9 @@ impl Directional {
             .iter()
             .map(|p| {
                 let l = scene.luminaire_of(p.material)?;
-                let nadir = p.normal.as_dvec3().normalize();
+                // A back faces away from the nadir.
+                let side = if l.upper { -1.0 } else { 1.0 };
+                let nadir = p.normal.as_dvec3().normalize() * side;
                 // The C0 direction made exactly perpendicular to this
                 // polygon's normal (a split piece or back keeps the
                 // luminaire's).
@@ -63,20 +69,27 @@ impl Directional {
                     nadir,
                     c0,
                     c90: nadir.cross(c0),
+                    upper: l.upper,
                 })
             })
             .collect()
     }
 
     /// `I(ω) / Φ` (per steradian) in the direction `d` (any length, from
-    /// the luminaire); 0 above its plane.
+    /// the luminaire); 0 behind the polygon (above a front's plane, below
+    /// a back's).
     pub fn relative_intensity(&self, d: DVec3) -> f64 {
         let len = d.length();
         if len <= 0.0 {
             return 0.0;
         }
         let cos_theta = self.nadir.dot(d) / len;
-        if cos_theta <= 0.0 {
+        let in_front = if self.upper {
+            cos_theta < 0.0
+        } else {
+            cos_theta > 0.0
+        };
+        if !in_front {
             return 0.0;
         }
         let theta = cos_theta.clamp(-1.0, 1.0).acos();
