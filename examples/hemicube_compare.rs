@@ -3,8 +3,8 @@
 //! (`docs/accuracy.md`, "Hemicube"):
 //!
 //! ```sh
-//! cargo run --release --example hemicube_compare -- scenes/rtable.sc docs/images/hemicube-rtable.png
-//! cargo run --release --example hemicube_compare -- scenes/cornell.sc docs/images/hemicube-cornell.png
+//! cargo run --release --example hemicube_compare -- scenes/rtable.sc docs/images/hemicube-rtable.png docs/images/hemicube-errors-rtable.png
+//! cargo run --release --example hemicube_compare -- scenes/cornell.sc docs/images/hemicube-cornell.png docs/images/hemicube-errors-cornell.png
 //! ```
 //!
 //! Solves the scene with Wallace's estimate on a mesh of half the default
@@ -19,7 +19,9 @@
 //! luminance, over the pixels the camera shows, lamps excluded), at
 //! 320 × 240. Writes a 2 × 2 composite of the pictures (Wallace, hemicube
 //! 128, centre, hemicube 32) to the output path, all at the reference's
-//! exposure.
+//! exposure, and, given a third path, the relative error maps of hemicube
+//! 128 from 64 and from 256 cells side by side (red brighter, blue darker
+//! than the reference, full at ±10 %).
 
 use image::{GenericImage, RgbImage};
 use radiosity::color::Rgb;
@@ -72,9 +74,10 @@ fn solve(config: &RunConfig) -> (Frame, Frame, u64, f64) {
 fn main() {
     let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
     let (Some(scene), Some(out)) = (args.first(), args.get(1)) else {
-        eprintln!("usage: hemicube_compare SCENE OUT.png");
+        eprintln!("usage: hemicube_compare SCENE OUT.png [ERRORS.png]");
         std::process::exit(2);
     };
+    let error_map_out = args.get(2);
     let mut base = RunConfig::new(SceneSource::File(scene.clone()));
     base.size = Some(SIZE);
     let lenmax = prepare::prepare(&base).expect("the scene prepares").lenmax;
@@ -119,6 +122,7 @@ fn main() {
     ];
     let exposure = radiosity::render::tonemap::auto_exposure(&reference);
     let mut composite = RgbImage::new(SIZE.0 * 2, SIZE.1 * 2);
+    let mut errors = RgbImage::new(SIZE.0 * 2, SIZE.1);
     for (name, config) in runs {
         let (frame, _, steps, seconds) = solve(&config);
         let (mut diff, mut total) = (0.0, 0.0);
@@ -141,6 +145,17 @@ fn main() {
             "hemicube 32" => Some((1, 1)),
             _ => None,
         };
+        let panel = match name {
+            "hemicube 128" => Some(0),
+            "hemicube 128, 256 cells" => Some(1),
+            _ => None,
+        };
+        if let Some(x) = panel {
+            let map = error_map(&frame, &reference, &lamps);
+            errors
+                .copy_from(&map, x * SIZE.0, 0)
+                .expect("the panel fits");
+        }
         if let Some((x, y)) = at {
             let picture = radiosity::render::tonemap::to_srgb8(&frame, exposure);
             composite
@@ -149,4 +164,34 @@ fn main() {
         }
     }
     composite.save(out).expect("the composite is written");
+    if let Some(path) = error_map_out {
+        errors.save(path).expect("the error map is written");
+    }
+}
+
+/// The signed relative luminance error of `frame` against `reference` per
+/// pixel: red where brighter, blue where darker, full at ±10 %, over the
+/// reference's luminance drawn dim in green; lamps and uncovered pixels
+/// black.
+fn error_map(frame: &Frame, reference: &Frame, lamps: &Frame) -> RgbImage {
+    let brightest = reference
+        .pixels
+        .iter()
+        .map(luminance)
+        .fold(f64::MIN_POSITIVE, f64::max);
+    RgbImage::from_fn(SIZE.0, SIZE.1, |x, y| {
+        let k = (y * SIZE.0 + x) as usize;
+        if !reference.covered[k] || lamps.pixels[k][0] > 0.0 {
+            return image::Rgb([0, 0, 0]);
+        }
+        let r = luminance(&reference.pixels[k]);
+        let rel = (luminance(&frame.pixels[k]) - r) / r.max(1e-9);
+        let level = ((rel.abs() / 0.1).min(1.0) * 255.0) as u8;
+        let dim = ((r / brightest).min(1.0) * 60.0) as u8;
+        if rel > 0.0 {
+            image::Rgb([level, dim, 0])
+        } else {
+            image::Rgb([0, dim, level])
+        }
+    })
 }
