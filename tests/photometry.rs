@@ -107,20 +107,21 @@ fn a_parallel_square_gives_howells_configuration_factor() {
     }
 }
 
-/// A luminaire table: I(θ) = 1000 + 500 sin(2θ) cd over 0..90° in 5°
-/// steps (nothing upwards), with two horizontal planes so that the
-/// azimuth matters: C0 as given, C90 × 0.5 (bilateral, quadrant-symmetric).
-fn ies_text() -> String {
-    let vertical: Vec<f64> = (0..=18).map(|k| k as f64 * 5.0).collect();
+/// `I(θ) = 1000 + 500 sin(2θ)` cd, the test tables' light below the
+/// horizontal.
+fn downward_candela(degrees: f64) -> f64 {
+    1000.0 + 500.0 * (2.0 * degrees.to_radians()).sin()
+}
+
+/// A test table with vertical angles 0 to `top` degrees in 5° steps and
+/// two horizontal planes so that the azimuth matters: C0 as
+/// `candela(θ°)` gives, C90 × 0.5 (bilateral, quadrant-symmetric).
+fn table_text(top: u32, candela: impl Fn(f64) -> f64) -> String {
+    let vertical: Vec<f64> = (0..=top / 5).map(|k| k as f64 * 5.0).collect();
     let row = |scale: f64| -> String {
         vertical
             .iter()
-            .map(|d: &f64| {
-                format!(
-                    "{:.3}",
-                    scale * (1000.0 + 500.0 * (2.0 * d.to_radians()).sin())
-                )
-            })
+            .map(|&d| format!("{:.3}", scale * candela(d)))
             .collect::<Vec<_>>()
             .join(" ")
     };
@@ -136,6 +137,11 @@ fn ies_text() -> String {
         row(1.0),
         row(0.5)
     )
+}
+
+/// A luminaire table: [`downward_candela`] over 0..90° (nothing upwards).
+fn ies_text() -> String {
+    table_text(90, downward_candela)
 }
 
 /// The floor illuminance of a 2 cm luminaire 2 m over a floor of
@@ -357,33 +363,13 @@ fn a_checkpoint_knows_the_luminaires_distribution() {
 /// below the horizontal and `1000 − 600 sin(θ − 90°)` cd above it (1000
 /// at the horizontal, 400 at the zenith), C90 × 0.5 throughout.
 fn uplight_ies_text() -> String {
-    let vertical: Vec<f64> = (0..=36).map(|k| k as f64 * 5.0).collect();
-    let candela = |d: f64| {
+    table_text(180, |d| {
         if d <= 90.0 {
-            1000.0 + 500.0 * (2.0 * d.to_radians()).sin()
+            downward_candela(d)
         } else {
             1000.0 - 600.0 * (d - 90.0).to_radians().sin()
         }
-    };
-    let row = |scale: f64| -> String {
-        vertical
-            .iter()
-            .map(|&d| format!("{:.3}", scale * candela(d)))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
-    format!(
-        "IESNA:LM-63-2002\n[TEST] uplight test table\nTILT=NONE\n\
-         1 -1 1 {} 2 1 2 0.1 0.1 0\n1 1 0\n{}\n0 90\n{}\n{}\n",
-        vertical.len(),
-        vertical
-            .iter()
-            .map(|v| v.to_string())
-            .collect::<Vec<_>>()
-            .join(" "),
-        row(1.0),
-        row(0.5)
-    )
+    })
 }
 
 /// A pendant's uplight leaves the luminaire's back with the table's upper

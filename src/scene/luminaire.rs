@@ -192,17 +192,7 @@ impl Scene {
     /// and in its front's groups; returns its id.
     fn add_back_copy(&mut self, i: usize) -> PolygonId {
         let id = PolygonId(self.polygons.len() as u32);
-        let p = &self.polygons[i];
-        let mut vertices = Vec::with_capacity(p.vertices.len());
-        vertices.push(p.vertices[0]);
-        vertices.extend(p.vertices[1..].iter().rev());
-        let mut back = super::Polygon {
-            vertices,
-            normal: -p.normal,
-            ..p.clone()
-        };
-        back.surface.back = None;
-        back.surface.back_of = Some(PolygonId(i as u32));
+        let back = super::sides::back_copy(&self.polygons[i], PolygonId(i as u32));
         self.polygons[i].surface.back = Some(id);
         self.polygons.push(back);
         // The new id is above every other, so the groups stay ascending.

@@ -59,6 +59,23 @@ fn reversed_key(vertices: &[glam::Vec3]) -> Vec<[u32; 3]> {
     face_key(&reversed)
 }
 
+/// The back copy of `front` (polygon `id`): its vertices reversed from
+/// the second on, so the first stays first, its normal negated, marked as
+/// `id`'s back and with no back of its own.
+pub(super) fn back_copy(front: &Polygon, id: PolygonId) -> Polygon {
+    let mut vertices = Vec::with_capacity(front.vertices.len());
+    vertices.push(front.vertices[0]);
+    vertices.extend(front.vertices[1..].iter().rev());
+    let mut back = Polygon {
+        vertices,
+        normal: -front.normal,
+        ..front.clone()
+    };
+    back.surface.back = None;
+    back.surface.back_of = Some(id);
+    back
+}
+
 impl Scene {
     /// Drops every polygon that repeats an earlier one exactly (the same
     /// vertices, bit for bit, in the same cyclic order), keeping one of
@@ -183,16 +200,7 @@ impl Scene {
                 continue;
             }
             let back_id = PolygonId((count + copies.len()) as u32);
-            let mut vertices = Vec::with_capacity(p.vertices.len());
-            vertices.push(p.vertices[0]);
-            vertices.extend(p.vertices[1..].iter().rev());
-            let mut back = Polygon {
-                vertices,
-                normal: -p.normal,
-                ..p.clone()
-            };
-            back.surface.back = None;
-            back.surface.back_of = Some(PolygonId(i as u32));
+            let back = back_copy(p, PolygonId(i as u32));
             self.polygons[i].surface.back = Some(back_id);
             copies.push(back);
         }

@@ -111,6 +111,18 @@ impl Quadrature {
 }
 
 impl ShooterSample {
+    /// Bounds `(min, max)` of its cell's corners, or its position alone
+    /// without a cell, in scene units.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.cell.map_or((self.position, self.position), |corners| {
+            corners
+                .iter()
+                .fold((self.position, self.position), |(lo, hi), &c| {
+                    (lo.min(c), hi.max(c))
+                })
+        })
+    }
+
     /// A sample without a cell: always the disc approximation.
     pub fn point(position: Vec3, area: f64) -> Self {
         ShooterSample {

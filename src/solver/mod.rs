@@ -1093,16 +1093,7 @@ impl<'a> Progressive<'a> {
             .filter(|c| c.power > 0.0)
             .collect();
         let strata = Strata::build(&cells, hemicubes, |c| {
-            let sample = &samples[cells[c].sample as usize];
-            sample
-                .cell
-                .map_or((sample.position, sample.position), |corners| {
-                    corners
-                        .iter()
-                        .fold((sample.position, sample.position), |(lo, hi), &c| {
-                            (lo.min(c), hi.max(c))
-                        })
-                })
+            samples[cells[c].sample as usize].bounds()
         });
         let mut points = Vec::with_capacity(strata.roots.len());
         let mut shot = Vec::with_capacity(strata.roots.len());
@@ -1113,14 +1104,7 @@ impl<'a> Progressive<'a> {
             if area <= 0.0 {
                 continue;
             }
-            points.push(ShooterSample {
-                position: node.centroid,
-                area,
-                cell: None,
-                near_r2: 0.0,
-                exact_r2: 0.0,
-                ..samples[cells[node.representative as usize].sample as usize]
-            });
+            points.push(ShooterSample::point(node.centroid, area));
             shot.push(node.power / area);
         }
         Some((points, shot))
@@ -1155,17 +1139,7 @@ impl<'a> Progressive<'a> {
         }
         let k = roots.min(self.cells.len());
         let samples = &self.cell_samples;
-        self.strata = Strata::build(&self.cells, k, |c| {
-            let sample = &samples[c];
-            match sample.cell {
-                Some(corners) => corners
-                    .iter()
-                    .fold((sample.position, sample.position), |(lo, hi), &c| {
-                        (lo.min(c), hi.max(c))
-                    }),
-                None => (sample.position, sample.position),
-            }
-        });
+        self.strata = Strata::build(&self.cells, k, |c| samples[c].bounds());
     }
 
     /// Cluster step, phase 3: every polygon with some reflectance
