@@ -59,7 +59,7 @@ fn bench_gather(c: &mut Criterion) {
             let g = FinalGather::new(
                 &prepared.scene,
                 &prepared.mesh,
-                &prepared.visibility,
+                prepared.visibility(),
                 &radiosity,
                 near_field,
             );

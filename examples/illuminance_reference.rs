@@ -207,7 +207,7 @@ fn main() {
     let gather = FinalGather::new(
         scene,
         mesh,
-        &prepared.visibility,
+        prepared.visibility(),
         radiosity,
         config.solver.near_field,
     );

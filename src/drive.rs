@@ -43,7 +43,9 @@ pub fn run(
                 fallback(&why.to_string());
                 return batch(config, None, cancel, arm_cancel);
             }
-            let prepared = prepare::prepare(config)?;
+            // The window's first frame needs no BVH: the solver's thread
+            // builds it.
+            let prepared = prepare::prepare_deferred(config)?;
             match viewer::run(&prepared, config) {
                 Ok(()) => Ok(None),
                 Err(ViewerError::CannotOpen(why)) => {

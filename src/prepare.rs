@@ -18,7 +18,7 @@ use crate::scene::{
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// Why a scene could not be prepared.
@@ -79,17 +79,42 @@ pub struct Prepared {
     pub scene: Scene,
     /// Its element mesh.
     pub mesh: Mesh,
-    /// Its visibility structure.
-    pub visibility: Visibility,
+    /// Its visibility structure and the seconds its build took, built on
+    /// first use ([`Prepared::visibility`]).
+    visibility: OnceLock<(Visibility, f64)>,
     /// The lenmax the mesh was built with, in scene units.
     pub lenmax: f32,
-    /// Seconds spent so far (load, mesh, bvh).
+    /// Seconds spent so far on load and mesh; see
+    /// [`Prepared::phase_seconds`] for the BVH's.
     pub seconds: PhaseSeconds,
     /// What splitting along intersections did to the loaded scene.
     pub split: SplitStats,
 }
 
 impl Prepared {
+    /// The scene's visibility structure (its BVH), built on first use:
+    /// [`prepare`] builds it at once; [`prepare_deferred`] leaves it to
+    /// whoever first needs it, so that a window can show its first frame
+    /// (emitters and the ambient estimate, which need no rays) while the
+    /// solver's thread builds it.
+    pub fn visibility(&self) -> &Visibility {
+        &self
+            .visibility
+            .get_or_init(|| {
+                let t = Instant::now();
+                let visibility = Visibility::new(&self.scene);
+                (visibility, t.elapsed().as_secs_f64())
+            })
+            .0
+    }
+
+    /// Seconds spent on load, mesh and, once built, the BVH.
+    pub fn phase_seconds(&self) -> PhaseSeconds {
+        let mut seconds = self.seconds;
+        seconds.bvh = self.visibility.get().map_or(0.0, |v| v.1);
+        seconds
+    }
+
     /// The view of the scene's camera, with the configured size override.
     pub fn view(&self, config: &RunConfig) -> Result<View, ViewError> {
         match config.size {
@@ -103,6 +128,16 @@ impl Prepared {
 /// [`RunConfig::max_elements`] before building it, with the lenmax that
 /// would fit.
 pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
+    let prepared = prepare_deferred(config)?;
+    prepared.visibility();
+    Ok(prepared)
+}
+
+/// [`prepare`] without building the BVH, which [`Prepared::visibility`]
+/// builds on first use (on a scene of 100,000 triangles it takes about a
+/// quarter of a second, a quarter of the time before a window's first
+/// frame).
+pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
     let mut scene = load_scene(&config.scene, config.camera.as_deref())?;
@@ -156,13 +191,10 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
     seconds.mesh = t.elapsed().as_secs_f64();
 
-    let t = Instant::now();
-    let visibility = Visibility::new(&scene);
-    seconds.bvh = t.elapsed().as_secs_f64();
     Ok(Prepared {
         scene,
         mesh,
-        visibility,
+        visibility: OnceLock::new(),
         lenmax: mesh_options.lenmax,
         seconds,
         split,
@@ -177,4 +209,30 @@ pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, 
         SceneSource::File(path) => scene::load(path)?,
     };
     scene.with_camera_from(camera)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_deferred_preparation_builds_the_bvh_on_first_use() {
+        let config = RunConfig::new(SceneSource::Bundled);
+        let deferred = prepare_deferred(&config).expect("the bundled scene prepares");
+        assert!(
+            deferred.visibility.get().is_none(),
+            "no BVH before it is asked for"
+        );
+        assert_eq!(deferred.phase_seconds().bvh, 0.0);
+        let built = deferred.visibility();
+        assert_eq!(built.polygon_count(), deferred.scene.polygons.len());
+        assert!(deferred.phase_seconds().bvh > 0.0);
+        // The same structure on every later call.
+        assert!(std::ptr::eq(built, deferred.visibility()));
+        // `prepare` builds it at once, and counts its time.
+        let eager = prepare(&config).expect("the bundled scene prepares");
+        assert!(eager.visibility.get().is_some());
+        assert!(eager.phase_seconds().bvh > 0.0);
+        assert_eq!(eager.seconds.load, eager.phase_seconds().load);
+    }
 }

@@ -209,7 +209,7 @@ impl<'p> Session<'p> {
         Session::new(
             &prepared.scene,
             &prepared.mesh,
-            &prepared.visibility,
+            prepared.visibility(),
             options,
         )
     }

@@ -238,7 +238,9 @@ pub fn run_prepared(
         ));
     }
     let output = config.output_path();
-    let mut seconds = prepared.seconds;
+    // Built here if a window that could not open left it to be built.
+    prepared.visibility();
+    let mut seconds = prepared.phase_seconds();
     let view = prepared.view(config)?;
     // Bad points or a work plane outside the scene are said before solving.
     photometry::check(config, prepared)?;

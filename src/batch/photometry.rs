@@ -69,7 +69,7 @@ pub fn write(
         FinalGather::new(
             &prepared.scene,
             mesh,
-            &prepared.visibility,
+            prepared.visibility(),
             radiosity,
             near_field,
         )
