@@ -338,7 +338,7 @@ fn quit(display: &str, program: &mut Reaper) {
 }
 
 /// From the camera of every bundled scene, dragging with the left button
-/// (150 px right and 80 px up, then back past the start) looks around
+/// (150 px right and 80 px up, then back to the start) looks around
 /// from the eye: the view stays in the room and the picture `w` writes is
 /// not black. The state panel is on the screen but not in that picture:
 /// `p` writes the screen with it, and after `i` without it.
@@ -370,7 +370,14 @@ fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
         std::thread::sleep(Duration::from_millis(100));
         xdotool(&display, &["mousedown", "1"]).expect("press");
         std::thread::sleep(Duration::from_millis(100));
-        for (dx, dy) in [(30, -16); 5].into_iter().chain([(-40, 20); 6]) {
+        // Out and back to the very point pressed: the turn a drag makes is
+        // where the pointer was last seen pressed minus where it was first
+        // seen pressed, so a press noticed one motion late (a busy
+        // machine) changes the result by one motion, not by the whole
+        // overshoot a drag past the start would leave (the camera of
+        // `cornell` is outside its open box: turned far, it sees the
+        // void).
+        for (dx, dy) in [(30, -16); 5].into_iter().chain([(-30, 16); 5]) {
             xdotool(
                 &display,
                 &["mousemove_relative", "--", &dx.to_string(), &dy.to_string()],
@@ -378,6 +385,7 @@ fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
             .expect("drag");
             std::thread::sleep(Duration::from_millis(60));
         }
+        std::thread::sleep(Duration::from_millis(100));
         xdotool(&display, &["mouseup", "1"]).expect("release");
         std::thread::sleep(Duration::from_millis(200));
         xdotool(&display, &["key", "w"]).expect("key w");
