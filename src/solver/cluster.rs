@@ -24,9 +24,10 @@
 //! halved, and a cut of at most `k` nodes (the *strata*) of about equal
 //! power. For each receiving vertex, each stratum is taken as one far
 //! term when [`Stratum::seen_from`] proves it safe: every cell in front of
-//! the receiver's plane, the box's centre by [`PLANE_DEPTH_RATIO`] of its
-//! half depth along the receiver's normal, and facing the receiver (its normal cone widened
-//! by the angle its bounding sphere subtends), and the receiver more than
+//! the receiver's plane, the box's centre by [`PLANE_DEPTH_RATIO`] of
+//! its half depth along the receiver's normal, and facing the receiver
+//! (its normal cone widened by the angle its bounding sphere subtends),
+//! and the receiver more than
 //! [`STRATUM_NEAR_RATIO`] of its diameter away. The far term is the
 //! node's power from its power-weighted centroid with its power-weighted
 //! mean normal (exact for the cosine at the shooter while every cell
@@ -304,8 +305,8 @@ impl Stratum {
     /// of a floor's cells, a table top) has a sphere as wide as the floor
     /// run, which would cross the plane of every receiver within its radius
     /// of the floor (the ceiling of a large hall) though every cell lies in
-    /// front of it. On the 30-table hall, that sphere test sent 40 % of the
-    /// descents.
+    /// front of it. On the 30-table hall, that sphere test alone sent 45 %
+    /// of the descents.
     #[inline]
     pub fn seen_from(&self, x: Vec3, nx: Vec3) -> Seen {
         let d = x - self.centre;
@@ -314,11 +315,11 @@ impl Stratum {
         if dist2 <= r * r {
             return Seen::Near;
         }
-        // The receiver's plane against the box: the nearest and farthest
-        // signed distances of its corners in front of the plane.
-        let (lo, hi) = self.bounds;
-        let mid = nx.dot((lo + hi) * 0.5 - x);
-        let half = nx.abs().dot((hi - lo) * 0.5);
+        // The receiver's plane against the box: the signed distance of
+        // its centre in front of the plane, and the box's half depth
+        // along the normal.
+        let mid = -nx.dot(d);
+        let half = nx.abs().dot((self.bounds.1 - self.bounds.0) * 0.5);
         if mid + half <= 0.0 {
             return Seen::Behind;
         }
@@ -591,22 +592,7 @@ mod tests {
 
     #[test]
     fn near_means_within_the_ratio_of_the_diameter() {
-        let s = Stratum {
-            cells: 0..1,
-            representative: 0,
-            power: Rgb::BLACK,
-            bounds: (Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)),
-            near_r2: STRATUM_NEAR_RATIO * STRATUM_NEAR_RATIO,
-            children: None,
-            centre: Vec3::new(0.5, 0.0, 0.0),
-            radius: 0.5,
-            axis: Vec3::Z,
-            cone_cos: 1.0,
-            cone_sin: 0.0,
-            centroid: Vec3::new(0.5, 0.0, 0.0),
-            mean_normal: Vec3::Z,
-            bins: [(Rgb::BLACK, Vec3::ZERO); 6],
-        };
+        let s = flat((Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)), Vec3::Z);
         assert!(s.is_near(Vec3::new(0.5, 0.0, STRATUM_NEAR_RATIO * 0.99)));
         assert!(!s.is_near(Vec3::new(0.5, 0.0, STRATUM_NEAR_RATIO * 1.01)));
         assert!(s.is_near(Vec3::new(1.0 + STRATUM_NEAR_RATIO * 0.99, 0.0, 0.0)));
