@@ -1,6 +1,7 @@
-//! Compares the clustered solver with its brute-force twins
-//! (`--no-clustering`, and `--exact-receivers`) on one scene and mesh (`docs/accuracy.md`,
-//! `docs/performance.md`):
+//! Compares the clustered, overshooting solver with its twins on one
+//! scene and mesh (`docs/accuracy.md`, `docs/performance.md`): the
+//! original algorithm (`--no-clustering --no-overshoot`, the reference),
+//! `--exact-receivers` and `--no-overshoot`:
 //!
 //! ```sh
 //! cargo run --release --example sphere_box -- 32 > spheres32.sc
@@ -9,11 +10,11 @@
 //! ```
 //!
 //! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
-//! absent for the program's default) and the threshold (default 0.001). Solves without clustering (the
-//! reference; `CC_SKIP_BRUTE=1` skips it, and the clustered solve with
-//! exact receivers is then the reference) and with it, to the default threshold, and prints for each
-//! the steps, rays and solve seconds; for the clustered solves (exact
-//! receivers, then interpolated), their difference from the reference: the picture's relative L1 error (mean
+//! absent for the program's default) and the threshold (default 0.001).
+//! Solves in each mode (`CC_SKIP_BRUTE=1` skips the slow reference, and
+//! the solve with exact receivers is then the reference) and prints for
+//! each the steps, rays and solve seconds, and for all but the reference
+//! their difference from it: the picture's relative L1 error (mean
 //! absolute luminance difference over mean luminance, over the pixels
 //! the scene's camera shows, lamps excluded), the same over vertices
 //! (area-weighted, emitters excluded), and the largest difference of a
@@ -75,15 +76,18 @@ fn main() {
     // reference. CC_SKIP_BRUTE=1 skips the (slow) unclustered solve, so the
     // clustered solve with exact receivers is the reference.
     let skip_brute = std::env::var_os("CC_SKIP_BRUTE").is_some();
+    // (clustering, receiver interpolation, overshooting, label)
     let modes = [
-        (false, false, "--no-clustering"),
-        (true, false, "--exact-receivers"),
-        (true, true, "clustered"),
+        (false, false, false, "--no-clustering --no-overshoot"),
+        (true, false, true, "--exact-receivers"),
+        (true, true, false, "--no-overshoot"),
+        (true, true, true, "default"),
     ];
-    for &(clustering, interpolation, label) in &modes[skip_brute as usize..] {
+    for &(clustering, interpolation, overshoot, label) in &modes[skip_brute as usize..] {
         let mut c = config.clone();
         c.solver.clustering = clustering;
         c.solver.receiver_interpolation = interpolation;
+        c.solver.overshoot = overshoot;
         let t = Instant::now();
         let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
         session

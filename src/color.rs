@@ -4,7 +4,7 @@
 //! millions of small contributions per vertex and `f32` would lose the tail
 //! of the series.
 
-use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Sub};
+use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub};
 
 /// A linear RGB triple. What the channels mean (radiosity in the scene's
 /// emission units, or a dimensionless reflectance) is said by whoever holds it.
@@ -65,6 +65,11 @@ impl Rgb {
         self.r.is_finite() && self.g.is_finite() && self.b.is_finite()
     }
 
+    /// The channel-wise maximum of `self` and `o`.
+    pub fn max(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r.max(o.r), self.g.max(o.g), self.b.max(o.b))
+    }
+
     /// The channels as an array `[r, g, b]`.
     pub fn to_array(self) -> [f64; 3] {
         [self.r, self.g, self.b]
@@ -88,6 +93,13 @@ impl AddAssign for Rgb {
         self.r += o.r;
         self.g += o.g;
         self.b += o.b;
+    }
+}
+
+impl Neg for Rgb {
+    type Output = Rgb;
+    fn neg(self) -> Rgb {
+        Rgb::new(-self.r, -self.g, -self.b)
     }
 }
 

@@ -197,3 +197,44 @@ pub fn mean_radiosity(m: &crate::mesh::Mesh, radiosity: &[Rgb], p: usize) -> Rgb
     }
     sum / pm.area
 }
+
+/// `p` (a quadrilateral) cut into `n × n` quadrilaterals of its material,
+/// as an exporter that triangulates or tiles a wall writes it.
+pub fn tiled(p: &crate::scene::Polygon, n: usize) -> Vec<crate::scene::Polygon> {
+    let v = &p.vertices;
+    let at = |u: f32, w: f32| {
+        (1.0 - u) * (1.0 - w) * v[0] + u * (1.0 - w) * v[1] + u * w * v[2] + (1.0 - u) * w * v[3]
+    };
+    let mut out = Vec::new();
+    for b in 0..n {
+        for a in 0..n {
+            let (u0, u1) = (a as f32 / n as f32, (a + 1) as f32 / n as f32);
+            let (w0, w1) = (b as f32 / n as f32, (b + 1) as f32 / n as f32);
+            let corners = [at(u0, w0), at(u1, w0), at(u1, w1), at(u0, w1)].map(|c| c.to_array());
+            out.push(polygon(p.material.0, &corners));
+        }
+    }
+    out
+}
+
+/// [`glowing_box`] and [`shadowed_box`] with every wall but the glowing
+/// ceiling cut into `n × n` tiles, so that clusters form.
+pub fn tiled_box(shadowed: bool, n: usize) -> Scene {
+    let s = if shadowed {
+        shadowed_box()
+    } else {
+        glowing_box()
+    };
+    let polygons = s
+        .polygons
+        .iter()
+        .flat_map(|p| {
+            if p.material.0 == 0 {
+                vec![p.clone()]
+            } else {
+                tiled(p, n)
+            }
+        })
+        .collect();
+    scene(polygons, s.materials)
+}

@@ -131,6 +131,16 @@ pub struct Args {
     #[arg(long)]
     pub(crate) exact_receivers: bool,
 
+    /// Shoot exactly the unshot light, never more.
+    ///
+    /// By default a step also sends out half the light its shooters can
+    /// expect to receive later (the ambient term times their reflectance),
+    /// which converges in fewer steps; what it sent ahead and never
+    /// received is taken back by steps of negative light. This is the
+    /// original algorithm, for comparison.
+    #[arg(long)]
+    pub(crate) no_overshoot: bool,
+
     /// Where unshot radiosity is kept between shooting steps.
     #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]
     pub(crate) unshot: UnshotScheme,

@@ -212,6 +212,7 @@ impl TryFrom<Args> for Invocation {
                 clustering: !args.no_clustering,
                 receiver_interpolation: !args.exact_receivers,
                 hemicube_res: args.hemicube_res,
+                overshoot: !args.no_overshoot,
             },
             size: args.size,
             exposure,
@@ -329,6 +330,7 @@ mod tests {
             "--no-shaft-culling",
             "--no-clustering",
             "--exact-receivers",
+            "--no-overshoot",
             "--aa",
             "5",
             "--size",
@@ -374,6 +376,7 @@ mod tests {
                 clustering: false,
                 receiver_interpolation: false,
                 hemicube_res: crate::solver::hemicube::HemicubeRes::default(),
+                overshoot: false,
             }
         );
         assert_eq!(c.size, Some((32, 24)));

@@ -695,8 +695,8 @@ impl Shooting {
     /// Shoots polygon `shooter` by hemicubes: one at each of its
     /// `samples`, carrying `shot[k]` (its unshot radiosity read there)
     /// over the sample's area, scaled per channel so that the samples
-    /// together carry exactly `power`, the polygon's unshot power
-    /// (radiosity × area) that the step clears: the field read at cell
+    /// together carry exactly `power`, the power (radiosity × area) the
+    /// step takes from the polygon's unshot radiosity: the field read at cell
     /// centres integrates a polygon's vertex field only to second order,
     /// and the difference would be light made or lost. Polygons marked in `receives` get
     /// `ΔB_e = ρ_j Σ_k shot_k F_k(e) A_k / A_e` per element, spread to

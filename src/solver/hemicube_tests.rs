@@ -310,7 +310,7 @@ fn solve(
         solver.radiosity().to_vec(),
         solver.steps(),
         solver.initial_unshot_power(),
-        solver.unshot_power(),
+        solver.net_unshot_power(),
     );
     (m, out.0, out.1, out.2, out.3)
 }
@@ -603,7 +603,7 @@ fn weak_steps_merge_cells_into_fewer_hemicubes_with_the_same_power() {
     solver.step().unwrap();
     let shooter = solver.next_shooter().unwrap();
     let i = shooter.index();
-    solver.read_shooter(shooter);
+    solver.read_shooter(shooter, crate::solver::unshot::Shot::PLAIN);
     let cells = solver.samples[i].len();
     assert_eq!(cells, crate::solver::DEFAULT_SHOOTER_SAMPLES as usize);
     assert!(solver.hemicube_points(shooter, cells).is_none());

@@ -14,6 +14,16 @@
 //! Δb_i  = 0
 //! ```
 //!
+//! **Overshooting** ([`SolverOptions::overshoot`], on by default; Feda and
+//! Purgathofer 1992, the over-relaxation of Gortler, Cohen and Slusallek's
+//! Southwell view of progressive refinement): a shooter also sends the
+//! light it is expected to receive later, `ρ_i ·` [`OVERSHOOT_SHARE`] `·`
+//! [`Progressive::ambient`], and is left at `Δb_i = −` that, filled as the
+//! light arrives; a negative part the shrinking ambient term no longer
+//! covers is shot as negative light (a step of the same gather, its
+//! `Δrad` subtracted). Unshot radiosity is then signed, and the threshold
+//! reads its magnitude.
+//!
 //! A sky (`--sky`, [`crate::scene::Scene::add_sky`]) is an enclosure of
 //! emitting facets that reflect nothing: each shoots like any emitter, from
 //! its own grid of [`formfactor::SKY_FACET_SAMPLES`] points, and its unshot
@@ -61,7 +71,7 @@ use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterS
 use rayon::prelude::*;
 use receivers::CoarseGrid;
 use std::sync::atomic::{AtomicBool, Ordering};
-use unshot::UnshotField;
+use unshot::{Shot, UnshotField};
 
 /// Receiver vertices are grouped in runs of this many consecutive vertices
 /// of one polygon (a stretch of a grid row) for shaft culling: a shaft to
@@ -106,6 +116,15 @@ pub const FULL_STRATA_SHARE: f64 = 0.01;
 /// The fewest strata a clustered step shoots from (unless its cells are
 /// fewer).
 pub const MIN_STRATA: usize = 8;
+
+/// The share of the ambient term ([`Progressive::ambient`]) a polygon is
+/// expected to receive after it shoots, and so sends ahead when it does
+/// ([`SolverOptions::overshoot`]). The ambient term counts every bounce
+/// still to come as if spread evenly; measured on the 15-, 30- and 60-table
+/// halls and the 32-segment spheres (`docs/performance.md`), half of it
+/// took the fewest rays (0.35 and 0.65 within a few per cent, 1 and 2
+/// 10 to 30 % more, some steps sending light back).
+const OVERSHOOT_SHARE: f64 = 0.5;
 
 /// Default fraction of the initial unshot power at which solving stops.
 pub const DEFAULT_THRESHOLD: f64 = 1e-3;
@@ -182,6 +201,13 @@ pub struct SolverOptions {
     /// Pixels across a hemicube's top face, for
     /// [`FormFactorMethod::Hemicube`] (ignored by the other methods).
     pub hemicube_res: hemicube::HemicubeRes,
+    /// Overshoot (Feda and Purgathofer 1992): a step also sends out the
+    /// light its shooters are expected to receive later, `ρ · ambient`
+    /// ([`Progressive::ambient`]), leaving their unshot radiosity negative
+    /// until that light arrives; what is still negative then is shot as
+    /// negative light. Fewer steps to the same residual; off, unshot
+    /// radiosity never goes below zero (the original algorithm).
+    pub overshoot: bool,
 }
 
 /// Where unshot radiosity is kept between shooting steps.
@@ -212,6 +238,7 @@ impl Default for SolverOptions {
             clustering: true,
             receiver_interpolation: true,
             hemicube_res: hemicube::HemicubeRes::default(),
+            overshoot: true,
         }
     }
 }
@@ -227,8 +254,10 @@ pub struct StepReport {
     /// How many polygons shot together: 1, or the members of a cluster
     /// ([`cluster`]).
     pub polygons: u32,
-    /// The power it shot: `A_i · mean(Δb_i)`, in radiosity × area units
-    /// (for a sky facet, weighted as [`Progressive::unshot_power`] says).
+    /// The power it shot: `A_i · mean(Δb_i)` with the overshoot, in
+    /// radiosity × area units (for a sky facet, weighted as
+    /// [`Progressive::unshot_power`] says); negative for a step that shot
+    /// negative light ([`SolverOptions::overshoot`]).
     pub shot_power: f64,
     /// Unshot power left after the step, as a fraction of the initial.
     pub unshot_fraction: f64,
@@ -270,7 +299,7 @@ pub enum SolverError {
         /// Its radiosity, in the scene's emission units.
         value: Rgb,
     },
-    /// An unshot value is negative or not finite.
+    /// An unshot value is not finite.
     #[error("{unit} {index} has unshot radiosity {value:?}")]
     BadUnshot {
         /// What the value belongs to: "polygon" or "vertex" (by
@@ -296,7 +325,8 @@ pub enum SolverError {
         /// Unshot entries this solve has.
         expected_unshot: usize,
     },
-    /// A state to restore holds a negative or non-finite value.
+    /// A state to restore holds a non-finite value, or a negative
+    /// radiosity or charge.
     #[error("the saved state holds a negative or non-finite value")]
     BadStateValue,
 }
@@ -313,8 +343,9 @@ pub enum StopReason {
 /// The state of a progressive solve: a value that is advanced one shooting
 /// step at a time.
 ///
-/// Invariants (checked by [`Progressive::validate`]): every radiosity and
-/// unshot value is finite and non-negative; one radiosity per mesh vertex
+/// Invariants (checked by [`Progressive::validate`]): every radiosity is
+/// finite and non-negative, every unshot value finite (negative only with
+/// [`SolverOptions::overshoot`]); one radiosity per mesh vertex
 /// and one unshot value per polygon or per mesh vertex, by
 /// [`SolverOptions::unshot`].
 pub struct Progressive<'a> {
@@ -570,7 +601,9 @@ impl<'a> Progressive<'a> {
     /// `ambient = R · Σ Δb_i A_i / Σ A_i` with `R = 1 / (1 − ρ̄)` and
     /// `ρ̄ = Σ ρ_i A_i / Σ A_i`, per channel. It estimates what is still
     /// missing from an unconverged solution and tends to zero as the solve
-    /// converges. It is for display only: it never enters the solution.
+    /// converges. With overshooting the unshot radiosity is signed, and so
+    /// is this: what is left to shoot less what was sent ahead. It is for
+    /// display only, and for the overshoot ([`OVERSHOOT_SHARE`]).
     pub fn ambient(&self) -> Rgb {
         ambient_term(&self.mesh, &self.reflectance, &self.power_weight, |j| {
             self.unshot.mean(&self.mesh, j)
@@ -578,8 +611,10 @@ impl<'a> Progressive<'a> {
     }
 
     /// The radiosity to show: per vertex `b + ρ · ambient` (see
-    /// [`Progressive::ambient`]), written into `out` (resized to the vertex
-    /// count). The solution itself is not changed.
+    /// [`Progressive::ambient`]), at least 0 per channel, written into
+    /// `out` (resized to the vertex count). The ambient term is negative
+    /// while overshooting has sent more light ahead than is left to shoot
+    /// ([`SolverOptions::overshoot`]). The solution itself is not changed.
     pub fn radiosity_with_ambient(&self, out: &mut Vec<Rgb>) {
         let ambient = self.ambient();
         out.clear();
@@ -587,27 +622,79 @@ impl<'a> Progressive<'a> {
             self.radiosity
                 .iter()
                 .zip(&self.mesh.vertex_polygon)
-                .map(|(b, p)| *b + self.reflectance[p.index()] * ambient),
+                .map(|(b, p)| (*b + self.reflectance[p.index()] * ambient).max(Rgb::BLACK)),
         );
     }
 
-    /// Total unshot power `Σ A_i · mean(Δb_i)` (per-vertex scheme: the
-    /// sum over vertices of `mean(Δb_l) · vertex area`), in radiosity ×
-    /// area units. A sky's facets count together as at most `S · A_scene`
-    /// (its radiosity times the area of every other polygon), the most it
-    /// can bring to the scene, not its own far larger power (see
-    /// [`sky_power_weights`]).
+    /// Total unshot power: `Σ A_i · mean(|Δb_i|)` (per-vertex scheme: the
+    /// sum over vertices of `mean(|Δb_l|) · vertex area`, per channel), in
+    /// radiosity × area units: how far the solution is from converged,
+    /// counting light still to be sent and light sent ahead by overshooting
+    /// ([`SolverOptions::overshoot`]) alike. A sky's facets count together
+    /// as at most `S · A_scene` (its radiosity times the area of every
+    /// other polygon), the most it can bring to the scene, not its own far
+    /// larger power (see [`sky_power_weights`]).
     pub fn unshot_power(&self) -> f64 {
         (0..self.mesh.polygons.len())
-            .map(|j| self.polygon_unshot_power(j))
+            .map(|j| self.polygon_power(j, Shot::PLAIN) + self.polygon_power(j, Shot::NEGATIVE))
             .sum()
     }
 
-    /// Unshot power of polygon `j`, in radiosity × area units, as it
+    /// The signed unshot power `Σ A_i · mean(Δb_i)`: light still to be sent
+    /// less light sent ahead, in radiosity × area units, weighted as
+    /// [`Progressive::unshot_power`]. Energy balance reads it: emitted =
+    /// absorbed + escaped + this. Equal to [`Progressive::unshot_power`]
+    /// without overshooting.
+    pub fn net_unshot_power(&self) -> f64 {
+        (0..self.mesh.polygons.len())
+            .map(|j| self.polygon_power(j, Shot::PLAIN) - self.polygon_power(j, Shot::NEGATIVE))
+            .sum()
+    }
+
+    /// The power polygon `j` sends out in a step that sends `shot`
+    /// ([`UnshotField::sent_power`], the channel mean), in radiosity ×
+    /// area units, as it
     /// counts for choosing the shooter and for the threshold: a sky
     /// facet's weighted by [`sky_power_weights`].
-    fn polygon_unshot_power(&self, j: usize) -> f64 {
-        self.unshot.power(&self.mesh, j) * self.power_weight[j]
+    fn polygon_power(&self, j: usize, shot: Shot) -> f64 {
+        self.unshot.sent_power(&self.mesh, j, shot).mean() * self.power_weight[j]
+    }
+
+    /// What polygon `j` sends in a step of sign `negative` when the light
+    /// still expected everywhere is `ambient` (before reflectance): its
+    /// part of that sign, with `over = ρ_j · ambient` ([`Shot`]).
+    fn polygon_shot(&self, j: usize, negative: bool, ambient: Rgb) -> Shot {
+        Shot {
+            negative,
+            over: self.reflectance[j] * ambient,
+        }
+    }
+
+    /// The unshot power of polygon `j` due to be shot in a step of sign
+    /// `negative`, weighted as [`Progressive::polygon_power`]: the
+    /// positive part as it is (what it expects to receive does not count:
+    /// a polygon lit by nothing yet would otherwise shoot only light it
+    /// expects), the negative part beyond what it still expects with
+    /// `ambient` (what it sent ahead waits for the light to arrive, and is
+    /// taken back once the ambient term, shrinking as the solve converges,
+    /// no longer promises it).
+    fn polygon_due(&self, j: usize, negative: bool, ambient: Rgb) -> f64 {
+        if negative {
+            self.polygon_power(j, self.polygon_shot(j, true, ambient))
+        } else {
+            self.polygon_power(j, Shot::PLAIN)
+        }
+    }
+
+    /// The overshoot of the next step before each shooter's reflectance:
+    /// the ambient term ([`Progressive::ambient`]) clamped at zero per
+    /// channel, or black without [`SolverOptions::overshoot`].
+    fn overshoot_ambient(&self) -> Rgb {
+        if self.options.overshoot {
+            self.ambient().max(Rgb::BLACK) * OVERSHOOT_SHARE
+        } else {
+            Rgb::BLACK
+        }
     }
 
     /// Unshot power at the start (the emitted power).
@@ -666,8 +753,9 @@ impl<'a> Progressive<'a> {
     /// with the most unshot power, or of the cluster with the most, its
     /// member with the most; `None` when nothing is left to shoot.
     pub fn next_shooter(&self) -> Option<PolygonId> {
-        self.choose_shooter()
-            .map(|(cluster, _)| self.strongest_member(cluster))
+        let ambient = self.overshoot_ambient();
+        self.choose_shooter(ambient)
+            .map(|(cluster, _, negative)| self.strongest_member(cluster, negative, ambient))
     }
 
     /// The clusters the solve shoots from (each polygon alone without
@@ -676,12 +764,12 @@ impl<'a> Progressive<'a> {
         &self.clusters
     }
 
-    /// The member of `cluster` with the most unshot power (the first on
-    /// ties).
-    fn strongest_member(&self, cluster: usize) -> PolygonId {
+    /// The member of `cluster` with the most unshot power due of sign
+    /// `negative` ([`Progressive::polygon_due`]; the first on ties).
+    fn strongest_member(&self, cluster: usize, negative: bool, ambient: Rgb) -> PolygonId {
         let mut best = (0u32, f64::NEG_INFINITY);
         for &m in self.clusters.members(cluster) {
-            let power = self.polygon_unshot_power(m as usize);
+            let power = self.polygon_due(m as usize, negative, ambient);
             if power > best.1 {
                 best = (m, power);
             }
@@ -702,8 +790,9 @@ impl<'a> Progressive<'a> {
     /// returning `None`. A window uses it to quit promptly during a long
     /// step.
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
-        let (cluster, shot_power) = self.choose_shooter()?;
-        let shooter = self.strongest_member(cluster);
+        let ambient = self.overshoot_ambient();
+        let (cluster, shot_power, negative) = self.choose_shooter(ambient)?;
+        let shooter = self.strongest_member(cluster, negative, ambient);
         let roots = self.step_roots(shot_power);
         // Emitters, every polygon without clustering and every polygon of
         // a scene where nothing clusters (a room of large walls, where
@@ -715,26 +804,28 @@ impl<'a> Progressive<'a> {
                 || !self.emission[shooter.index()].is_black()
                 || roots >= self.samples[shooter.index()].len());
         let by_hemicube = self.hemicube.is_some() && !self.mesh.polygons[shooter.index()].sky;
+        let shot = self.polygon_shot(shooter.index(), negative, ambient);
         let gathered = if by_hemicube {
-            self.read_shooter(shooter);
+            self.read_shooter(shooter, shot);
             self.mark_receivers(shooter.index());
             let hemicubes = if self.options.clustering {
                 roots
             } else {
                 usize::MAX
             };
-            self.gather_hemicube(shooter, hemicubes, cancel)?
+            self.gather_hemicube(shooter, shot, hemicubes, cancel)?
         } else if alone {
-            self.read_shooter(shooter);
+            self.read_shooter(shooter, shot);
             self.cull(shooter);
             self.gather(shooter, cancel)?
         } else {
-            self.read_cluster(cluster, roots);
+            self.read_cluster(cluster, roots, negative, ambient);
             self.cull_cluster(cluster);
             let from_top = roots < self.step_roots(f64::INFINITY);
             self.gather_cluster(cluster, from_top, cancel)?
         };
-        Some(self.apply(cluster, shooter, shot_power, gathered))
+        let shot_power = if negative { -shot_power } else { shot_power };
+        Some(self.apply(cluster, shooter, shot_power, ambient, gathered))
     }
 
     /// How many strata a clustered step shoots from at most, for a step
@@ -762,31 +853,41 @@ impl<'a> Progressive<'a> {
     }
 
     /// Phase 1, choose the shooter: the cluster (without clustering, the
-    /// polygon) with the most unshot power (the lowest index on ties) and
-    /// that power, in radiosity × area units; `None` when nothing is left
-    /// to shoot. A linear pass over the polygons: it costs far less than
-    /// the gather, which visits every receiving vertex.
-    fn choose_shooter(&self) -> Option<(usize, f64)> {
-        let mut power = vec![0.0f64; self.clusters.len()];
+    /// polygon) with the most unshot power due of one sign
+    /// ([`Progressive::polygon_due`] with the overshoot `ambient`; the
+    /// lowest index on ties, the positive part before the negative), that
+    /// power in radiosity × area units and whether it is the negative part;
+    /// `None` when nothing is due. A linear pass over the polygons: it
+    /// costs far less than the gather, which visits every receiving
+    /// vertex.
+    fn choose_shooter(&self, ambient: Rgb) -> Option<(usize, f64, bool)> {
+        let mut positive = vec![0.0f64; self.clusters.len()];
+        let mut negative = vec![0.0f64; self.clusters.len()];
         for i in 0..self.mesh.polygons.len() {
-            power[self.clusters.of(PolygonId(i as u32))] += self.polygon_unshot_power(i);
+            let c = self.clusters.of(PolygonId(i as u32));
+            positive[c] += self.polygon_due(i, false, ambient);
+            if self.options.overshoot {
+                negative[c] += self.polygon_due(i, true, ambient);
+            }
         }
-        let mut best: Option<(usize, f64)> = None;
-        for (c, &p) in power.iter().enumerate() {
-            if p > 0.0 && best.is_none_or(|(_, b)| p > b) {
-                best = Some((c, p));
+        let mut best: Option<(usize, f64, bool)> = None;
+        for (c, (&p, &n)) in positive.iter().zip(&negative).enumerate() {
+            for (power, sign) in [(p, false), (n, true)] {
+                if power > 0.0 && best.is_none_or(|(_, b, _)| power > b) {
+                    best = Some((c, power, sign));
+                }
             }
         }
         best
     }
 
     /// Phase 2, read the shooter's samples: fills `self.shot` with the
-    /// unshot radiosity each sample of `shooter` carries
-    /// ([`UnshotField::read_shooter`]).
-    fn read_shooter(&mut self, shooter: PolygonId) {
+    /// radiosity each sample of `shooter` sends in a step that sends
+    /// `shot` ([`UnshotField::read_shooter`]).
+    fn read_shooter(&mut self, shooter: PolygonId, shot: Shot) {
         let i = shooter.index();
         self.unshot
-            .read_shooter(&self.mesh, i, self.samples[i].len(), &mut self.shot);
+            .read_shooter(&self.mesh, i, self.samples[i].len(), shot, &mut self.shot);
     }
 
     /// Phase 3, cull: marks the receivers of `shooter` and, with shaft
@@ -1025,16 +1126,18 @@ impl<'a> Progressive<'a> {
     }
 
     /// Phase 4 by hemicubes ([`hemicube::Shooting::gather`]): `Δrad` of
-    /// every receiving vertex into `self.delta`, from at most `hemicubes`
-    /// hemicubes ([`Progressive::hemicube_points`]).
+    /// every receiving vertex into `self.delta`, from what `shot` sends
+    /// (read into `self.shot`), from at most `hemicubes` hemicubes
+    /// ([`Progressive::hemicube_points`]).
     fn gather_hemicube(
         &mut self,
         shooter: PolygonId,
+        shot: Shot,
         hemicubes: usize,
         cancel: &AtomicBool,
     ) -> Option<Gathered> {
         let i = shooter.index();
-        let power = self.unshot.mean(&self.mesh, i) * self.mesh.polygons[i].area;
+        let power = self.unshot.sent_power(&self.mesh, i, shot);
         let merged = self.hemicube_points(shooter, hemicubes);
         let (samples, shot) = match &merged {
             Some((samples, shot)) => (&samples[..], &shot[..]),
@@ -1114,14 +1217,15 @@ impl<'a> Progressive<'a> {
     /// samples that carry unshot power, with what they carry) and their
     /// strata ([`Strata::build`]), a cut of at most `roots`
     /// ([`Progressive::step_roots`]).
-    fn read_cluster(&mut self, cluster: usize, roots: usize) {
+    fn read_cluster(&mut self, cluster: usize, roots: usize, negative: bool, ambient: Rgb) {
         let mesh: &Mesh = &self.mesh;
         self.cells.clear();
         self.cell_samples.clear();
         for &m in self.clusters.members(cluster) {
             let i = m as usize;
+            let shot = self.polygon_shot(i, negative, ambient);
             self.unshot
-                .read_shooter(mesh, i, self.samples[i].len(), &mut self.shot);
+                .read_shooter(mesh, i, self.samples[i].len(), shot, &mut self.shot);
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
                 if power > 0.0 {
@@ -1345,27 +1449,33 @@ impl<'a> Progressive<'a> {
         )
     }
 
-    /// Phase 5, apply: adds the gathered `Δrad` to every receiver's
-    /// radiosity and unshot radiosity (polygon by polygon in index order,
-    /// so the sums are the same whatever the thread count), clears the
-    /// shooter's unshot radiosity and counts the step. `shot_power` is what
-    /// [`Progressive::choose_shooter`] found the shooter to hold.
+    /// Phase 5, apply: adds the gathered `Δrad` (subtracts it, for a step
+    /// of negative light: `shot_power < 0`) to every receiver's radiosity
+    /// and unshot radiosity (polygon by polygon in index order, so the sums
+    /// are the same whatever the thread count), takes what they sent from
+    /// the shooters' unshot radiosity ([`UnshotField::spend`], with the
+    /// overshoot `ambient` the step read them with) and counts the step.
+    /// `shot_power` is what [`Progressive::choose_shooter`] found the
+    /// shooter to send, signed.
     fn apply(
         &mut self,
         cluster: usize,
         shooter: PolygonId,
         shot_power: f64,
+        ambient: Rgb,
         gathered: Gathered,
     ) -> StepReport {
-        let mesh: &Mesh = &self.mesh;
+        let negative = shot_power < 0.0;
         let culling = self.options.shaft_culling;
         let (mut receivers, mut clear) = (0u64, 0u64);
-        // Cleared first: a cluster's members receive from each other in
+        // Spent first: a cluster's members receive from each other in
         // the step that empties them.
         let members = self.clusters.members(cluster);
         for &m in members {
-            self.unshot.clear(mesh, m as usize);
+            let shot = self.polygon_shot(m as usize, negative, ambient);
+            self.unshot.spend(&self.mesh, m as usize, shot);
         }
+        let mesh: &Mesh = &self.mesh;
         for (j, pm) in mesh.polygons.iter().enumerate() {
             if !self.receives[j] {
                 continue;
@@ -1373,7 +1483,17 @@ impl<'a> Progressive<'a> {
             receivers += 1;
             clear += (culling && !self.small[j] && self.candidates[j].is_empty()) as u64;
             for l in pm.vertices.clone() {
-                self.radiosity[l as usize] += self.delta[l as usize];
+                let l = l as usize;
+                if negative {
+                    self.delta[l] = -self.delta[l];
+                    // Negative light takes back what overshooting sent
+                    // ahead; where the two reached a vertex by other
+                    // sample points, rounding could take a little more
+                    // than it holds.
+                    self.radiosity[l] = (self.radiosity[l] + self.delta[l]).max(Rgb::BLACK);
+                } else {
+                    self.radiosity[l] += self.delta[l];
+                }
             }
             self.unshot.accumulate(mesh, j, &self.delta);
         }
@@ -1486,7 +1606,9 @@ impl<'a> Progressive<'a> {
                 value: self.radiosity[l],
             });
         }
-        if let Some(j) = self.unshot().iter().position(bad) {
+        // Unshot radiosity is negative where overshooting sent light
+        // ahead, so only its finiteness is checked.
+        if let Some(j) = self.unshot().iter().position(|c| !c.is_finite()) {
             return Err(SolverError::BadUnshot {
                 unit: self.unshot.unit(),
                 index: j,
@@ -1521,7 +1643,8 @@ impl<'a> Progressive<'a> {
 
     /// Replaces the solve's state by a saved one from a solve of the same
     /// scene, mesh and options; refuses (and changes nothing) when the
-    /// array sizes differ or a value is not finite and non-negative.
+    /// array sizes differ, a value is not finite, or a radiosity or charge
+    /// is negative.
     pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), SolverError> {
         if state.radiosity.len() != self.radiosity.len()
             || state.unshot.len() != self.unshot.values().len()
@@ -1535,12 +1658,8 @@ impl<'a> Progressive<'a> {
             });
         }
         let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
-        if state
-            .radiosity
-            .iter()
-            .chain(&state.unshot)
-            .chain(&state.charges)
-            .any(bad)
+        if state.radiosity.iter().chain(&state.charges).any(bad)
+            || state.unshot.iter().any(|c| !c.is_finite())
         {
             return Err(SolverError::BadStateValue);
         }
@@ -1827,6 +1946,8 @@ fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
         .collect()
 }
 
+#[cfg(test)]
+mod overshoot_tests;
 #[cfg(test)]
 mod sky_tests;
 #[cfg(test)]

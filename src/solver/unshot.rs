@@ -22,7 +22,9 @@ use crate::mesh::{Mesh, PolygonMesh};
 /// Invariant: [`UnshotField::fits`] the mesh it was made for, that is one
 /// value per polygon ([`UnshotScheme::Polygon`]) or one per mesh vertex
 /// ([`UnshotScheme::Vertex`]); [`super::Progressive::validate`] checks it
-/// and that every value is finite and non-negative.
+/// and that every value is finite. Values are negative where an
+/// overshooting step ([`Shot`]) sent out more than was there; without
+/// overshooting they stay `>= 0`.
 #[derive(Clone, Debug)]
 pub(crate) struct UnshotField {
     /// One value per polygon or per mesh vertex, by `layout`.
@@ -68,6 +70,74 @@ enum SampleSource {
     /// The area-weighted mean over the polygon's vertices (the one-sample
     /// centre estimate).
     PolygonMean,
+}
+
+/// What a step sends out of a polygon's unshot radiosity `Δb`, per
+/// channel, given the light `over >= 0` the polygon still expects to
+/// receive: with `negative` false, `max(Δb + over, 0)`, its positive part
+/// raised by what it expects; with `negative` true, `max(−(Δb + over), 0)`,
+/// the magnitude of the negative part that what it expects will not fill,
+/// sent as negative light. Either way what is sent is `>= 0`, so every
+/// gather works on non-negative light and the step's sign is applied once,
+/// to what it gathered; and the polygon is left at `−over` (or where it
+/// was, on channels with nothing to send).
+///
+/// This is overshooting (Feda and Purgathofer 1992): a polygon sends out
+/// with its own unshot light the light it will receive later, `over = ρ ·
+/// ambient`, so it need not shoot again when that light arrives; its
+/// unshot radiosity stays negative until then. Without overshooting,
+/// `over` is 0 and a step sends exactly the positive part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Shot {
+    /// Send the negative part instead of the positive one.
+    pub(crate) negative: bool,
+    /// The light the polygon still expects, per channel, `>= 0`, in the
+    /// scene's emission units.
+    pub(crate) over: Rgb,
+}
+
+impl Shot {
+    /// The positive part with no overshoot: what a step without
+    /// overshooting sends out.
+    pub(crate) const PLAIN: Shot = Shot {
+        negative: false,
+        over: Rgb::BLACK,
+    };
+
+    /// The whole negative part.
+    pub(crate) const NEGATIVE: Shot = Shot {
+        negative: true,
+        over: Rgb::BLACK,
+    };
+
+    /// What a value `v` sends out, per channel, `>= 0`.
+    fn sent(&self, v: Rgb) -> Rgb {
+        if self.negative {
+            (-(v + self.over)).max(Rgb::BLACK)
+        } else {
+            (v + self.over).max(Rgb::BLACK)
+        }
+    }
+
+    /// `v` after sending [`Shot::sent`] out: `v − sent` for the positive
+    /// part, `v + sent` for the negative one; `−over` on every channel
+    /// that sent anything.
+    fn left(&self, v: Rgb) -> Rgb {
+        if self.negative {
+            v + self.sent(v)
+        } else {
+            v - self.sent(v)
+        }
+    }
+
+    /// The same shot with `over` scaled by `k` (a polygon's open share in
+    /// the per-polygon scheme).
+    fn scaled(&self, k: f64) -> Shot {
+        Shot {
+            over: self.over * k,
+            ..*self
+        }
+    }
 }
 
 impl UnshotField {
@@ -174,7 +244,7 @@ impl UnshotField {
     }
 
     /// Replaces the values; the caller has checked that there are
-    /// [`UnshotField::expected_len`] of them, each finite and `>= 0`.
+    /// [`UnshotField::expected_len`] of them, each finite.
     pub(crate) fn set_values(&mut self, values: Vec<Rgb>) {
         self.values = values;
         // A field carried over from a coarser mesh knows nothing of which
@@ -191,31 +261,72 @@ impl UnshotField {
         match &self.layout {
             Layout::Polygon { .. } => self.values[j],
             Layout::Vertex { vertex_area, .. } => {
-                polygon_mean(&mesh.polygons[j], vertex_area, &self.values)
+                polygon_mean(&mesh.polygons[j], vertex_area, |l| self.values[l])
             }
         }
     }
 
-    /// Unshot power of polygon `j`, `mean(Δb_j) · A_j` (the channel mean),
-    /// in radiosity × area units.
-    pub(crate) fn power(&self, mesh: &Mesh, j: usize) -> f64 {
-        self.mean(mesh, j).mean() * mesh.polygons[j].area
+    /// The power polygon `j` sends out in a step that sends `shot`
+    /// ([`Shot::sent`]), per channel: `Σ sent(Δb) · area` over its
+    /// vertices (its value times its area in the per-polygon scheme),
+    /// `>= 0`, in radiosity × area units. [`Shot::PLAIN`] gives the power
+    /// of the positive part, `mean(Δb_j) · A_j` while nothing is negative.
+    pub(crate) fn sent_power(&self, mesh: &Mesh, j: usize, shot: Shot) -> Rgb {
+        let pm = &mesh.polygons[j];
+        match &self.layout {
+            Layout::Polygon { mean_weight } => {
+                let shot = shot.scaled(open_share(mesh, j, mean_weight));
+                shot.sent(self.values[j]) * pm.area
+            }
+            Layout::Vertex {
+                vertex_area,
+                covered,
+                ..
+            } => {
+                let mut sum = Rgb::BLACK;
+                for l in pm.vertices.clone() {
+                    if !covered.get(l as usize).copied().unwrap_or(false) {
+                        sum += shot.sent(self.values[l as usize]) * vertex_area[l as usize];
+                    }
+                }
+                sum
+            }
+        }
     }
 
-    /// Writes into `out` (cleared first) the unshot radiosity each of
-    /// shooter `i`'s `samples` samples carries: the polygon's value, or
-    /// (per-vertex scheme) the field read at the sample.
-    pub(crate) fn read_shooter(&self, mesh: &Mesh, i: usize, samples: usize, out: &mut Vec<Rgb>) {
+    /// Writes into `out` (cleared first) the radiosity each of shooter
+    /// `i`'s `samples` samples sends out in a step that sends `shot`
+    /// ([`Shot::sent`], `>= 0`): read from the polygon's value, or
+    /// (per-vertex scheme) from the field at the sample. A vertex hidden
+    /// under a coplanar polygon sends nothing.
+    pub(crate) fn read_shooter(
+        &self,
+        mesh: &Mesh,
+        i: usize,
+        samples: usize,
+        shot: Shot,
+        out: &mut Vec<Rgb>,
+    ) {
         out.clear();
         match &self.layout {
-            Layout::Polygon { .. } => out.resize(samples, self.values[i]),
+            Layout::Polygon { mean_weight } => {
+                let shot = shot.scaled(open_share(mesh, i, mean_weight));
+                out.resize(samples, shot.sent(self.values[i]));
+            }
             Layout::Vertex {
                 vertex_area,
                 sources,
-                ..
+                covered,
             } => {
-                let mean = polygon_mean(&mesh.polygons[i], vertex_area, &self.values);
-                read_at_samples(&sources[i], &self.values, mean, out);
+                let sent = |l: usize| {
+                    if covered.get(l).copied().unwrap_or(false) {
+                        Rgb::BLACK
+                    } else {
+                        shot.sent(self.values[l])
+                    }
+                };
+                let mean = polygon_mean(&mesh.polygons[i], vertex_area, sent);
+                read_at_samples(&sources[i], sent, mean, out);
             }
         }
     }
@@ -245,13 +356,22 @@ impl UnshotField {
         }
     }
 
-    /// Sets shooter `i`'s unshot radiosity to zero: it has shot it all.
-    pub(crate) fn clear(&mut self, mesh: &Mesh, i: usize) {
-        match self.layout {
-            Layout::Polygon { .. } => self.values[i] = Rgb::BLACK,
-            Layout::Vertex { .. } => {
+    /// Takes from shooter `i`'s unshot radiosity what a step sending `shot`
+    /// sent out ([`Shot::left`]): without overshoot, its positive part
+    /// becomes 0.
+    pub(crate) fn spend(&mut self, mesh: &Mesh, i: usize, shot: Shot) {
+        match &self.layout {
+            Layout::Polygon { mean_weight } => {
+                let shot = shot.scaled(open_share(mesh, i, mean_weight));
+                self.values[i] = shot.left(self.values[i]);
+            }
+            Layout::Vertex { covered, .. } => {
                 let range = &mesh.polygons[i].vertices;
-                self.values[range.start as usize..range.end as usize].fill(Rgb::BLACK);
+                for l in range.start as usize..range.end as usize {
+                    if !covered.get(l).copied().unwrap_or(false) {
+                        self.values[l] = shot.left(self.values[l]);
+                    }
+                }
             }
         }
     }
@@ -303,8 +423,9 @@ impl UnshotField {
                 .zip(sources)
                 .map(|(pm, sources)| {
                     let mut values = Vec::new();
-                    let mean = polygon_mean(pm, vertex_area, &shot_field);
-                    read_at_samples(sources, &shot_field, mean, &mut values);
+                    let field = |l: usize| shot_field[l];
+                    let mean = polygon_mean(pm, vertex_area, field);
+                    read_at_samples(sources, field, mean, &mut values);
                     values
                 })
                 .collect(),
@@ -312,12 +433,23 @@ impl UnshotField {
     }
 }
 
-/// Area-weighted mean of a per-vertex `field` over polygon `pm`, with
-/// `vertex_area` the area each vertex stands for.
-fn polygon_mean(pm: &PolygonMesh, vertex_area: &[f64], field: &[Rgb]) -> Rgb {
+/// The share of polygon `i` not hidden under a coplanar polygon (the sum
+/// of its vertices' mean weights; 1 when nothing is hidden): in the
+/// per-polygon scheme a value times the area is the power of the open
+/// part, so an overshoot is scaled by it too.
+fn open_share(mesh: &Mesh, i: usize, mean_weight: &[f64]) -> f64 {
+    let range = &mesh.polygons[i].vertices;
+    mean_weight[range.start as usize..range.end as usize]
+        .iter()
+        .sum()
+}
+
+/// Area-weighted mean of a per-vertex `field` (read by vertex index) over
+/// polygon `pm`, with `vertex_area` the area each vertex stands for.
+fn polygon_mean(pm: &PolygonMesh, vertex_area: &[f64], field: impl Fn(usize) -> Rgb) -> Rgb {
     let mut sum = Rgb::BLACK;
     for l in pm.vertices.clone() {
-        sum += field[l as usize] * vertex_area[l as usize];
+        sum += field(l as usize) * vertex_area[l as usize];
     }
     if pm.area > 0.0 {
         sum / pm.area
@@ -326,18 +458,23 @@ fn polygon_mean(pm: &PolygonMesh, vertex_area: &[f64], field: &[Rgb]) -> Rgb {
     }
 }
 
-/// Appends to `out` the per-vertex `field` read at each of a polygon's
-/// samples, whose `sources` say where (interpolated within the element
-/// triangle holding the sample); `mean` for samples that stand for the
-/// whole polygon.
-fn read_at_samples(sources: &[SampleSource], field: &[Rgb], mean: Rgb, out: &mut Vec<Rgb>) {
+/// Appends to `out` the per-vertex `field` (read by vertex index) at each
+/// of a polygon's samples, whose `sources` say where (interpolated within
+/// the element triangle holding the sample); `mean` for samples that stand
+/// for the whole polygon.
+fn read_at_samples(
+    sources: &[SampleSource],
+    field: impl Fn(usize) -> Rgb,
+    mean: Rgb,
+    out: &mut Vec<Rgb>,
+) {
     for source in sources {
         let value = match *source {
-            SampleSource::Vertex(l) => field[l as usize],
+            SampleSource::Vertex(l) => field(l as usize),
             SampleSource::Triangle(v, w) => {
                 let mut sum = Rgb::BLACK;
                 for (l, weight) in v.iter().zip(w) {
-                    sum += field[*l as usize] * f64::from(weight.max(0.0));
+                    sum += field(*l as usize) * f64::from(weight.max(0.0));
                 }
                 sum / f64::from(
                     w.iter()
@@ -402,6 +539,32 @@ fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f
 
 #[cfg(test)]
 mod tests {
+    use super::Shot;
+    use crate::color::Rgb;
+
+    /// A shot sends, per channel, its sign's part beyond what the polygon
+    /// still expects (`over`), and leaves it at `−over` where it sent.
+    #[test]
+    fn a_shot_leaves_the_light_still_expected() {
+        let over = Rgb::new(0.5, 0.5, 0.5);
+        let v = Rgb::new(2.0, -0.25, -1.0);
+        let up = Shot {
+            negative: false,
+            over,
+        };
+        assert_eq!(up.sent(v), Rgb::new(2.5, 0.25, 0.0));
+        assert_eq!(up.left(v), Rgb::new(-0.5, -0.5, -1.0));
+        let down = Shot {
+            negative: true,
+            over,
+        };
+        assert_eq!(down.sent(v), Rgb::new(0.0, 0.0, 0.5));
+        assert_eq!(down.left(v), Rgb::new(2.0, -0.25, -0.5));
+        // Without overshoot: the positive part all sent, the rest kept.
+        assert_eq!(Shot::PLAIN.left(v), Rgb::new(0.0, -0.25, -1.0));
+        assert_eq!(Shot::NEGATIVE.sent(v), Rgb::new(0.0, 0.25, 1.0));
+    }
+
     #[test]
     fn barycentric_weights_reproduce_the_point() {
         let (a, b, c) = (
