@@ -70,6 +70,11 @@ impl Rgb {
         Rgb::new(self.r.max(o.r), self.g.max(o.g), self.b.max(o.b))
     }
 
+    /// The channel-wise minimum of `self` and `o`.
+    pub fn min(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r.min(o.r), self.g.min(o.g), self.b.min(o.b))
+    }
+
     /// The channels as an array `[r, g, b]`.
     pub fn to_array(self) -> [f64; 3] {
         [self.r, self.g, self.b]

@@ -133,11 +133,12 @@ pub struct Args {
 
     /// Shoot exactly the unshot light, never more.
     ///
-    /// By default a step also sends out half the light its shooters can
-    /// expect to receive later (the ambient term times their reflectance),
-    /// which converges in fewer steps; what it sent ahead and never
-    /// received is taken back by steps of negative light. This is the
-    /// original algorithm, for comparison.
+    /// By default each point of a shooter also sends out the light it can
+    /// expect to receive later (what it has received so far times the ratio
+    /// of light still to come to light shot, at most half its reflectance
+    /// times the ambient term), which converges in fewer steps; what it
+    /// sent ahead and never received is taken back by steps of negative
+    /// light. This is the original algorithm, for comparison.
     #[arg(long)]
     pub(crate) no_overshoot: bool,
 

@@ -16,13 +16,14 @@
 //!
 //! **Overshooting** ([`SolverOptions::overshoot`], on by default; Feda and
 //! Purgathofer 1992, the over-relaxation of Gortler, Cohen and Slusallek's
-//! Southwell view of progressive refinement): a shooter also sends the
-//! light it is expected to receive later, `ρ_i ·` [`OVERSHOOT_SHARE`] `·`
-//! [`Progressive::ambient`], and is left at `Δb_i = −` that, filled as the
-//! light arrives; a negative part the shrinking ambient term no longer
-//! covers is shot as negative light (a step of the same gather, its
-//! `Δrad` subtracted). Unshot radiosity is then signed, and the threshold
-//! reads its magnitude.
+//! Southwell view of progressive refinement): each point of a shooter
+//! also sends the light it expects to receive later ([`Expectation`]:
+//! what it has received so far times the ratio of light still to come to
+//! light shot, capped by its share of the ambient term), and is left at
+//! `Δb = −` that, filled as the light arrives; a negative part the
+//! shrinking expectation no longer covers is shot as negative light (a
+//! step of the same gather, its `Δrad` subtracted). Unshot radiosity is
+//! then signed, and the threshold reads its magnitude.
 //!
 //! A sky (`--sky`, [`crate::scene::Scene::add_sky`]) is an enclosure of
 //! emitting facets that reflect nothing: each shoots like any emitter, from
@@ -117,14 +118,42 @@ pub const FULL_STRATA_SHARE: f64 = 0.01;
 /// fewer).
 pub const MIN_STRATA: usize = 8;
 
-/// The share of the ambient term ([`Progressive::ambient`]) a polygon is
-/// expected to receive after it shoots, and so sends ahead when it does
-/// ([`SolverOptions::overshoot`]). The ambient term counts every bounce
-/// still to come as if spread evenly; measured on the 15-, 30- and 60-table
-/// halls and the 32-segment spheres (`docs/performance.md`), half of it
-/// took the fewest rays (0.35 and 0.65 within a few per cent, 1 and 2
-/// 10 to 30 % more, some steps sending light back).
+/// The share of the ambient term ([`Progressive::ambient`]) times its
+/// reflectance that a point may expect to receive later, and so send ahead
+/// when it shoots ([`SolverOptions::overshoot`], [`Expectation`]). The
+/// ambient term counts every bounce still to come as if spread evenly;
+/// measured as the only expectation on the 15-, 30- and 60-table halls and
+/// the 32-segment spheres (`docs/performance.md`), half of it took the
+/// fewest rays (0.35 and 0.65 within a few per cent, 1 and 2 10 to 30 %
+/// more, some steps sending light back).
 const OVERSHOOT_SHARE: f64 = 0.5;
+
+/// What a step expects each point to receive later (overshooting, [`Shot`]):
+/// a point that has received `r` so far expects `min(gain · r, ρ ·
+/// ambient)` per channel. The first is local: a point that received `r`
+/// of the `S` shot so far should receive about `r · U / S` of the `U`
+/// still to shoot, and `R = 1 / (1 − ρ̄)` times that with its bounces, so
+/// `gain = R · U / S`; it keeps points in dark corners from sending ahead
+/// light they will never get (with the ambient term alone, the facets
+/// where a sphere rests on the floor came out 27 % too bright at 0.01 %
+/// unshot). The second caps it where the light received so far is mostly
+/// direct, which lamps spread far less evenly than its later bounces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Expectation {
+    /// `R · U / S` (see above), `>= 0`.
+    gain: f64,
+    /// [`OVERSHOOT_SHARE`] times the ambient term, clamped at 0 per
+    /// channel, in the scene's emission units.
+    ambient: Rgb,
+}
+
+impl Expectation {
+    /// Nothing expected: no overshoot.
+    const NONE: Expectation = Expectation {
+        gain: 0.0,
+        ambient: Rgb::BLACK,
+    };
+}
 
 /// Default fraction of the initial unshot power at which solving stops.
 pub const DEFAULT_THRESHOLD: f64 = 1e-3;
@@ -603,7 +632,7 @@ impl<'a> Progressive<'a> {
     /// missing from an unconverged solution and tends to zero as the solve
     /// converges. With overshooting the unshot radiosity is signed, and so
     /// is this: what is left to shoot less what was sent ahead. It is for
-    /// display only, and for the overshoot ([`OVERSHOOT_SHARE`]).
+    /// display only, and for the overshoot ([`Expectation`]).
     pub fn ambient(&self) -> Rgb {
         ambient_term(&self.mesh, &self.reflectance, &self.power_weight, |j| {
             self.unshot.mean(&self.mesh, j)
@@ -657,43 +686,63 @@ impl<'a> Progressive<'a> {
     /// counts for choosing the shooter and for the threshold: a sky
     /// facet's weighted by [`sky_power_weights`].
     fn polygon_power(&self, j: usize, shot: Shot) -> f64 {
-        self.unshot.sent_power(&self.mesh, j, shot).mean() * self.power_weight[j]
-    }
-
-    /// What polygon `j` sends in a step of sign `negative` when the light
-    /// still expected everywhere is `ambient` (before reflectance): its
-    /// part of that sign, with `over = ρ_j · ambient` ([`Shot`]).
-    fn polygon_shot(&self, j: usize, negative: bool, ambient: Rgb) -> Shot {
-        Shot {
-            negative,
-            over: self.reflectance[j] * ambient,
-        }
+        let received = |l: usize| self.radiosity[l] - self.emission[j];
+        self.unshot.sent_power(&self.mesh, j, shot, received).mean() * self.power_weight[j]
     }
 
     /// The unshot power of polygon `j` due to be shot in a step of sign
     /// `negative`, weighted as [`Progressive::polygon_power`]: the
     /// positive part as it is (what it expects to receive does not count:
-    /// a polygon lit by nothing yet would otherwise shoot only light it
-    /// expects), the negative part beyond what it still expects with
-    /// `ambient` (what it sent ahead waits for the light to arrive, and is
-    /// taken back once the ambient term, shrinking as the solve converges,
-    /// no longer promises it).
-    fn polygon_due(&self, j: usize, negative: bool, ambient: Rgb) -> f64 {
+    /// it would only be sent ahead), the negative part beyond what it still
+    /// expects ([`Progressive::polygon_shot`]; what it sent ahead waits for
+    /// the light to arrive, and is taken back once the expectation,
+    /// shrinking as the solve converges, no longer covers it).
+    fn polygon_due(&self, j: usize, negative: bool, expected: Expectation) -> f64 {
         if negative {
-            self.polygon_power(j, self.polygon_shot(j, true, ambient))
+            self.polygon_power(j, self.polygon_shot(j, true, expected))
         } else {
             self.polygon_power(j, Shot::PLAIN)
         }
     }
 
-    /// The overshoot of the next step before each shooter's reflectance:
-    /// the ambient term ([`Progressive::ambient`]) clamped at zero per
-    /// channel, or black without [`SolverOptions::overshoot`].
-    fn overshoot_ambient(&self) -> Rgb {
-        if self.options.overshoot {
-            self.ambient().max(Rgb::BLACK) * OVERSHOOT_SHARE
-        } else {
-            Rgb::BLACK
+    /// What the next step expects every point to receive later
+    /// ([`Expectation`]); nothing without [`SolverOptions::overshoot`].
+    fn expectation(&self) -> Expectation {
+        if !self.options.overshoot {
+            return Expectation::NONE;
+        }
+        let ambient = self.ambient().max(Rgb::BLACK) * OVERSHOOT_SHARE;
+        let (mut shot, mut area, mut reflected) = (0.0, 0.0, 0.0);
+        for (j, pm) in self.mesh.polygons.iter().enumerate() {
+            shot += self
+                .unshot
+                .shot_so_far(&self.mesh, j, &self.radiosity)
+                .mean()
+                * self.power_weight[j];
+            if !pm.sky {
+                area += pm.area;
+                reflected += self.reflectance[j].mean() * pm.area;
+            }
+        }
+        let left = self.net_unshot_power();
+        if shot <= 0.0 || left <= 0.0 || area <= 0.0 {
+            return Expectation::NONE;
+        }
+        let r = 1.0 / (1.0 - reflected / area);
+        Expectation {
+            gain: r * left / shot,
+            ambient,
+        }
+    }
+
+    /// The shot of polygon `j` in a step of sign `negative` ([`Shot`]):
+    /// each of its points expects `gain` times what it has received, at
+    /// most `ρ_j ·` the step's share of the ambient term.
+    fn polygon_shot(&self, j: usize, negative: bool, expected: Expectation) -> Shot {
+        Shot {
+            negative,
+            gain: expected.gain,
+            cap: self.reflectance[j] * expected.ambient,
         }
     }
 
@@ -753,9 +802,9 @@ impl<'a> Progressive<'a> {
     /// with the most unshot power, or of the cluster with the most, its
     /// member with the most; `None` when nothing is left to shoot.
     pub fn next_shooter(&self) -> Option<PolygonId> {
-        let ambient = self.overshoot_ambient();
-        self.choose_shooter(ambient)
-            .map(|(cluster, _, negative)| self.strongest_member(cluster, negative, ambient))
+        let expected = self.expectation();
+        self.choose_shooter(expected)
+            .map(|(cluster, _, negative)| self.strongest_member(cluster, negative, expected))
     }
 
     /// The clusters the solve shoots from (each polygon alone without
@@ -766,10 +815,10 @@ impl<'a> Progressive<'a> {
 
     /// The member of `cluster` with the most unshot power due of sign
     /// `negative` ([`Progressive::polygon_due`]; the first on ties).
-    fn strongest_member(&self, cluster: usize, negative: bool, ambient: Rgb) -> PolygonId {
+    fn strongest_member(&self, cluster: usize, negative: bool, expected: Expectation) -> PolygonId {
         let mut best = (0u32, f64::NEG_INFINITY);
         for &m in self.clusters.members(cluster) {
-            let power = self.polygon_due(m as usize, negative, ambient);
+            let power = self.polygon_due(m as usize, negative, expected);
             if power > best.1 {
                 best = (m, power);
             }
@@ -790,9 +839,9 @@ impl<'a> Progressive<'a> {
     /// returning `None`. A window uses it to quit promptly during a long
     /// step.
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
-        let ambient = self.overshoot_ambient();
-        let (cluster, shot_power, negative) = self.choose_shooter(ambient)?;
-        let shooter = self.strongest_member(cluster, negative, ambient);
+        let expected = self.expectation();
+        let (cluster, shot_power, negative) = self.choose_shooter(expected)?;
+        let shooter = self.strongest_member(cluster, negative, expected);
         let roots = self.step_roots(shot_power);
         // Emitters, every polygon without clustering and every polygon of
         // a scene where nothing clusters (a room of large walls, where
@@ -804,7 +853,7 @@ impl<'a> Progressive<'a> {
                 || !self.emission[shooter.index()].is_black()
                 || roots >= self.samples[shooter.index()].len());
         let by_hemicube = self.hemicube.is_some() && !self.mesh.polygons[shooter.index()].sky;
-        let shot = self.polygon_shot(shooter.index(), negative, ambient);
+        let shot = self.polygon_shot(shooter.index(), negative, expected);
         let gathered = if by_hemicube {
             self.read_shooter(shooter, shot);
             self.mark_receivers(shooter.index());
@@ -819,13 +868,13 @@ impl<'a> Progressive<'a> {
             self.cull(shooter);
             self.gather(shooter, cancel)?
         } else {
-            self.read_cluster(cluster, roots, negative, ambient);
+            self.read_cluster(cluster, roots, negative, expected);
             self.cull_cluster(cluster);
             let from_top = roots < self.step_roots(f64::INFINITY);
             self.gather_cluster(cluster, from_top, cancel)?
         };
         let shot_power = if negative { -shot_power } else { shot_power };
-        Some(self.apply(cluster, shooter, shot_power, ambient, gathered))
+        Some(self.apply(cluster, shooter, shot_power, expected, gathered))
     }
 
     /// How many strata a clustered step shoots from at most, for a step
@@ -854,20 +903,20 @@ impl<'a> Progressive<'a> {
 
     /// Phase 1, choose the shooter: the cluster (without clustering, the
     /// polygon) with the most unshot power due of one sign
-    /// ([`Progressive::polygon_due`] with the overshoot `ambient`; the
+    /// ([`Progressive::polygon_due`] with the step's `expected` light; the
     /// lowest index on ties, the positive part before the negative), that
     /// power in radiosity × area units and whether it is the negative part;
     /// `None` when nothing is due. A linear pass over the polygons: it
     /// costs far less than the gather, which visits every receiving
     /// vertex.
-    fn choose_shooter(&self, ambient: Rgb) -> Option<(usize, f64, bool)> {
+    fn choose_shooter(&self, expected: Expectation) -> Option<(usize, f64, bool)> {
         let mut positive = vec![0.0f64; self.clusters.len()];
         let mut negative = vec![0.0f64; self.clusters.len()];
         for i in 0..self.mesh.polygons.len() {
             let c = self.clusters.of(PolygonId(i as u32));
-            positive[c] += self.polygon_due(i, false, ambient);
+            positive[c] += self.polygon_due(i, false, expected);
             if self.options.overshoot {
-                negative[c] += self.polygon_due(i, true, ambient);
+                negative[c] += self.polygon_due(i, true, expected);
             }
         }
         let mut best: Option<(usize, f64, bool)> = None;
@@ -886,8 +935,11 @@ impl<'a> Progressive<'a> {
     /// `shot` ([`UnshotField::read_shooter`]).
     fn read_shooter(&mut self, shooter: PolygonId, shot: Shot) {
         let i = shooter.index();
+        let (radiosity, e) = (&self.radiosity, self.emission[i]);
+        let received = |l: usize| radiosity[l] - e;
+        let samples = self.samples[i].len();
         self.unshot
-            .read_shooter(&self.mesh, i, self.samples[i].len(), shot, &mut self.shot);
+            .read_shooter(&self.mesh, i, samples, shot, received, &mut self.shot);
     }
 
     /// Phase 3, cull: marks the receivers of `shooter` and, with shaft
@@ -1137,7 +1189,10 @@ impl<'a> Progressive<'a> {
         cancel: &AtomicBool,
     ) -> Option<Gathered> {
         let i = shooter.index();
-        let power = self.unshot.sent_power(&self.mesh, i, shot);
+        let e = self.emission[i];
+        let power = self
+            .unshot
+            .sent_power(&self.mesh, i, shot, |l| self.radiosity[l] - e);
         let merged = self.hemicube_points(shooter, hemicubes);
         let (samples, shot) = match &merged {
             Some((samples, shot)) => (&samples[..], &shot[..]),
@@ -1217,15 +1272,29 @@ impl<'a> Progressive<'a> {
     /// samples that carry unshot power, with what they carry) and their
     /// strata ([`Strata::build`]), a cut of at most `roots`
     /// ([`Progressive::step_roots`]).
-    fn read_cluster(&mut self, cluster: usize, roots: usize, negative: bool, ambient: Rgb) {
+    fn read_cluster(
+        &mut self,
+        cluster: usize,
+        roots: usize,
+        negative: bool,
+        expected: Expectation,
+    ) {
         let mesh: &Mesh = &self.mesh;
         self.cells.clear();
         self.cell_samples.clear();
         for &m in self.clusters.members(cluster) {
             let i = m as usize;
-            let shot = self.polygon_shot(i, negative, ambient);
-            self.unshot
-                .read_shooter(mesh, i, self.samples[i].len(), shot, &mut self.shot);
+            let shot = self.polygon_shot(i, negative, expected);
+            let (radiosity, e) = (&self.radiosity, self.emission[i]);
+            let received = |l: usize| radiosity[l] - e;
+            self.unshot.read_shooter(
+                mesh,
+                i,
+                self.samples[i].len(),
+                shot,
+                received,
+                &mut self.shot,
+            );
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
                 if power > 0.0 {
@@ -1454,7 +1523,7 @@ impl<'a> Progressive<'a> {
     /// and unshot radiosity (polygon by polygon in index order, so the sums
     /// are the same whatever the thread count), takes what they sent from
     /// the shooters' unshot radiosity ([`UnshotField::spend`], with the
-    /// overshoot `ambient` the step read them with) and counts the step.
+    /// `expected` light the step read them with) and counts the step.
     /// `shot_power` is what [`Progressive::choose_shooter`] found the
     /// shooter to send, signed.
     fn apply(
@@ -1462,7 +1531,7 @@ impl<'a> Progressive<'a> {
         cluster: usize,
         shooter: PolygonId,
         shot_power: f64,
-        ambient: Rgb,
+        expected: Expectation,
         gathered: Gathered,
     ) -> StepReport {
         let negative = shot_power < 0.0;
@@ -1472,8 +1541,10 @@ impl<'a> Progressive<'a> {
         // the step that empties them.
         let members = self.clusters.members(cluster);
         for &m in members {
-            let shot = self.polygon_shot(m as usize, negative, ambient);
-            self.unshot.spend(&self.mesh, m as usize, shot);
+            let shot = self.polygon_shot(m as usize, negative, expected);
+            let (radiosity, e) = (&self.radiosity, self.emission[m as usize]);
+            let received = |l: usize| radiosity[l] - e;
+            self.unshot.spend(&self.mesh, m as usize, shot, received);
         }
         let mesh: &Mesh = &self.mesh;
         for (j, pm) in mesh.polygons.iter().enumerate() {

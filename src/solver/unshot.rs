@@ -72,28 +72,32 @@ enum SampleSource {
     PolygonMean,
 }
 
-/// What a step sends out of a polygon's unshot radiosity `Δb`, per
-/// channel, given the light `over >= 0` the polygon still expects to
-/// receive: with `negative` false, `max(Δb + over, 0)`, its positive part
-/// raised by what it expects; with `negative` true, `max(−(Δb + over), 0)`,
-/// the magnitude of the negative part that what it expects will not fill,
-/// sent as negative light. Either way what is sent is `>= 0`, so every
-/// gather works on non-negative light and the step's sign is applied once,
-/// to what it gathered; and the polygon is left at `−over` (or where it
-/// was, on channels with nothing to send).
+/// What a step sends out of a shooter's unshot radiosity: the part of one
+/// sign, raised by the light each point still expects (overshooting, Feda
+/// and Purgathofer 1992).
 ///
-/// This is overshooting (Feda and Purgathofer 1992): a polygon sends out
-/// with its own unshot light the light it will receive later, `over = ρ ·
-/// ambient`, so it need not shoot again when that light arrives; its
-/// unshot radiosity stays negative until then. Without overshooting,
-/// `over` is 0 and a step sends exactly the positive part.
+/// A point that shoots now would shoot again for every bounce of light
+/// that reaches it later. With overshooting it sends that light ahead: it
+/// expects `over = min(gain · r, cap)` more, per channel, where `r` is
+/// the light it has received so far, `b − e` (its radiosity less its
+/// emission, at least 0; 0 on a polygon that reflects nothing). A point in a dark
+/// corner thus sends ahead little. The positive part sends `max(Δb + over,
+/// 0)`; the negative part sends `max(−(Δb + over), 0)` as negative light
+/// (what it sent ahead beyond what it still expects). Either way what is
+/// sent is `>= 0`, so every gather works on non-negative light and the
+/// step's sign is applied once, to what it gathered; the point is left at
+/// `Δb = −over` on every channel that sent anything, and that is filled as
+/// the light arrives. Without overshooting `gain` and `cap` are 0 and a
+/// step sends exactly the positive part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Shot {
     /// Send the negative part instead of the positive one.
     pub(crate) negative: bool,
-    /// The light the polygon still expects, per channel, `>= 0`, in the
+    /// Light still expected per unit of light received so far, `>= 0`.
+    pub(crate) gain: f64,
+    /// The most light a point expects, per channel, `>= 0`, in the
     /// scene's emission units.
-    pub(crate) over: Rgb,
+    pub(crate) cap: Rgb,
 }
 
 impl Shot {
@@ -101,15 +105,35 @@ impl Shot {
     /// overshooting sends out.
     pub(crate) const PLAIN: Shot = Shot {
         negative: false,
-        over: Rgb::BLACK,
+        gain: 0.0,
+        cap: Rgb::BLACK,
     };
 
     /// The whole negative part.
     pub(crate) const NEGATIVE: Shot = Shot {
         negative: true,
-        over: Rgb::BLACK,
+        gain: 0.0,
+        cap: Rgb::BLACK,
     };
 
+    /// The shot at a point that has received `received` so far.
+    fn at(&self, received: Rgb) -> Part {
+        Part {
+            negative: self.negative,
+            over: (received.max(Rgb::BLACK) * self.gain).min(self.cap),
+        }
+    }
+}
+
+/// [`Shot`] at one point: its sign and the light `over >= 0` the point
+/// still expects, per channel, in the scene's emission units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Part {
+    negative: bool,
+    over: Rgb,
+}
+
+impl Part {
     /// What a value `v` sends out, per channel, `>= 0`.
     fn sent(&self, v: Rgb) -> Rgb {
         if self.negative {
@@ -119,7 +143,7 @@ impl Shot {
         }
     }
 
-    /// `v` after sending [`Shot::sent`] out: `v − sent` for the positive
+    /// `v` after sending [`Part::sent`] out: `v − sent` for the positive
     /// part, `v + sent` for the negative one; `−over` on every channel
     /// that sent anything.
     fn left(&self, v: Rgb) -> Rgb {
@@ -127,15 +151,6 @@ impl Shot {
             v + self.sent(v)
         } else {
             v - self.sent(v)
-        }
-    }
-
-    /// The same shot with `over` scaled by `k` (a polygon's open share in
-    /// the per-polygon scheme).
-    fn scaled(&self, k: f64) -> Shot {
-        Shot {
-            over: self.over * k,
-            ..*self
         }
     }
 }
@@ -267,16 +282,24 @@ impl UnshotField {
     }
 
     /// The power polygon `j` sends out in a step that sends `shot`
-    /// ([`Shot::sent`]), per channel: `Σ sent(Δb) · area` over its
-    /// vertices (its value times its area in the per-polygon scheme),
-    /// `>= 0`, in radiosity × area units. [`Shot::PLAIN`] gives the power
-    /// of the positive part, `mean(Δb_j) · A_j` while nothing is negative.
-    pub(crate) fn sent_power(&self, mesh: &Mesh, j: usize, shot: Shot) -> Rgb {
+    /// ([`Shot`]), per channel: `Σ sent(Δb) · area` over its vertices (its
+    /// value times its area in the per-polygon scheme), `>= 0`, in radiosity
+    /// × area units. `received` gives, per mesh vertex, the light it has
+    /// received so far (`b − e`), for the overshoot. [`Shot::PLAIN`] gives
+    /// the power of the positive part, `mean(Δb_j) · A_j` while nothing is
+    /// negative.
+    pub(crate) fn sent_power(
+        &self,
+        mesh: &Mesh,
+        j: usize,
+        shot: Shot,
+        received: impl Fn(usize) -> Rgb,
+    ) -> Rgb {
         let pm = &mesh.polygons[j];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
-                let shot = shot.scaled(open_share(mesh, j, mean_weight));
-                shot.sent(self.values[j]) * pm.area
+                let part = shot.at(polygon_received(pm, mean_weight, received));
+                part.sent(self.values[j]) * pm.area
             }
             Layout::Vertex {
                 vertex_area,
@@ -285,8 +308,9 @@ impl UnshotField {
             } => {
                 let mut sum = Rgb::BLACK;
                 for l in pm.vertices.clone() {
-                    if !covered.get(l as usize).copied().unwrap_or(false) {
-                        sum += shot.sent(self.values[l as usize]) * vertex_area[l as usize];
+                    let l = l as usize;
+                    if !covered.get(l).copied().unwrap_or(false) {
+                        sum += shot.at(received(l)).sent(self.values[l]) * vertex_area[l];
                     }
                 }
                 sum
@@ -295,23 +319,26 @@ impl UnshotField {
     }
 
     /// Writes into `out` (cleared first) the radiosity each of shooter
-    /// `i`'s `samples` samples sends out in a step that sends `shot`
-    /// ([`Shot::sent`], `>= 0`): read from the polygon's value, or
-    /// (per-vertex scheme) from the field at the sample. A vertex hidden
-    /// under a coplanar polygon sends nothing.
+    /// `i`'s `samples` samples sends in a step that sends `shot`
+    /// ([`Shot`], `>= 0`; `received` as for [`UnshotField::sent_power`]):
+    /// read from the polygon's value, or (per-vertex scheme) from the field
+    /// at the sample. A vertex hidden under a coplanar polygon sends
+    /// nothing.
     pub(crate) fn read_shooter(
         &self,
         mesh: &Mesh,
         i: usize,
         samples: usize,
         shot: Shot,
+        received: impl Fn(usize) -> Rgb,
         out: &mut Vec<Rgb>,
     ) {
         out.clear();
+        let pm = &mesh.polygons[i];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
-                let shot = shot.scaled(open_share(mesh, i, mean_weight));
-                out.resize(samples, shot.sent(self.values[i]));
+                let part = shot.at(polygon_received(pm, mean_weight, received));
+                out.resize(samples, part.sent(self.values[i]));
             }
             Layout::Vertex {
                 vertex_area,
@@ -322,10 +349,10 @@ impl UnshotField {
                     if covered.get(l).copied().unwrap_or(false) {
                         Rgb::BLACK
                     } else {
-                        shot.sent(self.values[l])
+                        shot.at(received(l)).sent(self.values[l])
                     }
                 };
-                let mean = polygon_mean(&mesh.polygons[i], vertex_area, sent);
+                let mean = polygon_mean(pm, vertex_area, sent);
                 read_at_samples(&sources[i], sent, mean, out);
             }
         }
@@ -357,21 +384,55 @@ impl UnshotField {
     }
 
     /// Takes from shooter `i`'s unshot radiosity what a step sending `shot`
-    /// sent out ([`Shot::left`]): without overshoot, its positive part
-    /// becomes 0.
-    pub(crate) fn spend(&mut self, mesh: &Mesh, i: usize, shot: Shot) {
+    /// sent out ([`Shot`]; `received` as for [`UnshotField::sent_power`]):
+    /// without overshoot, its positive part becomes 0.
+    pub(crate) fn spend(
+        &mut self,
+        mesh: &Mesh,
+        i: usize,
+        shot: Shot,
+        received: impl Fn(usize) -> Rgb,
+    ) {
+        let pm = &mesh.polygons[i];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
-                let shot = shot.scaled(open_share(mesh, i, mean_weight));
-                self.values[i] = shot.left(self.values[i]);
+                let part = shot.at(polygon_received(pm, mean_weight, received));
+                self.values[i] = part.left(self.values[i]);
             }
             Layout::Vertex { covered, .. } => {
-                let range = &mesh.polygons[i].vertices;
-                for l in range.start as usize..range.end as usize {
+                for l in pm.vertices.start as usize..pm.vertices.end as usize {
                     if !covered.get(l).copied().unwrap_or(false) {
-                        self.values[l] = shot.left(self.values[l]);
+                        self.values[l] = shot.at(received(l)).left(self.values[l]);
                     }
                 }
+            }
+        }
+    }
+
+    /// The light polygon `j` has shot so far, per channel, in radiosity ×
+    /// area units: `Σ (b − Δb) · area` over its vertices (`radiosity` is
+    /// `b` per mesh vertex; hidden vertices never shoot), or `(mean b −
+    /// Δb) · A` in the per-polygon scheme. At the start `b = Δb = e` and it
+    /// is 0; a step adds what the shooter sent and leaves every receiver's
+    /// unchanged.
+    pub(crate) fn shot_so_far(&self, mesh: &Mesh, j: usize, radiosity: &[Rgb]) -> Rgb {
+        let pm = &mesh.polygons[j];
+        match &self.layout {
+            Layout::Polygon { mean_weight } => {
+                (polygon_received(pm, mean_weight, |l| radiosity[l]) - self.values[j]) * pm.area
+            }
+            Layout::Vertex {
+                vertex_area,
+                covered,
+                ..
+            } => {
+                let mut sum = Rgb::BLACK;
+                for l in pm.vertices.start as usize..pm.vertices.end as usize {
+                    if !covered.get(l).copied().unwrap_or(false) {
+                        sum += (radiosity[l] - self.values[l]) * vertex_area[l];
+                    }
+                }
+                sum
             }
         }
     }
@@ -433,15 +494,16 @@ impl UnshotField {
     }
 }
 
-/// The share of polygon `i` not hidden under a coplanar polygon (the sum
-/// of its vertices' mean weights; 1 when nothing is hidden): in the
-/// per-polygon scheme a value times the area is the power of the open
-/// part, so an overshoot is scaled by it too.
-fn open_share(mesh: &Mesh, i: usize, mean_weight: &[f64]) -> f64 {
-    let range = &mesh.polygons[i].vertices;
-    mean_weight[range.start as usize..range.end as usize]
-        .iter()
-        .sum()
+/// The light polygon `pm` has received so far in the per-polygon scheme:
+/// `received` (per vertex) averaged with the weights its value is averaged
+/// with, which leave hidden vertices out (so it is scaled by the open
+/// share, as the value is).
+fn polygon_received(pm: &PolygonMesh, mean_weight: &[f64], received: impl Fn(usize) -> Rgb) -> Rgb {
+    let mut sum = Rgb::BLACK;
+    for l in pm.vertices.clone() {
+        sum += received(l as usize) * mean_weight[l as usize];
+    }
+    sum
 }
 
 /// Area-weighted mean of a per-vertex `field` (read by vertex index) over
@@ -542,27 +604,38 @@ mod tests {
     use super::Shot;
     use crate::color::Rgb;
 
-    /// A shot sends, per channel, its sign's part beyond what the polygon
-    /// still expects (`over`), and leaves it at `−over` where it sent.
+    /// A shot sends, per channel, its sign's part beyond what the point
+    /// still expects (`gain` times what it has received, at most `cap`),
+    /// and leaves it at minus that where it sent.
     #[test]
     fn a_shot_leaves_the_light_still_expected() {
-        let over = Rgb::new(0.5, 0.5, 0.5);
+        let received = Rgb::new(1.0, 1.0, -3.0);
         let v = Rgb::new(2.0, -0.25, -1.0);
+        let cap = Rgb::new(1.0, 0.25, 1.0);
         let up = Shot {
             negative: false,
-            over,
-        };
-        assert_eq!(up.sent(v), Rgb::new(2.5, 0.25, 0.0));
-        assert_eq!(up.left(v), Rgb::new(-0.5, -0.5, -1.0));
+            gain: 0.5,
+            cap,
+        }
+        .at(received);
+        // Green is capped; a negative "received" (rounding) expects nothing.
+        assert_eq!(up.over, Rgb::new(0.5, 0.25, 0.0));
+        assert_eq!(up.sent(v), Rgb::new(2.5, 0.0, 0.0));
+        assert_eq!(up.left(v), Rgb::new(-0.5, -0.25, -1.0));
         let down = Shot {
             negative: true,
-            over,
-        };
-        assert_eq!(down.sent(v), Rgb::new(0.0, 0.0, 0.5));
-        assert_eq!(down.left(v), Rgb::new(2.0, -0.25, -0.5));
+            gain: 0.5,
+            cap,
+        }
+        .at(received);
+        assert_eq!(down.sent(v), Rgb::new(0.0, 0.0, 1.0));
+        assert_eq!(down.left(v), Rgb::new(2.0, -0.25, 0.0));
         // Without overshoot: the positive part all sent, the rest kept.
-        assert_eq!(Shot::PLAIN.left(v), Rgb::new(0.0, -0.25, -1.0));
-        assert_eq!(Shot::NEGATIVE.sent(v), Rgb::new(0.0, 0.25, 1.0));
+        assert_eq!(Shot::PLAIN.at(received).left(v), Rgb::new(0.0, -0.25, -1.0));
+        assert_eq!(
+            Shot::NEGATIVE.at(received).sent(v),
+            Rgb::new(0.0, 0.25, 1.0)
+        );
     }
 
     #[test]
