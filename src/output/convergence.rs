@@ -8,8 +8,8 @@
 //! | `step` | the step, from 1 |
 //! | `shooter` | the polygon that shot: its index in the scene, from 0 |
 //! | `shooter_line` | the line of the scene file where that polygon is written |
-//! | `shot_power` | the power it shot, radiosity × area (scene units) |
-//! | `unshot_fraction` | unshot power left after the step ÷ emitted power |
+//! | `shot_power` | the power it shot, radiosity × area (scene units); negative for a step of negative light, which takes back what overshooting sent ahead |
+//! | `unshot_fraction` | unshot power left after the step (its magnitude: light still to shoot and light sent ahead) ÷ emitted power |
 //! | `rays` | shadow rays cast in the step |
 //! | `seconds` | wall-clock seconds from the start of the solve to the end of the step (a resumed solve's clock continues the saved one's) |
 //!
@@ -44,7 +44,8 @@ pub struct StepRecord {
     pub step: u64,
     /// The polygon that shot: its index in the scene, from 0.
     pub shooter: u32,
-    /// The power it shot, radiosity × area (scene units).
+    /// The power it shot, radiosity × area (scene units); negative for a
+    /// step of negative light.
     pub shot_power: f64,
     /// Unshot power left after the step ÷ emitted power.
     pub unshot_fraction: f64,

@@ -231,11 +231,11 @@ pub struct SolverOptions {
     /// [`FormFactorMethod::Hemicube`] (ignored by the other methods).
     pub hemicube_res: hemicube::HemicubeRes,
     /// Overshoot (Feda and Purgathofer 1992): a step also sends out the
-    /// light its shooters are expected to receive later, `ρ · ambient`
-    /// ([`Progressive::ambient`]), leaving their unshot radiosity negative
-    /// until that light arrives; what is still negative then is shot as
-    /// negative light. Fewer steps to the same residual; off, unshot
-    /// radiosity never goes below zero (the original algorithm).
+    /// light each point of its shooters is expected to receive later
+    /// ([`Expectation`]), leaving their unshot radiosity negative until
+    /// that light arrives; what the shrinking expectation no longer covers
+    /// is shot as negative light. Fewer steps to the same residual; off,
+    /// unshot radiosity never goes below zero (the original algorithm).
     pub overshoot: bool,
 }
 
