@@ -186,6 +186,19 @@ pub fn shadowed_box() -> Scene {
     scene(polygons, glowing_box().materials)
 }
 
+/// The regular mesh of `s` with elements at most `lenmax` across and the
+/// default inset.
+pub fn regular_mesh(s: &Scene, lenmax: f32) -> crate::mesh::Mesh {
+    crate::mesh::build(
+        s,
+        &crate::mesh::MeshOptions {
+            lenmax,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap()
+}
+
 /// Area-weighted mean radiosity of polygon `p` of mesh `m`, from
 /// `radiosity` per mesh vertex.
 pub fn mean_radiosity(m: &crate::mesh::Mesh, radiosity: &[Rgb], p: usize) -> Rgb {

@@ -294,14 +294,7 @@ fn solve(
     lenmax: f32,
     options: SolverOptions,
 ) -> (Mesh, Vec<Rgb>, u64, f64, f64) {
-    let m = mesh::build(
-        s,
-        &MeshOptions {
-            lenmax,
-            inset: mesh::DEFAULT_INSET,
-        },
-    )
-    .unwrap();
+    let m = crate::testutil::regular_mesh(s, lenmax);
     let vis = Visibility::new(s);
     let mut solver = Progressive::new(s, &m, &vis, options);
     while !solver.is_done() && solver.step().is_some() {}

@@ -4,8 +4,7 @@
 //! state holding negative unshot light bit for bit.
 
 use super::*;
-use crate::mesh::{self, MeshOptions};
-use crate::testutil::{closed_box, grey, mean_radiosity, scene, tiled, tiled_box};
+use crate::testutil::{closed_box, grey, mean_radiosity, regular_mesh, scene, tiled, tiled_box};
 
 /// A solve of `s` on a mesh of `lenmax` to `threshold`, with or without
 /// overshooting, with or without clustering: the mesh, the radiosity, the steps, the steps of negative
@@ -20,14 +19,7 @@ struct Run {
 }
 
 fn run(s: &Scene, lenmax: f32, threshold: f64, overshoot: bool, clustering: bool) -> Run {
-    let mesh = mesh::build(
-        s,
-        &MeshOptions {
-            lenmax,
-            inset: mesh::DEFAULT_INSET,
-        },
-    )
-    .unwrap();
+    let mesh = regular_mesh(s, lenmax);
     let vis = Visibility::new(s);
     let mut solver = Progressive::new(
         s,
@@ -178,14 +170,7 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
 #[test]
 fn negative_unshot_light_saves_and_resumes_bit_for_bit() {
     let s = tiled_box(true, 5);
-    let mesh = mesh::build(
-        &s,
-        &MeshOptions {
-            lenmax: 0.1,
-            inset: mesh::DEFAULT_INSET,
-        },
-    )
-    .unwrap();
+    let mesh = regular_mesh(&s, 0.1);
     let vis = Visibility::new(&s);
     let options = SolverOptions {
         threshold: 1e-5,
