@@ -211,6 +211,21 @@ pub fn mean_radiosity(m: &crate::mesh::Mesh, radiosity: &[Rgb], p: usize) -> Rgb
     sum / pm.area
 }
 
+/// The power the polygons of a closed scene `s` have absorbed, from their
+/// mean radiosity on mesh `m` (red channel): each reflects `ρ` of what it
+/// receives, so it absorbs `(1 − ρ) / ρ · (b − e) · A`. Every polygon must
+/// reflect something.
+pub fn absorbed_power(s: &Scene, m: &crate::mesh::Mesh, radiosity: &[Rgb]) -> f64 {
+    let mut absorbed = 0.0;
+    for (p, polygon) in s.polygons.iter().enumerate() {
+        let material = &s.materials[polygon.material.index()];
+        let rho = material.reflectance().r;
+        let b = mean_radiosity(m, radiosity, p).r;
+        absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
+    }
+    absorbed
+}
+
 /// `p` (a quadrilateral) cut into `n × n` quadrilaterals of its material,
 /// as an exporter that triangulates or tiles a wall writes it.
 pub fn tiled(p: &crate::scene::Polygon, n: usize) -> Vec<crate::scene::Polygon> {

@@ -400,13 +400,7 @@ fn energy_balance_in_a_closed_box() {
             ..hemicube_options()
         };
         let (m, b, _, initial, left) = solve(&s, 0.1, options);
-        let mut absorbed = 0.0;
-        for (p, polygon) in s.polygons.iter().enumerate() {
-            let material = &s.materials[polygon.material.index()];
-            let rho = material.reflectance().r;
-            let mean = mean_radiosity(&m, &b, p).r;
-            absorbed += polygon.area * (1.0 - rho) / rho * (mean - material.emission().r);
-        }
+        let absorbed = crate::testutil::absorbed_power(&s, &m, &b);
         let error = (absorbed + left - initial).abs() / initial;
         eprintln!("{unshot:?}: energy error {error}");
         assert!(error < bound, "{unshot:?}: {error}");

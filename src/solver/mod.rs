@@ -664,9 +664,7 @@ impl<'a> Progressive<'a> {
     /// other polygon), the most it can bring to the scene, not its own far
     /// larger power (see [`sky_power_weights`]).
     pub fn unshot_power(&self) -> f64 {
-        (0..self.mesh.polygons.len())
-            .map(|j| self.polygon_power(j, Shot::PLAIN) + self.polygon_power(j, Shot::NEGATIVE))
-            .sum()
+        self.unshot_sums().0
     }
 
     /// The signed unshot power `Σ A_i · mean(Δb_i)`: light still to be sent
@@ -675,19 +673,28 @@ impl<'a> Progressive<'a> {
     /// absorbed + escaped + this. Equal to [`Progressive::unshot_power`]
     /// without overshooting.
     pub fn net_unshot_power(&self) -> f64 {
-        (0..self.mesh.polygons.len())
-            .map(|j| self.polygon_power(j, Shot::PLAIN) - self.polygon_power(j, Shot::NEGATIVE))
-            .sum()
+        self.unshot_sums().1
+    }
+
+    /// [`Progressive::unshot_power`] and [`Progressive::net_unshot_power`]
+    /// in one pass: per polygon its positive part's power `p` and its
+    /// negative part's magnitude `n` (weighted as
+    /// [`Progressive::polygon_power`]), summed as `p + n` and `p − n`.
+    fn unshot_sums(&self) -> (f64, f64) {
+        (0..self.mesh.polygons.len()).fold((0.0, 0.0), |(magnitude, net), j| {
+            let p = self.polygon_power(j, Shot::PLAIN);
+            let n = self.polygon_power(j, Shot::NEGATIVE);
+            (magnitude + (p + n), net + (p - n))
+        })
     }
 
     /// The power polygon `j` sends out in a step that sends `shot`
     /// ([`UnshotField::sent_power`], the channel mean), in radiosity ×
-    /// area units, as it
-    /// counts for choosing the shooter and for the threshold: a sky
-    /// facet's weighted by [`sky_power_weights`].
+    /// area units, as it counts for choosing the shooter and for the
+    /// threshold: a sky facet's weighted by [`sky_power_weights`].
     fn polygon_power(&self, j: usize, shot: Shot) -> f64 {
-        let received = |l: usize| self.radiosity[l] - self.emission[j];
-        self.unshot.sent_power(&self.mesh, j, shot, received).mean() * self.power_weight[j]
+        let sent = self.unshot.sent_power(&self.mesh, j, shot, &self.radiosity);
+        sent.mean() * self.power_weight[j]
     }
 
     /// The unshot power of polygon `j` due to be shot in a step of sign
@@ -743,6 +750,7 @@ impl<'a> Progressive<'a> {
             negative,
             gain: expected.gain,
             cap: self.reflectance[j] * expected.ambient,
+            emission: self.emission[j],
         }
     }
 
@@ -935,11 +943,15 @@ impl<'a> Progressive<'a> {
     /// `shot` ([`UnshotField::read_shooter`]).
     fn read_shooter(&mut self, shooter: PolygonId, shot: Shot) {
         let i = shooter.index();
-        let (radiosity, e) = (&self.radiosity, self.emission[i]);
-        let received = |l: usize| radiosity[l] - e;
         let samples = self.samples[i].len();
-        self.unshot
-            .read_shooter(&self.mesh, i, samples, shot, received, &mut self.shot);
+        self.unshot.read_shooter(
+            &self.mesh,
+            i,
+            samples,
+            shot,
+            &self.radiosity,
+            &mut self.shot,
+        );
     }
 
     /// Phase 3, cull: marks the receivers of `shooter` and, with shaft
@@ -1189,10 +1201,7 @@ impl<'a> Progressive<'a> {
         cancel: &AtomicBool,
     ) -> Option<Gathered> {
         let i = shooter.index();
-        let e = self.emission[i];
-        let power = self
-            .unshot
-            .sent_power(&self.mesh, i, shot, |l| self.radiosity[l] - e);
+        let power = self.unshot.sent_power(&self.mesh, i, shot, &self.radiosity);
         let merged = self.hemicube_points(shooter, hemicubes);
         let (samples, shot) = match &merged {
             Some((samples, shot)) => (&samples[..], &shot[..]),
@@ -1285,14 +1294,12 @@ impl<'a> Progressive<'a> {
         for &m in self.clusters.members(cluster) {
             let i = m as usize;
             let shot = self.polygon_shot(i, negative, expected);
-            let (radiosity, e) = (&self.radiosity, self.emission[i]);
-            let received = |l: usize| radiosity[l] - e;
             self.unshot.read_shooter(
                 mesh,
                 i,
                 self.samples[i].len(),
                 shot,
-                received,
+                &self.radiosity,
                 &mut self.shot,
             );
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
@@ -1542,9 +1549,8 @@ impl<'a> Progressive<'a> {
         let members = self.clusters.members(cluster);
         for &m in members {
             let shot = self.polygon_shot(m as usize, negative, expected);
-            let (radiosity, e) = (&self.radiosity, self.emission[m as usize]);
-            let received = |l: usize| radiosity[l] - e;
-            self.unshot.spend(&self.mesh, m as usize, shot, received);
+            self.unshot
+                .spend(&self.mesh, m as usize, shot, &self.radiosity);
         }
         let mesh: &Mesh = &self.mesh;
         for (j, pm) in mesh.polygons.iter().enumerate() {

@@ -4,7 +4,9 @@
 //! state holding negative unshot light bit for bit.
 
 use super::*;
-use crate::testutil::{closed_box, grey, mean_radiosity, regular_mesh, scene, tiled, tiled_box};
+use crate::testutil::{
+    absorbed_power, closed_box, grey, mean_radiosity, regular_mesh, scene, tiled, tiled_box,
+};
 
 /// A solve of `s` on a mesh of `lenmax` to `threshold`, with or without
 /// overshooting, with or without clustering: the mesh, the radiosity, the steps, the steps of negative
@@ -144,13 +146,7 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     let s = tiled_box(false, 6);
     let [plain, over] = [false, true].map(|o| {
         let r = run(&s, 0.1, 1e-5, o, true);
-        let mut absorbed = 0.0;
-        for (p, polygon) in s.polygons.iter().enumerate() {
-            let material = &s.materials[polygon.material.index()];
-            let rho = material.reflectance().r;
-            let b = mean_radiosity(&r.mesh, &r.radiosity, p).r;
-            absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
-        }
+        let absorbed = absorbed_power(&s, &r.mesh, &r.radiosity);
         let error = (absorbed + r.net_unshot - r.emitted) / r.emitted;
         eprintln!(
             "overshoot {o}: {} steps ({} negative), energy error {error}",

@@ -547,13 +547,7 @@ fn energy_balance_in_an_open_box() {
 /// `|absorbed + unshot − emitted| / emitted` of a solve of a closed scene
 /// whose every polygon reflects.
 fn energy_error(s: &Scene, solved: &Solved) -> f64 {
-    let mut absorbed = 0.0;
-    for (p, polygon) in s.polygons.iter().enumerate() {
-        let material = &s.materials[polygon.material.index()];
-        let rho = material.reflectance().r;
-        let b = mean_radiosity(&solved.mesh, &solved.radiosity, p).r;
-        absorbed += polygon.area * (1.0 - rho) / rho * (b - material.emission().r);
-    }
+    let absorbed = crate::testutil::absorbed_power(s, &solved.mesh, &solved.radiosity);
     (absorbed + solved.unshot_power - solved.initial_power).abs() / solved.initial_power
 }
 

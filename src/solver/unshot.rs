@@ -98,6 +98,9 @@ pub(crate) struct Shot {
     /// The most light a point expects, per channel, `>= 0`, in the
     /// scene's emission units.
     pub(crate) cap: Rgb,
+    /// The shooter's emission `e`: what a point has received so far is its
+    /// radiosity less this.
+    pub(crate) emission: Rgb,
 }
 
 impl Shot {
@@ -107,6 +110,7 @@ impl Shot {
         negative: false,
         gain: 0.0,
         cap: Rgb::BLACK,
+        emission: Rgb::BLACK,
     };
 
     /// The whole negative part.
@@ -114,6 +118,7 @@ impl Shot {
         negative: true,
         gain: 0.0,
         cap: Rgb::BLACK,
+        emission: Rgb::BLACK,
     };
 
     /// The shot at a point that has received `received` so far.
@@ -284,21 +289,17 @@ impl UnshotField {
     /// The power polygon `j` sends out in a step that sends `shot`
     /// ([`Shot`]), per channel: `Σ sent(Δb) · area` over its vertices (its
     /// value times its area in the per-polygon scheme), `>= 0`, in radiosity
-    /// × area units. `received` gives, per mesh vertex, the light it has
-    /// received so far (`b − e`), for the overshoot. [`Shot::PLAIN`] gives
+    /// × area units. `radiosity` is `b` per mesh vertex, from which the
+    /// overshoot reads what each point has received. [`Shot::PLAIN`] gives
     /// the power of the positive part, `mean(Δb_j) · A_j` while nothing is
     /// negative.
-    pub(crate) fn sent_power(
-        &self,
-        mesh: &Mesh,
-        j: usize,
-        shot: Shot,
-        received: impl Fn(usize) -> Rgb,
-    ) -> Rgb {
+    pub(crate) fn sent_power(&self, mesh: &Mesh, j: usize, shot: Shot, radiosity: &[Rgb]) -> Rgb {
         let pm = &mesh.polygons[j];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
-                let part = shot.at(polygon_received(pm, mean_weight, received));
+                let part = shot.at(polygon_received(pm, mean_weight, |l| {
+                    radiosity[l] - shot.emission
+                }));
                 part.sent(self.values[j]) * pm.area
             }
             Layout::Vertex {
@@ -310,7 +311,8 @@ impl UnshotField {
                 for l in pm.vertices.clone() {
                     let l = l as usize;
                     if !covered.get(l).copied().unwrap_or(false) {
-                        sum += shot.at(received(l)).sent(self.values[l]) * vertex_area[l];
+                        sum += shot.at(radiosity[l] - shot.emission).sent(self.values[l])
+                            * vertex_area[l];
                     }
                 }
                 sum
@@ -320,7 +322,7 @@ impl UnshotField {
 
     /// Writes into `out` (cleared first) the radiosity each of shooter
     /// `i`'s `samples` samples sends in a step that sends `shot`
-    /// ([`Shot`], `>= 0`; `received` as for [`UnshotField::sent_power`]):
+    /// ([`Shot`], `>= 0`; `radiosity` as for [`UnshotField::sent_power`]):
     /// read from the polygon's value, or (per-vertex scheme) from the field
     /// at the sample. A vertex hidden under a coplanar polygon sends
     /// nothing.
@@ -330,14 +332,16 @@ impl UnshotField {
         i: usize,
         samples: usize,
         shot: Shot,
-        received: impl Fn(usize) -> Rgb,
+        radiosity: &[Rgb],
         out: &mut Vec<Rgb>,
     ) {
         out.clear();
         let pm = &mesh.polygons[i];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
-                let part = shot.at(polygon_received(pm, mean_weight, received));
+                let part = shot.at(polygon_received(pm, mean_weight, |l| {
+                    radiosity[l] - shot.emission
+                }));
                 out.resize(samples, part.sent(self.values[i]));
             }
             Layout::Vertex {
@@ -349,7 +353,7 @@ impl UnshotField {
                     if covered.get(l).copied().unwrap_or(false) {
                         Rgb::BLACK
                     } else {
-                        shot.at(received(l)).sent(self.values[l])
+                        shot.at(radiosity[l] - shot.emission).sent(self.values[l])
                     }
                 };
                 let mean = polygon_mean(pm, vertex_area, sent);
@@ -384,25 +388,26 @@ impl UnshotField {
     }
 
     /// Takes from shooter `i`'s unshot radiosity what a step sending `shot`
-    /// sent out ([`Shot`]; `received` as for [`UnshotField::sent_power`]):
+    /// sent out ([`Shot`]; `radiosity` as for [`UnshotField::sent_power`]):
     /// without overshoot, its positive part becomes 0.
-    pub(crate) fn spend(
-        &mut self,
-        mesh: &Mesh,
-        i: usize,
-        shot: Shot,
-        received: impl Fn(usize) -> Rgb,
-    ) {
+    pub(crate) fn spend(&mut self, mesh: &Mesh, i: usize, shot: Shot, radiosity: &[Rgb]) {
         let pm = &mesh.polygons[i];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
-                let part = shot.at(polygon_received(pm, mean_weight, received));
+                let part = shot.at(polygon_received(pm, mean_weight, |l| {
+                    radiosity[l] - shot.emission
+                }));
                 self.values[i] = part.left(self.values[i]);
             }
             Layout::Vertex { covered, .. } => {
-                for l in pm.vertices.start as usize..pm.vertices.end as usize {
-                    if !covered.get(l).copied().unwrap_or(false) {
-                        self.values[l] = shot.at(received(l)).left(self.values[l]);
+                let range = pm.vertices.start as usize..pm.vertices.end as usize;
+                for (l, (value, b)) in self.values[range.clone()]
+                    .iter_mut()
+                    .zip(&radiosity[range.clone()])
+                    .enumerate()
+                {
+                    if !covered.get(range.start + l).copied().unwrap_or(false) {
+                        *value = shot.at(*b - shot.emission).left(*value);
                     }
                 }
             }
@@ -616,6 +621,7 @@ mod tests {
             negative: false,
             gain: 0.5,
             cap,
+            emission: Rgb::BLACK,
         }
         .at(received);
         // Green is capped; a negative "received" (rounding) expects nothing.
@@ -626,6 +632,7 @@ mod tests {
             negative: true,
             gain: 0.5,
             cap,
+            emission: Rgb::BLACK,
         }
         .at(received);
         assert_eq!(down.sent(v), Rgb::new(0.0, 0.0, 1.0));
