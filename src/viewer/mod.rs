@@ -33,6 +33,7 @@
 //! or away from the surface under the cursor, stopping in front of it.
 
 pub mod controls;
+pub mod pointer;
 
 use crate::color::Rgb;
 use crate::config::RunConfig;
@@ -46,6 +47,7 @@ use controls::CameraControl;
 use glam::Vec3;
 use image::RgbImage;
 use minifb::{InputCallback, Key, MouseButton, MouseMode, Window, WindowOptions};
+use pointer::{Buttons, Pointer};
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -236,7 +238,7 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
             buffer: vec![0; w * h],
             radiosity: Vec::new(),
             mesh: None,
-            last_mouse: None,
+            pointer: Pointer::default(),
             written: 0,
             navigation: Navigation::Look,
             presses,
@@ -389,7 +391,8 @@ struct Ui<'a> {
     /// The mesh [`Ui::radiosity`] belongs to (`None`: nothing published
     /// yet).
     mesh: Option<MeshRef<'a>>,
-    last_mouse: Option<(f32, f32)>,
+    /// The pointer as seen at the last frame, for drags.
+    pointer: Pointer,
     written: u32,
     /// What a left-drag does; `o` switches.
     navigation: Navigation,
@@ -707,41 +710,37 @@ impl<'a> Ui<'a> {
                 dirty = true;
             }
         }
-        let left = self.window.get_mouse_down(MouseButton::Left);
-        let right = self.window.get_mouse_down(MouseButton::Right);
-        if (left || right) && self.last_mouse.is_none() {
+        let now = Buttons {
+            left: self.window.get_mouse_down(MouseButton::Left),
+            right: self.window.get_mouse_down(MouseButton::Right),
+        };
+        let motion = self.pointer.frame(pos, now);
+        if let Some((x, y)) = motion.pressed_at {
             // The drag starts: what it turns around or moves towards is
-            // the surface under the cursor now, fixed for the whole drag.
-            self.pivot = pos.and_then(|(x, y)| {
-                if right {
-                    self.zoom_target(x, y)
-                } else {
-                    self.pick(x, y)
-                }
-            });
+            // the surface under the point pressed, fixed for the whole
+            // drag.
+            self.pivot = if now.right {
+                self.zoom_target(x, y)
+            } else {
+                self.pick(x, y)
+            };
         }
-        match (pos, self.last_mouse) {
-            (Some((x, y)), Some((x0, y0))) if left || right => {
-                let (dx, dy) = (x - x0, y - y0);
-                if dx != 0.0 || dy != 0.0 {
-                    if left && self.navigation == Navigation::Look {
-                        // Drag right turns right; drag up looks up.
-                        self.camera.look(-dx * LOOK_PER_PIXEL, -dy * LOOK_PER_PIXEL);
-                    } else if left {
-                        let pivot = self.pivot.unwrap_or(self.camera.camera().lookat);
-                        self.camera
-                            .orbit_about(pivot, -dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
-                    } else if let Some(target) = self.pivot {
-                        // Drag up moves towards the point, down away.
-                        let stop = self.zoom_stop();
-                        self.camera.dolly(target, (dy * ZOOM_PER_PIXEL).exp(), stop);
-                    }
-                    dirty = true;
-                }
+        let (dx, dy) = motion.delta;
+        if dx != 0.0 || dy != 0.0 {
+            if motion.buttons.left && self.navigation == Navigation::Look {
+                // Drag right turns right; drag up looks up.
+                self.camera.look(-dx * LOOK_PER_PIXEL, -dy * LOOK_PER_PIXEL);
+            } else if motion.buttons.left {
+                let pivot = self.pivot.unwrap_or(self.camera.camera().lookat);
+                self.camera
+                    .orbit_about(pivot, -dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
+            } else if let Some(target) = self.pivot {
+                // Drag up moves towards the point, down away.
+                let stop = self.zoom_stop();
+                self.camera.dolly(target, (dy * ZOOM_PER_PIXEL).exp(), stop);
             }
-            _ => {}
+            dirty = true;
         }
-        self.last_mouse = if left || right { pos } else { None };
         dirty
     }
 
