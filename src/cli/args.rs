@@ -125,9 +125,11 @@ pub struct Args {
     /// By default, with clusters, a step of reflected light evaluates large
     /// receiving grids at every fourth row and column and at a check vertex
     /// in each cell between, and interpolates the cell's other vertices
-    /// where the corners predict the check vertex within 2 % (or 0.05 % of
-    /// what it already holds). Emitters' shots are always exact. This is
-    /// the exact twin, for comparison.
+    /// where the corners predict the check vertex within 2 % (or 0.1 % of
+    /// what it already holds), and a vertex takes a nearby part of the
+    /// shooting cluster as one term when its light there is too weak to
+    /// matter (within 0.3 % of what the vertex holds). Emitters' shots are
+    /// always exact. This is the exact twin, for comparison.
     #[arg(long)]
     pub(crate) exact_receivers: bool,
 

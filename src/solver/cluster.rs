@@ -242,6 +242,12 @@ pub struct Stratum {
     /// The run's unshot power `Σ unshot · area` per channel, in radiosity
     /// × area units.
     pub power: Rgb,
+    /// The largest mean unshot radiosity of its cells (emission units):
+    /// with the form factor of its bounding sphere, a bound on what it can
+    /// bring a receiver ([`Stratum::bound_at`]).
+    pub peak: f64,
+    /// The area its cells stand for, in square scene units.
+    pub area: f64,
     /// Bounds `(min, max)` of its cells (their corners), in scene units.
     pub bounds: (Vec3, Vec3),
     /// Squared distance from its bounds within which a receiver descends
@@ -356,6 +362,19 @@ impl Stratum {
         }
     }
 
+    /// An upper bound on the radiosity the stratum's unshot light brings
+    /// a point at `x` before reflection: its [`Stratum::peak`] times the
+    /// form factor of its bounding sphere, `min(1, radius² / distance²)`
+    /// (a sphere seen from outside subtends at most that share of a
+    /// point's cosine-weighted hemisphere), in emission units.
+    #[inline]
+    pub fn bound_at(&self, x: Vec3) -> f64 {
+        let d2 = f64::from((x - self.centre).length_squared());
+        let r2 = f64::from(self.radius) * f64::from(self.radius);
+        let share = if d2 > r2 { r2 / d2 } else { 1.0 };
+        self.peak * share
+    }
+
     /// Index of the normal bin of `n`: its dominant axis and sign.
     pub fn bin_of(n: Vec3) -> usize {
         let a = n.abs();
@@ -443,6 +462,7 @@ impl Strata {
         let middle = total * 0.5;
         let (mut acc, mut representative, mut split) = (0.0f64, range.start, range.end);
         let mut power = Rgb::BLACK;
+        let (mut peak, mut area) = (0.0f64, 0.0f64);
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for c in range.clone() {
@@ -457,6 +477,8 @@ impl Strata {
             }
             acc += cell.power;
             power += cell.unshot * cell.area;
+            peak = peak.max(cell.unshot.mean().abs());
+            area += cell.area;
             let (a, b) = corners(c);
             lo = lo.min(a);
             hi = hi.max(b);
@@ -504,6 +526,8 @@ impl Strata {
             cells: range.start as u32..range.end as u32,
             representative: representative as u32,
             power,
+            peak,
+            area,
             bounds: (lo, hi),
             near_r2: STRATUM_NEAR_RATIO * STRATUM_NEAR_RATIO * (hi - lo).length_squared(),
             children: None,
@@ -616,6 +640,61 @@ mod tests {
         assert_eq!(s.seen_from(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z), Seen::Near);
     }
 
+    #[test]
+    fn the_bound_holds_what_a_stratum_can_bring() {
+        // A 4 × 4 floor of unit cells facing up, unshot radiosity 0.5 to
+        // 2, its strata over their extents.
+        let corner = |c: usize| Vec3::new((c % 4) as f32, (c / 4) as f32, 0.0);
+        let extent = |c: usize| (corner(c), corner(c) + Vec3::new(1.0, 1.0, 0.0));
+        let cells: Vec<Cell> = (0..16).map(|c| cell(0.5 + (c % 7) as f64 * 0.25)).collect();
+        let strata = Strata::build(&cells, 4, extent);
+        // What each node brings a point facing down at it: every cell by
+        // a 24 × 24 midpoint quadrature, unoccluded.
+        let brought = |n: &Stratum, x: Vec3, nx: Vec3| -> f64 {
+            let mut sum = 0.0;
+            for c in n.cells.clone() {
+                let c = c as usize;
+                let k = 24;
+                for i in 0..k * k {
+                    let p = corner(c)
+                        + Vec3::new(
+                            ((i % k) as f32 + 0.5) / k as f32,
+                            ((i / k) as f32 + 0.5) / k as f32,
+                            0.0,
+                        );
+                    let d = x - p;
+                    let r2 = d.length_squared();
+                    let (cs, cx) = (d.z / r2.sqrt(), -nx.dot(d) / r2.sqrt());
+                    if cs > 0.0 && cx > 0.0 {
+                        let a = 1.0 / (k * k) as f64;
+                        sum += cells[c].unshot.mean() * f64::from(cs * cx) * a
+                            / (std::f64::consts::PI * f64::from(r2));
+                    }
+                }
+            }
+            sum
+        };
+        let mut tight: f64 = 0.0;
+        for n in &strata.nodes {
+            assert!(n.peak > 0.0 && n.area == n.cells.len() as f64);
+            for x in [
+                Vec3::new(2.0, 2.0, 0.1),
+                Vec3::new(0.5, 0.5, 0.3),
+                Vec3::new(6.0, 1.0, 1.0),
+                Vec3::new(2.0, 2.0, 3.0),
+                Vec3::new(-3.0, 9.0, 0.5),
+            ] {
+                for nx in [-Vec3::Z, Vec3::new(0.6, 0.0, -0.8), -Vec3::X] {
+                    let (b, bound) = (brought(n, x, nx), n.bound_at(x));
+                    assert!(b <= bound * 1.001, "{b} > {bound} at {x} for {:?}", n.cells);
+                    tight = tight.max(b / bound);
+                }
+            }
+        }
+        // And it is not loose everywhere.
+        assert!(tight > 0.3, "tightest {tight}");
+    }
+
     /// A stratum over `bounds` whose cells all face `normal`.
     fn flat(bounds: (Vec3, Vec3), normal: Vec3) -> Stratum {
         let centre = (bounds.0 + bounds.1) * 0.5;
@@ -623,6 +702,8 @@ mod tests {
             cells: 0..1,
             representative: 0,
             power: Rgb::BLACK,
+            peak: 0.0,
+            area: 0.0,
             bounds,
             near_r2: STRATUM_NEAR_RATIO
                 * STRATUM_NEAR_RATIO
