@@ -1474,18 +1474,19 @@ impl<'a> Progressive<'a> {
                 // A near stratum whose light is too weak here to matter
                 // is taken as one term all the same, while the bounds of
                 // what such terms bring stay within the allowance.
-                let lumped = !far && node.children.is_some() && allowance > 0.0 && {
+                // `lumped` holds the bound of such a stratum.
+                let lumped = if !far && node.children.is_some() && allowance > 0.0 {
                     let bound = node.bound_at(x);
-                    let weak = bound <= allowance
-                        && rep.polygon != j
-                        && !visibility.coplanar(rep.polygon, j);
-                    if weak {
-                        allowance -= bound;
-                    }
-                    weak
+                    (bound <= allowance && rep.polygon != j && !visibility.coplanar(rep.polygon, j))
+                        .then(|| {
+                            allowance -= bound;
+                            bound
+                        })
+                } else {
+                    None
                 };
                 match node.children {
-                    Some((a, b)) if !far && !lumped => {
+                    Some((a, b)) if !far && lumped.is_none() => {
                         let child = |c: u32| {
                             let at = strata.root_index[c as usize];
                             (c, if at != NONE { at } else { si })
@@ -1526,7 +1527,7 @@ impl<'a> Progressive<'a> {
                     continue;
                 }
                 let mut power = Rgb::BLACK;
-                if binned || lumped {
+                if binned || lumped.is_some() {
                     for (p, normal) in &node.bins {
                         let cos_s = normal.dot(d);
                         if cos_s > 0.0 {
@@ -1548,16 +1549,9 @@ impl<'a> Progressive<'a> {
                     let term = power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
                     // A lumped stratum may be close: its term is held to
                     // the bound on what it can bring.
-                    sum += if lumped {
-                        let cap = node.bound_at(x);
-                        let m = term.mean();
-                        if m > cap {
-                            term * (cap / m)
-                        } else {
-                            term
-                        }
-                    } else {
-                        term
+                    sum += match lumped {
+                        Some(cap) if term.mean() > cap => term * (cap / term.mean()),
+                        _ => term,
                     };
                 }
             }
