@@ -128,8 +128,10 @@ pub struct Args {
     /// where the corners predict the check vertex within 2 % (or 0.1 % of
     /// what it already holds), and a vertex takes a nearby part of the
     /// shooting cluster as one term when its light there is too weak to
-    /// matter (within 0.3 % of what the vertex holds). Emitters' shots are
-    /// always exact. This is the exact twin, for comparison.
+    /// matter (within 0.3 % of what the vertex holds). A facet under half
+    /// an element across asks one shadow ray per shooter sample for all
+    /// its vertices, in every step. Emitters' shots are otherwise always
+    /// exact. This is the exact twin, for comparison.
     #[arg(long)]
     pub(crate) exact_receivers: bool,
 

@@ -48,6 +48,11 @@
 //! and at a check vertex per coarse cell, and interpolates the cell's
 //! other vertices when the check shows the interpolation holds.
 //!
+//! **Shared facet rays** ([`facets`], with the same switch): a facet
+//! under half an element across asks one shadow ray per shooter sample or
+//! stratum, to its middle, for all its vertices, where no vertex is near
+//! the sample's cell.
+//!
 //! Emission and reflection are from the front only. Receivers are
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
@@ -56,6 +61,7 @@
 pub mod checkpoint;
 pub mod cluster;
 pub mod distribution;
+pub mod facets;
 pub mod formfactor;
 pub mod gather;
 pub mod hemicube;
@@ -68,6 +74,7 @@ use crate::mesh::{Mesh, MeshRef};
 use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
 use cluster::{Cell, Clusters, Seen, Strata};
+use facets::{Facets, Scratch};
 use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use receivers::CoarseGrid;
@@ -428,6 +435,8 @@ pub struct Progressive<'a> {
     /// Per polygon: fewer vertices than [`SHAFT_MIN_VERTICES`], so its
     /// rays always ask the BVH.
     small: Vec<bool>,
+    /// The small facets whose vertices share their shadow rays.
+    facets: Facets,
     /// Per polygon: scratch, its candidates in runs of one culling group
     /// with the group's bounds.
     candidate_runs: Vec<Vec<crate::visibility::CandidateRun>>,
@@ -590,6 +599,7 @@ impl<'a> Progressive<'a> {
                 .map(|pm| CoarseGrid::detect(mesh, pm))
                 .collect(),
             coarse_delta: Vec::new(),
+            facets: Facets::new(mesh, clustered && options.receiver_interpolation),
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,
             tiles,
@@ -831,6 +841,21 @@ impl<'a> Progressive<'a> {
         let expected = self.expectation();
         self.choose_shooter(expected)
             .map(|(cluster, _, negative)| self.strongest_member(cluster, negative, expected))
+    }
+
+    /// The small facets whose vertices share their shadow rays
+    /// ([`facets`]).
+    pub fn facets(&self) -> &Facets {
+        &self.facets
+    }
+
+    /// This solver with every receiving vertex asking its own shadow rays
+    /// (no [`facets`] sharing), all else alike: the twin the sharing is
+    /// tested against.
+    #[cfg(test)]
+    pub(crate) fn without_shared_rays(mut self) -> Self {
+        self.facets = Facets::default();
+        self
     }
 
     /// The clusters the solve shoots from (each polygon alone without
@@ -1149,10 +1174,12 @@ impl<'a> Progressive<'a> {
         let directional = self.directional[i].as_ref();
         // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
         // pairs and rays it took.
-        let exact = |l: usize, j: PolygonId, _: &mut Vec<(u32, u32)>| -> (Rgb, u64, u64) {
+        let facets = &self.facets;
+        let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
             let x = mesh.sample_positions[l];
             let tile = tile_of[l] as usize * groups;
             let mut rays = 0u64;
+            let memo = &mut scratch.memo;
             let (f, pairs) = distribution::shot_point_to_samples(
                 directional,
                 x,
@@ -1162,6 +1189,14 @@ impl<'a> Progressive<'a> {
                 |k| shot[k],
                 near_field,
                 |k, s| {
+                    // A small facet's vertices share one ray per sample.
+                    if let Some(middle) = facets.point(j.index(), s, samples[k].exact_r2) {
+                        let (hit, cast) = memo.answer(j.0, k as u32, || {
+                            (visibility.occluded(s, middle, (shooter, j)), 1)
+                        });
+                        rays += cast;
+                        return hit;
+                    }
                     let blockers = tile_candidates
                         .get(tile + k / SHOOTER_GROUP)
                         .map_or(&[][..], |c| &c[..]);
@@ -1418,7 +1453,9 @@ impl<'a> Progressive<'a> {
         };
         // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
         // pairs and rays it took.
-        let exact = |l: usize, j: PolygonId, stack: &mut Vec<(u32, u32)>| -> (Rgb, u64, u64) {
+        let facets = &self.facets;
+        let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
+            let Scratch { stack, memo } = scratch;
             let member = clusters.of(j) == cluster;
             let x = mesh.sample_positions[l];
             let nx = mesh.polygons[j.index()].normal;
@@ -1458,8 +1495,14 @@ impl<'a> Progressive<'a> {
                             }
                         },
                     );
-                let mut blocked = |from: glam::Vec3, own: PolygonId| {
-                    let (hit, cast) = ray_blocked(visibility, blockers, from, x, (own, j));
+                // A small facet's vertices share one ray per node.
+                let mut blocked = |from: glam::Vec3, own: PolygonId, exact_r2: f32| {
+                    let (hit, cast) = match facets.point(j.index(), from, exact_r2) {
+                        Some(middle) => {
+                            memo.answer(j.0, n, || (visibility.occluded(from, middle, (own, j)), 1))
+                        }
+                        None => ray_blocked(visibility, blockers, from, x, (own, j)),
+                    };
                     rays += cast;
                     hit
                 };
@@ -1508,7 +1551,10 @@ impl<'a> Progressive<'a> {
                             std::slice::from_ref(&cell_samples[node.representative as usize]),
                             |_| rep.unshot,
                             near_field,
-                            |_, from| blocked(from, rep.polygon),
+                            |_, from| {
+                                let exact_r2 = cell_samples[node.representative as usize].exact_r2;
+                                blocked(from, rep.polygon, exact_r2)
+                            },
                         );
                         sum += f;
                         pairs += asked;
@@ -1544,7 +1590,8 @@ impl<'a> Progressive<'a> {
                     continue;
                 }
                 pairs += 1;
-                if !blocked(sample.position, rep.polygon) {
+                // Far (or lumped, its light bounded): no vertex near a cell.
+                if !blocked(sample.position, rep.polygon, 0.0) {
                     let r2 = f64::from(r2);
                     let term = power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
                     // A lumped stratum may be close: its term is held to
@@ -1875,22 +1922,22 @@ fn gather_passes<E>(
     exact: E,
 ) -> Option<Gathered>
 where
-    E: Fn(usize, PolygonId, &mut Vec<(u32, u32)>) -> (Rgb, u64, u64) + Sync,
+    E: Fn(usize, PolygonId, &mut Scratch) -> (Rgb, u64, u64) + Sync,
 {
     let (receives, held) = (cells.receives, cells.held);
     let (pairs, rays) = delta
         .par_iter_mut()
         .enumerate()
         .with_min_len(64)
-        // One traversal stack per worker, reused from vertex to vertex.
-        .map_init(Vec::new, |stack: &mut Vec<(u32, u32)>, (l, delta)| {
+        // One scratch per worker, reused from vertex to vertex.
+        .map_init(Scratch::default, |scratch: &mut Scratch, (l, delta)| {
             let j = mesh.vertex_polygon[l];
             if !receives[j.index()] || cancel.load(Ordering::Relaxed) || cells.cell(l, j).is_some()
             {
                 *delta = Rgb::BLACK;
                 return (0, 0);
             }
-            let (d, pairs, rays) = exact(l, j, stack);
+            let (d, pairs, rays) = exact(l, j, scratch);
             *delta = d;
             (pairs, rays)
         })
@@ -1909,7 +1956,7 @@ where
         .par_iter_mut()
         .enumerate()
         .with_min_len(64)
-        .map_init(Vec::new, |stack: &mut Vec<(u32, u32)>, (l, delta)| {
+        .map_init(Scratch::default, |scratch: &mut Scratch, (l, delta)| {
             let j = mesh.vertex_polygon[l];
             let Some(cell) = cells.cell(l, j) else {
                 return (0, 0);
@@ -1925,7 +1972,7 @@ where
                 *delta = receivers::blend(corners, cell.weights);
                 return (0, 0);
             }
-            let (d, pairs, rays) = exact(l, j, stack);
+            let (d, pairs, rays) = exact(l, j, scratch);
             *delta = d;
             (pairs, rays)
         })
