@@ -53,6 +53,10 @@
 //! stratum, to its middle, for all its vertices, where no vertex is near
 //! the sample's cell.
 //!
+//! **Sky probes** ([`probes`], with the same switch): a receiving
+//! vertex asks a few of a sky facet's directions first and, when they
+//! agree, takes their answer for all of them.
+//!
 //! Emission and reflection are from the front only. Receivers are
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
@@ -65,6 +69,7 @@ pub mod facets;
 pub mod formfactor;
 pub mod gather;
 pub mod hemicube;
+pub mod probes;
 pub mod receivers;
 mod unshot;
 
@@ -437,6 +442,9 @@ pub struct Progressive<'a> {
     small: Vec<bool>,
     /// The small facets whose vertices share their shadow rays.
     facets: Facets,
+    /// Per polygon: a sky facet's probe samples ([`probes`]), empty for
+    /// every other polygon and when probing is off.
+    probes: Vec<Vec<u32>>,
     /// Per polygon: scratch, its candidates in runs of one culling group
     /// with the group's bounds.
     candidate_runs: Vec<Vec<crate::visibility::CandidateRun>>,
@@ -564,6 +572,18 @@ impl<'a> Progressive<'a> {
                 start = end;
             }
         }
+        let sky_probes = mesh
+            .polygons
+            .iter()
+            .zip(&samples)
+            .map(|(pm, own)| {
+                if pm.sky && clustered && options.receiver_interpolation {
+                    probes::spread(own, probes::SKY_PROBES)
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect();
         let mut solver = Progressive {
             mesh: mesh_ref.clone(),
             visibility,
@@ -600,6 +620,7 @@ impl<'a> Progressive<'a> {
                 .collect(),
             coarse_delta: Vec::new(),
             facets: Facets::new(mesh, clustered && options.receiver_interpolation),
+            probes: sky_probes,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,
             tiles,
@@ -855,6 +876,14 @@ impl<'a> Progressive<'a> {
     #[cfg(test)]
     pub(crate) fn without_shared_rays(mut self) -> Self {
         self.facets = Facets::default();
+        self
+    }
+
+    /// This solver with every sky direction asked of every vertex (no
+    /// [`probes`]), all else alike: the twin probing is tested against.
+    #[cfg(test)]
+    pub(crate) fn without_sky_probes(mut self) -> Self {
+        self.probes.iter_mut().for_each(Vec::clear);
         self
     }
 
@@ -1175,44 +1204,58 @@ impl<'a> Progressive<'a> {
         // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
         // pairs and rays it took.
         let facets = &self.facets;
+        let probes = &self.probes[i][..];
         let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
             let x = mesh.sample_positions[l];
             let tile = tile_of[l] as usize * groups;
             let mut rays = 0u64;
             let memo = &mut scratch.memo;
+            let nx = mesh.polygons[j.index()].normal;
+            // Whether sample `k` at `s` is hidden from this vertex.
+            let mut ray = |k: usize, s: glam::Vec3| -> bool {
+                // A small facet's vertices share one ray per sample.
+                if let Some(middle) = facets.point(j.index(), s, samples[k].exact_r2) {
+                    let (hit, cast) = memo.answer(j.0, k as u32, || {
+                        (visibility.occluded(s, middle, (shooter, j)), 1)
+                    });
+                    rays += cast;
+                    return hit;
+                }
+                let blockers = tile_candidates
+                    .get(tile + k / SHOOTER_GROUP)
+                    .map_or(&[][..], |c| &c[..]);
+                if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX {
+                    rays += 1;
+                    visibility.occluded(s, x, (shooter, j))
+                } else if blockers.is_empty() {
+                    // Nothing in the shaft: visible, no ray needed.
+                    false
+                } else if blockers.len() <= LINEAR_CANDIDATES {
+                    rays += 1;
+                    visibility.occluded_among(s, x, blockers)
+                } else {
+                    rays += 1;
+                    visibility.occluded(s, x, (shooter, j))
+                }
+            };
+            // A sky facet's probes, when they agree, stand for all its
+            // directions.
+            let verdict = if probes.is_empty() {
+                None
+            } else {
+                probes::verdict(probes, samples, x, nx, &mut ray)
+            };
             let (f, pairs) = distribution::shot_point_to_samples(
                 directional,
                 x,
-                mesh.polygons[j.index()].normal,
+                nx,
                 shooter_normal,
                 samples,
                 |k| shot[k],
                 near_field,
-                |k, s| {
-                    // A small facet's vertices share one ray per sample.
-                    if let Some(middle) = facets.point(j.index(), s, samples[k].exact_r2) {
-                        let (hit, cast) = memo.answer(j.0, k as u32, || {
-                            (visibility.occluded(s, middle, (shooter, j)), 1)
-                        });
-                        rays += cast;
-                        return hit;
-                    }
-                    let blockers = tile_candidates
-                        .get(tile + k / SHOOTER_GROUP)
-                        .map_or(&[][..], |c| &c[..]);
-                    if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX {
-                        rays += 1;
-                        visibility.occluded(s, x, (shooter, j))
-                    } else if blockers.is_empty() {
-                        // Nothing in the shaft: visible, no ray needed.
-                        false
-                    } else if blockers.len() <= LINEAR_CANDIDATES {
-                        rays += 1;
-                        visibility.occluded_among(s, x, blockers)
-                    } else {
-                        rays += 1;
-                        visibility.occluded(s, x, (shooter, j))
-                    }
+                |k, s| match verdict {
+                    Some(blocked) => blocked,
+                    None => ray(k, s),
                 },
             );
             (reflectance[j.index()] * f, pairs, rays)

@@ -628,7 +628,7 @@ fn lamp_materials() -> Vec<crate::scene::Material> {
 }
 
 /// Runs `f` on a pool of `threads` threads.
-fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+pub(super) fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -637,7 +637,7 @@ fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
 }
 
 /// True when the two radiosity arrays are equal bit for bit.
-fn same_bits(a: &[Rgb], b: &[Rgb]) -> bool {
+pub(super) fn same_bits(a: &[Rgb], b: &[Rgb]) -> bool {
     a.len() == b.len()
         && a.iter()
             .zip(b)
