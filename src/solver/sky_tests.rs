@@ -362,14 +362,7 @@ fn sky_probes_match_asking_every_direction() {
         vec![grey("floor", 0.0, 0.5), grey("black", 0.0, 0.0)],
     );
     s.add_sky(Rgb::splat(2.0)).unwrap();
-    let mesh = mesh::build(
-        &s,
-        &MeshOptions {
-            lenmax: 0.1,
-            inset: mesh::DEFAULT_INSET,
-        },
-    )
-    .unwrap();
+    let mesh = crate::testutil::regular_mesh(&s, 0.1);
     let vis = Visibility::new(&s);
     let run = |probing: bool| {
         let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());

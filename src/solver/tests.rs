@@ -1401,14 +1401,7 @@ fn first_look_is_what_a_new_solver_shows() {
 fn shared_facet_rays_match_per_vertex_rays() {
     let s = crate::scene::parse_str(&crate::scene::sphere_box::sphere_box_sc(24), "t.sc")
         .expect("the generated scene parses");
-    let mesh = mesh::build(
-        &s,
-        &MeshOptions {
-            lenmax: 80.0,
-            inset: crate::mesh::DEFAULT_INSET,
-        },
-    )
-    .unwrap();
+    let mesh = crate::testutil::regular_mesh(&s, 80.0);
     let vis = Visibility::new(&s);
     let options = SolverOptions {
         threshold: 1e-3,
