@@ -38,12 +38,18 @@
 //! The shared answer is a pure function of the facet and the sample (or
 //! stratum) it was asked for, so memoising it ([`Memo`]) cannot change a
 //! bit, whatever vertex asks first and however the vertices are split
-//! between threads. On with clusters and hierarchical receivers
+//! between threads. The count of rays cast does vary a little: a facet
+//! whose vertices fall in two workers' runs asks some rays twice, and
+//! the runs depend on work stealing (on the 100,000-triangle box, 4
+//! steps cast 12,319,995 to 12,320,055 rays over runs with the same
+//! picture bytes). On with clusters and hierarchical receivers
 //! ([`super::SolverOptions::receiver_interpolation`]); `--exact-receivers`
 //! and `--no-clustering` ask every ray per vertex.
 
 use super::SHAFT_MIN_VERTICES;
 use crate::mesh::Mesh;
+use crate::scene::PolygonId;
+use crate::visibility::Visibility;
 use glam::Vec3;
 
 /// A shooter sample nearer a facet's middle than this many of the facet's
@@ -121,6 +127,28 @@ impl Facets {
         let (middle, diameter) = self.points.get(j).copied().flatten()?;
         let reach = (NEAR_RATIO * diameter).max(exact_r2.sqrt() + diameter);
         (from.distance_squared(middle) > reach * reach).then_some(middle)
+    }
+
+    /// The shared answer for the segment from shooter point `from` (of
+    /// polygon `ends.0`, sample or stratum `key`) to receiving facet
+    /// `ends.1`: `Some((blocked, rays cast))` from `memo`, or from one ray
+    /// to the facet's middle, when the facet shares ([`Facets::point`]);
+    /// `None` when the vertex must ask its own ray.
+    #[inline]
+    pub fn shared_ray(
+        &self,
+        memo: &mut Memo,
+        visibility: &Visibility,
+        ends: (PolygonId, PolygonId),
+        key: u32,
+        from: Vec3,
+        exact_r2: f32,
+    ) -> Option<(bool, u64)> {
+        let facet = ends.1;
+        let middle = self.point(facet.index(), from, exact_r2)?;
+        Some(memo.answer(facet.0, key, || {
+            (visibility.occluded(from, middle, ends), 1)
+        }))
     }
 }
 

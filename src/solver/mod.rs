@@ -572,12 +572,15 @@ impl<'a> Progressive<'a> {
                 start = end;
             }
         }
+        // Shared facet rays and sky probes go with the other receiver
+        // approximations.
+        let approximate = clustered && options.receiver_interpolation;
         let sky_probes = mesh
             .polygons
             .iter()
             .zip(&samples)
             .map(|(pm, own)| {
-                if pm.sky && clustered && options.receiver_interpolation {
+                if pm.sky && approximate {
                     probes::spread(own, probes::SKY_PROBES)
                 } else {
                     Vec::new()
@@ -619,7 +622,7 @@ impl<'a> Progressive<'a> {
                 .map(|pm| CoarseGrid::detect(mesh, pm))
                 .collect(),
             coarse_delta: Vec::new(),
-            facets: Facets::new(mesh, clustered && options.receiver_interpolation),
+            facets: Facets::new(mesh, approximate),
             probes: sky_probes,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,
@@ -1214,10 +1217,14 @@ impl<'a> Progressive<'a> {
             // Whether sample `k` at `s` is hidden from this vertex.
             let mut ray = |k: usize, s: glam::Vec3| -> bool {
                 // A small facet's vertices share one ray per sample.
-                if let Some(middle) = facets.point(j.index(), s, samples[k].exact_r2) {
-                    let (hit, cast) = memo.answer(j.0, k as u32, || {
-                        (visibility.occluded(s, middle, (shooter, j)), 1)
-                    });
+                if let Some((hit, cast)) = facets.shared_ray(
+                    memo,
+                    visibility,
+                    (shooter, j),
+                    k as u32,
+                    s,
+                    samples[k].exact_r2,
+                ) {
                     rays += cast;
                     return hit;
                 }
@@ -1540,12 +1547,9 @@ impl<'a> Progressive<'a> {
                     );
                 // A small facet's vertices share one ray per node.
                 let mut blocked = |from: glam::Vec3, own: PolygonId, exact_r2: f32| {
-                    let (hit, cast) = match facets.point(j.index(), from, exact_r2) {
-                        Some(middle) => {
-                            memo.answer(j.0, n, || (visibility.occluded(from, middle, (own, j)), 1))
-                        }
-                        None => ray_blocked(visibility, blockers, from, x, (own, j)),
-                    };
+                    let (hit, cast) = facets
+                        .shared_ray(memo, visibility, (own, j), n, from, exact_r2)
+                        .unwrap_or_else(|| ray_blocked(visibility, blockers, from, x, (own, j)));
                     rays += cast;
                     hit
                 };
