@@ -168,8 +168,12 @@ impl<'a> FinalGather<'a> {
             // A shaft is worth building only for polygons of many elements.
             let culled = source.samples.len() >= SHAFT_MIN_VERTICES as usize;
             if culled {
-                self.visibility
-                    .box_shaft_candidates(point_box, id, &mut candidates);
+                self.visibility.box_shaft_candidates(
+                    point_box,
+                    id,
+                    LINEAR_CANDIDATES,
+                    &mut candidates,
+                );
             }
             let visibility = self.visibility;
             let occluded = |s: Vec3| {

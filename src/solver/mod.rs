@@ -1092,7 +1092,7 @@ impl<'a> Progressive<'a> {
             .enumerate()
             .for_each(|(j, c)| {
                 if receives[j] && !small[j] {
-                    visibility.shaft_candidates(shooter, PolygonId(j as u32), c);
+                    visibility.shaft_candidates(shooter, PolygonId(j as u32), REFINE_MAX, c);
                 } else {
                     c.clear();
                 }
@@ -1451,7 +1451,7 @@ impl<'a> Progressive<'a> {
             .for_each(|(j, c)| {
                 let member = clusters.of(PolygonId(j as u32)) == cluster;
                 if receives[j] && !member && !small[j] {
-                    visibility.box_shaft_candidates(bounds, PolygonId(j as u32), c);
+                    visibility.box_shaft_candidates(bounds, PolygonId(j as u32), REFINE_MAX, c);
                 } else {
                     c.clear();
                 }

@@ -186,8 +186,17 @@ impl Visibility {
     /// `from` to any point of polygon `to` (those two excluded), by the
     /// shaft between their bounding boxes; written to `out` (cleared
     /// first) in increasing order. Polygons not listed block no such
-    /// segment.
-    pub fn shaft_candidates(&self, from: PolygonId, to: PolygonId, out: &mut Vec<u32>) {
+    /// segment. The search stops once more than `limit` polygons are
+    /// found: a list of at most `limit` is complete, a longer one is only
+    /// some of the candidates (a caller that would not use so long a list
+    /// then pays for no more of it; pass `usize::MAX` for all).
+    pub fn shaft_candidates(
+        &self,
+        from: PolygonId,
+        to: PolygonId,
+        limit: usize,
+        out: &mut Vec<u32>,
+    ) {
         out.clear();
         let (Some(regions), Some(a), Some(b)) = (
             &self.regions,
@@ -197,13 +206,11 @@ impl Visibility {
             return;
         };
         let shaft = Shaft::between(a.exact_bounds, b.exact_bounds, self.shaft_tolerance);
-        self.polygons_in_shaft(regions, &shaft, out, |p, blocker| {
+        self.polygons_in_shaft(regions, &shaft, limit, out, |p, blocker| {
             !self.in_plane_of(p, (from, to))
                 && shaft.may_overlap_points(blocker.vertices.iter().copied())
                 && self.straddles(blocker, a.vertices.iter().chain(&b.vertices).copied())
         });
-        out.sort_unstable();
-        out.dedup();
     }
 
     /// The polygons that may block a segment from any point of the box
@@ -213,29 +220,39 @@ impl Visibility {
     /// [`Visibility::shaft_candidates`] only `to` and the polygons in its
     /// plane are left out: the polygons inside the box are listed when they
     /// may block, and the ray test leaves out each segment's own shooter
-    /// ([`Visibility::occluded_among_ends`]).
-    pub fn box_shaft_candidates(&self, from: (DVec3, DVec3), to: PolygonId, out: &mut Vec<u32>) {
+    /// ([`Visibility::occluded_among_ends`]). At most `limit` as in
+    /// [`Visibility::shaft_candidates`].
+    pub fn box_shaft_candidates(
+        &self,
+        from: (DVec3, DVec3),
+        to: PolygonId,
+        limit: usize,
+        out: &mut Vec<u32>,
+    ) {
         out.clear();
         let (Some(regions), Some(b)) = (&self.regions, self.blockers.get(to.index())) else {
             return;
         };
         let shaft = Shaft::between(from, b.exact_bounds, self.shaft_tolerance);
-        self.polygons_in_shaft(regions, &shaft, out, |p, blocker| {
+        self.polygons_in_shaft(regions, &shaft, limit, out, |p, blocker| {
             !self.in_plane_of(p, (to, to))
                 && shaft.may_overlap_points(blocker.vertices.iter().copied())
                 && self.boxes_straddle(blocker, from, b.exact_bounds)
         });
-        out.sort_unstable();
-        out.dedup();
     }
 
     /// Appends to `out` every polygon whose box the binary BVH `regions`
     /// finds overlapping `shaft` and that `keep` accepts (given its index
-    /// and its blocker).
+    /// and its blocker), sorted and without repeats, stopping once more
+    /// than `limit` distinct polygons are listed. In a large room the
+    /// shaft from the floor to a chair holds most of the scene: listing it
+    /// all for every receiver made culling cost the square of the
+    /// polygons per step, for lists too long to be used.
     fn polygons_in_shaft(
         &self,
         regions: &Bvh2,
         shaft: &Shaft,
+        limit: usize,
         out: &mut Vec<u32>,
         keep: impl Fn(u32, &Blocker) -> bool,
     ) {
@@ -260,9 +277,18 @@ impl Visibility {
             {
                 if keep(p, &self.blockers[p as usize]) {
                     out.push(p);
+                    if out.len() > limit {
+                        out.sort_unstable();
+                        out.dedup();
+                        if out.len() > limit {
+                            return;
+                        }
+                    }
                 }
             }
         }
+        out.sort_unstable();
+        out.dedup();
     }
 
     /// True unless all `points` lie in one closed half-space of
@@ -660,7 +686,7 @@ mod tests {
                 continue;
             }
             let ends = (PolygonId(i as u32), PolygonId(j as u32));
-            v.shaft_candidates(ends.0, ends.1, &mut candidates);
+            v.shaft_candidates(ends.0, ends.1, usize::MAX, &mut candidates);
             culled += 80 - 2 - candidates.len();
             let point_on = |p: &Polygon, u: f32, w: f32| {
                 let q = &p.vertices;
@@ -679,5 +705,45 @@ mod tests {
             culled > 300 * 40 && blocked > 100,
             "culled {culled}, blocked {blocked}"
         );
+    }
+
+    /// A candidate search with a limit gives the whole list when it is no
+    /// longer than the limit, and otherwise more than the limit, all of
+    /// them real candidates, in increasing order.
+    #[test]
+    fn shaft_candidates_stop_past_the_limit() {
+        let mut stream = crate::testutil::Xorshift(0x0bad_5eed_1234_5678);
+        let mut rand = move || stream.unit_f32();
+        let polygons: Vec<Polygon> = (0..120)
+            .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
+            .collect();
+        let v = Visibility::new(&scene(polygons));
+        let (mut all, mut some) = (Vec::new(), Vec::new());
+        let (mut whole, mut cut) = (0, 0);
+        for _ in 0..300 {
+            let (i, j) = ((rand() * 120.0) as u32 % 120, (rand() * 120.0) as u32 % 120);
+            let limit = (rand() * 12.0) as usize;
+            let ends = (PolygonId(i), PolygonId(j));
+            v.shaft_candidates(ends.0, ends.1, usize::MAX, &mut all);
+            v.shaft_candidates(ends.0, ends.1, limit, &mut some);
+            let from = v.blockers[i as usize].exact_bounds;
+            let mut boxed = Vec::new();
+            v.box_shaft_candidates(from, ends.1, usize::MAX, &mut boxed);
+            let mut boxed_some = Vec::new();
+            v.box_shaft_candidates(from, ends.1, limit, &mut boxed_some);
+            for (all, some) in [(&all, &some), (&boxed, &boxed_some)] {
+                if all.len() <= limit {
+                    assert_eq!(some, all);
+                    whole += 1;
+                } else {
+                    assert!(some.len() > limit, "{} of {}", some.len(), all.len());
+                    assert!(some.windows(2).all(|w| w[0] < w[1]));
+                    assert!(some.iter().all(|p| all.binary_search(p).is_ok()));
+                    cut += 1;
+                }
+            }
+        }
+        // Both cases are exercised.
+        assert!(whole > 50 && cut > 50, "whole {whole}, cut {cut}");
     }
 }
