@@ -363,16 +363,39 @@ impl Stratum {
     }
 
     /// An upper bound on the radiosity the stratum's unshot light brings
-    /// a point at `x` before reflection: its [`Stratum::peak`] times the
-    /// form factor of its bounding sphere, `min(1, radius² / distance²)`
-    /// (a sphere seen from outside subtends at most that share of a
-    /// point's cosine-weighted hemisphere), in emission units.
+    /// a point at `x` with unit normal `nx` before reflection, in emission
+    /// units: the smaller of two.
+    ///
+    /// - Its [`Stratum::peak`] times the form factor of its bounding
+    ///   sphere, `min(1, radius² / distance²)` (a sphere seen from outside
+    ///   subtends at most that share of a point's cosine-weighted
+    ///   hemisphere).
+    /// - Its power times the largest receiver cosine over its box over π
+    ///   times the cube of the box's distance: `P · h / (π d³)`, `h` the
+    ///   height of the box's top above the receiver's plane and `d` the
+    ///   distance from `x` to the box (each cell's cosine at `x` is at
+    ///   most `h / d`, its own cosine at most 1, its distance at least
+    ///   `d`). A stratum lying along the receiver's plane (the legs of a
+    ///   room's furniture seen from its floor, metres away) brings almost
+    ///   nothing, though its sphere's bound is large: this is the bound
+    ///   that says so.
     #[inline]
-    pub fn bound_at(&self, x: Vec3) -> f64 {
+    pub fn bound_at(&self, x: Vec3, nx: Vec3) -> f64 {
         let d2 = f64::from((x - self.centre).length_squared());
         let r2 = f64::from(self.radius) * f64::from(self.radius);
         let share = if d2 > r2 { r2 / d2 } else { 1.0 };
-        self.peak * share
+        let sphere = self.peak * share;
+        let (lo, hi) = self.bounds;
+        let outside = (lo - x).max(x - hi).max(Vec3::ZERO);
+        let d = f64::from(outside.length());
+        if d <= 0.0 {
+            return sphere;
+        }
+        let centre = (lo + hi) * 0.5;
+        let top = nx.dot(centre - x) + nx.abs().dot((hi - lo) * 0.5);
+        let plane =
+            self.power.mean() * f64::from(top.max(0.0)) / (std::f64::consts::PI * d * d * d);
+        sphere.min(plane)
     }
 
     /// Index of the normal bin of `n`: its dominant axis and sign.
@@ -685,7 +708,7 @@ mod tests {
                 Vec3::new(-3.0, 9.0, 0.5),
             ] {
                 for nx in [-Vec3::Z, Vec3::new(0.6, 0.0, -0.8), -Vec3::X] {
-                    let (b, bound) = (brought(n, x, nx), n.bound_at(x));
+                    let (b, bound) = (brought(n, x, nx), n.bound_at(x, nx));
                     assert!(b <= bound * 1.001, "{b} > {bound} at {x} for {:?}", n.cells);
                     tight = tight.max(b / bound);
                 }
@@ -693,6 +716,22 @@ mod tests {
         }
         // And it is not loose everywhere.
         assert!(tight > 0.3, "tightest {tight}");
+        // A receiver 8 away whose plane runs through the floor (a point of
+        // furniture's top, tilted a little towards it): the floor's light
+        // reaches it at grazing angles only. The plane's bound says so,
+        // where the bounding sphere's is 200 times larger, and it still
+        // holds.
+        let x = Vec3::new(12.0, 2.0, 0.2);
+        let nx = Vec3::new(-0.02, 0.0, 1.0).normalize();
+        let root = &strata.nodes[0];
+        let sphere = root.peak * f64::from(root.radius * root.radius)
+            / f64::from((x - root.centre).length_squared());
+        let (b, bound) = (brought(root, x, nx), root.bound_at(x, nx));
+        assert!(b > 0.0 && b <= bound, "{b} against {bound}");
+        assert!(
+            bound < sphere / 100.0,
+            "{bound} against the sphere's {sphere}"
+        );
     }
 
     /// A stratum over `bounds` whose cells all face `normal`.

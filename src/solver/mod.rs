@@ -1566,7 +1566,7 @@ impl<'a> Progressive<'a> {
                 // what such terms bring stay within the allowance.
                 // `lumped` holds the bound of such a stratum.
                 let lumped = if !far && node.children.is_some() && allowance > 0.0 {
-                    let bound = node.bound_at(x);
+                    let bound = node.bound_at(x, nx);
                     (bound <= allowance && rep.polygon != j && !visibility.coplanar(rep.polygon, j))
                         .then(|| {
                             allowance -= bound;
