@@ -321,11 +321,7 @@ impl Stratum {
         if dist2 <= r * r {
             return Seen::Near;
         }
-        // The receiver's plane against the box: the signed distance of
-        // its centre in front of the plane, and the box's half depth
-        // along the normal.
-        let mid = -nx.dot(d);
-        let half = nx.abs().dot((self.bounds.1 - self.bounds.0) * 0.5);
+        let (mid, half) = self.depth(x, nx);
         if mid + half <= 0.0 {
             return Seen::Behind;
         }
@@ -385,17 +381,33 @@ impl Stratum {
         let r2 = f64::from(self.radius) * f64::from(self.radius);
         let share = if d2 > r2 { r2 / d2 } else { 1.0 };
         let sphere = self.peak * share;
-        let (lo, hi) = self.bounds;
-        let outside = (lo - x).max(x - hi).max(Vec3::ZERO);
-        let d = f64::from(outside.length());
+        let d = f64::from(self.outside(x).length());
         if d <= 0.0 {
             return sphere;
         }
-        let centre = (lo + hi) * 0.5;
-        let top = nx.dot(centre - x) + nx.abs().dot((hi - lo) * 0.5);
+        let (mid, half) = self.depth(x, nx);
+        let top = mid + half;
         let plane =
             self.power.mean() * f64::from(top.max(0.0)) / (std::f64::consts::PI * d * d * d);
         sphere.min(plane)
+    }
+
+    /// The receiver's plane (through `x`, unit normal `nx`) against the
+    /// bounding box: the signed height of the box's centre above the
+    /// plane and the box's half depth along the normal, in scene units.
+    #[inline]
+    fn depth(&self, x: Vec3, nx: Vec3) -> (f32, f32) {
+        let mid = -nx.dot(x - self.centre);
+        let half = nx.abs().dot((self.bounds.1 - self.bounds.0) * 0.5);
+        (mid, half)
+    }
+
+    /// How far `x` lies outside the bounding box along each axis (zero
+    /// inside it), in scene units.
+    #[inline]
+    fn outside(&self, x: Vec3) -> Vec3 {
+        let (lo, hi) = self.bounds;
+        (lo - x).max(x - hi).max(Vec3::ZERO)
     }
 
     /// Index of the normal bin of `n`: its dominant axis and sign.
@@ -414,9 +426,7 @@ impl Stratum {
     /// True when `x` is too close to the stratum for its representative.
     #[inline]
     pub fn is_near(&self, x: Vec3) -> bool {
-        let (lo, hi) = self.bounds;
-        let outside = (lo - x).max(x - hi).max(Vec3::ZERO);
-        outside.length_squared() < self.near_r2
+        self.outside(x).length_squared() < self.near_r2
     }
 }
 
