@@ -67,6 +67,21 @@ pub const STRATUM_NEAR_RATIO: f32 = 2.0;
 /// run of floor cells seen from the ceiling).
 pub const PLANE_DEPTH_RATIO: f32 = 1.5;
 
+/// A stratum whose box rests on a receiver's plane (no part behind it,
+/// but too deep for [`PLANE_DEPTH_RATIO`]: a chair seen from the floor
+/// it stands on) is in front of it from this many times the near
+/// distance ([`STRATUM_NEAR_RATIO`] diameters). No cell is behind, so the
+/// far term's cosine at the power-weighted centroid is the cells' mean
+/// height over the plane, exactly; what the extra distance buys is the
+/// spread of their distances, which here weighs with heights from zero.
+/// Measured on the 30-table hall: 5.7 % fewer rays, the picture as far
+/// from the unclustered solve as without it (0.355 %).
+pub const RESTING_NEAR_FACTOR: f32 = 2.0;
+
+/// How far below the receiver's plane a resting box's bottom may reach,
+/// as a fraction of its half depth (rounding of a floor's height).
+const RESTING_TOLERANCE: f32 = 1e-3;
+
 /// A partition of the scene's polygons into clusters.
 ///
 /// Invariants: every polygon is in exactly one cluster; clusters are
@@ -100,7 +115,7 @@ impl Clusters {
     pub fn build(scene: &Scene, mesh: &Mesh, emission: &[Rgb]) -> Self {
         let limit = CLUSTER_EXTENT * scene.extent();
         let mut groups: Vec<Vec<u32>> = Vec::new();
-        let mut items: Vec<(u32, Vec3, Vec3, Vec3)> = Vec::new();
+        let mut items: Vec<Item> = Vec::new();
         for (j, p) in scene.polygons.iter().enumerate() {
             let alone =
                 p.surface.sky || !emission[j].is_black() || mesh.polygons[j].vertex_count() == 0;
@@ -173,10 +188,14 @@ impl Clusters {
     }
 }
 
-/// Splits `items` (polygon, bounds min, bounds max, centroid) top-down
-/// until a node is at most `limit` across or holds one polygon; each such
-/// node is pushed to `groups`.
-fn split(items: &mut [(u32, Vec3, Vec3, Vec3)], limit: f32, groups: &mut Vec<Vec<u32>>) {
+/// A polygon as the hierarchy sees it: (index, bounds min, bounds max,
+/// centroid of its bounds), in scene units.
+type Item = (u32, Vec3, Vec3, Vec3);
+
+/// Splits `items` top-down until a node is at most `limit` across or
+/// holds one polygon; each such node is pushed to `groups`, its members in
+/// the leaf order of the same splitting carried on to single polygons.
+fn split(items: &mut [Item], limit: f32, groups: &mut Vec<Vec<u32>>) {
     if items.is_empty() {
         return;
     }
@@ -185,9 +204,35 @@ fn split(items: &mut [(u32, Vec3, Vec3, Vec3)], limit: f32, groups: &mut Vec<Vec
         |(lo, hi), it| (lo.min(it.1), hi.max(it.2)),
     );
     if items.len() == 1 || (hi - lo).length() <= limit {
+        // The strata of a cluster split its cells where the power halves,
+        // in member order: that order must be compact at every scale, or a
+        // stratum is a slab across the whole cluster (sorted along one
+        // axis only, the 150-table hall's strata were strips 13 m long,
+        // near every receiver, and a floor vertex took ~240 terms).
+        leaf_order(items);
         groups.push(items.iter().map(|it| it.0).collect());
         return;
     }
+    let (left, right) = halve(items);
+    split(left, limit, groups);
+    split(right, limit, groups);
+}
+
+/// Orders `items` as the leaves of the hierarchy [`halve`] builds over
+/// them.
+fn leaf_order(items: &mut [Item]) {
+    if items.len() > 1 {
+        let (left, right) = halve(items);
+        leaf_order(left);
+        leaf_order(right);
+    }
+}
+
+/// Splits `items` (at least two) in two, along the longest axis of their
+/// centroids' bounds: at its middle, so that an object standing apart
+/// stays whole, or at the median when that leaves a side empty. Both
+/// halves are non-empty.
+fn halve(items: &mut [Item]) -> (&mut [Item], &mut [Item]) {
     let (clo, chi) = items.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), it| (lo.min(it.3), hi.max(it.3)),
@@ -202,16 +247,12 @@ fn split(items: &mut [(u32, Vec3, Vec3, Vec3)], limit: f32, groups: &mut Vec<Vec
     };
     // Ties broken by polygon index, so the split is the same on every run.
     items.sort_by(|a, b| a.3[axis].total_cmp(&b.3[axis]).then(a.0.cmp(&b.0)));
-    // At the middle of the centroids' extent, so that an object standing
-    // apart stays whole; at the median when that leaves a side empty.
     let middle = (clo[axis] + chi[axis]) * 0.5;
     let mut at = items.partition_point(|it| it.3[axis] < middle);
     if at == 0 || at == items.len() {
         at = items.len() / 2;
     }
-    let (left, right) = items.split_at_mut(at);
-    split(left, limit, groups);
-    split(right, limit, groups);
+    items.split_at_mut(at)
 }
 
 /// One shooter sample of a cluster's member, with what it carries.
@@ -281,6 +322,12 @@ pub struct Stratum {
     /// normal (length at most 1). A node whose cells face every way (a
     /// chair) is taken from far as these six, each with its own cosine.
     pub bins: [(Rgb, Vec3); 6],
+    /// Per normal bin: the cell where the bin's middle power falls (in
+    /// cell order; `u32::MAX` for an empty bin). A far term taken by bins
+    /// casts its ray from the bin bringing the most, so the ray starts on
+    /// a cell that faces the receiver (the node's representative may lie
+    /// on a table's underside, whose ray to the ceiling the top blocks).
+    pub bin_representatives: [u32; 6],
 }
 
 /// How a receiver point sees a stratum.
@@ -329,7 +376,12 @@ impl Stratum {
         // vary little over the box ([`PLANE_DEPTH_RATIO`]; a sphere's
         // test, distance ≥ radius, asks about as much of a box seen
         // edge-on, and far more of a flat one seen face-on).
-        let in_front = mid >= PLANE_DEPTH_RATIO * half;
+        // Or resting on the plane (no part behind it: furniture seen from
+        // its floor), farther away ([`RESTING_NEAR_FACTOR`]).
+        let in_front = mid >= PLANE_DEPTH_RATIO * half
+            || (mid - half >= -RESTING_TOLERANCE * half
+                && self.outside(x).length_squared()
+                    >= RESTING_NEAR_FACTOR * RESTING_NEAR_FACTOR * self.near_r2);
         let dist = dist2.sqrt();
         // The cone of cell normals, widened by the angle the sphere
         // subtends: every cell faces x when the angle between the axis and
@@ -543,6 +595,15 @@ impl Strata {
                 bin.1 /= w as f32;
             }
         }
+        let mut bin_representatives = [u32::MAX; 6];
+        let mut bin_acc = [0.0f64; 6];
+        for (c, cell) in cells[range.clone()].iter().enumerate() {
+            let b = Stratum::bin_of(cell.normal);
+            if cell.power > 0.0 && bin_acc[b] <= bin_weight[b] * 0.5 {
+                bin_representatives[b] = (range.start + c) as u32;
+            }
+            bin_acc[b] += cell.power.max(0.0);
+        }
         let centroid = (centroid / weight).as_vec3();
         let axis = axis.normalize_or_zero();
         let cone_cos = if axis == Vec3::ZERO {
@@ -572,6 +633,7 @@ impl Strata {
             centroid,
             mean_normal,
             bins,
+            bin_representatives,
         });
         if range.len() > 1 {
             let left = self.node(cells, range.start..split, corners);
@@ -595,6 +657,106 @@ mod tests {
             normal: Vec3::Z,
             power,
         }
+    }
+
+    /// A 16 × 16 grid of small floor squares is one cluster; its members
+    /// must come in an order compact at every scale (each aligned run of
+    /// 4, 16 or 64 within a square-ish patch), not sorted along one axis
+    /// (where a run of 16 is a column 15 units long), since strata are
+    /// runs of that order.
+    #[test]
+    fn a_cluster_lists_its_members_compactly() {
+        use crate::testutil::{grey, polygon, regular_mesh, scene};
+        let mut polygons = Vec::new();
+        for i in 0..16 {
+            for k in 0..16 {
+                let (x, z) = (i as f32, k as f32);
+                polygons.push(polygon(
+                    0,
+                    &[
+                        [x, 0.0, z],
+                        [x, 0.0, z + 0.5],
+                        [x + 0.5, 0.0, z + 0.5],
+                        [x + 0.5, 0.0, z],
+                    ],
+                ));
+            }
+        }
+        // A tall thin post makes the scene's extent large enough for the
+        // whole grid to be one cluster.
+        polygons.push(polygon(
+            0,
+            &[[0.0, 0.0, -1.0], [0.0, 200.0, -1.0], [0.1, 200.0, -1.0]],
+        ));
+        let s = scene(polygons, vec![grey("g", 0.0, 0.5)]);
+        let mesh = regular_mesh(&s, 1.0);
+        let clusters = Clusters::build(&s, &mesh, &vec![Rgb::BLACK; s.polygons.len()]);
+        let grid = (0..clusters.len())
+            .map(|c| clusters.members(c))
+            .find(|m| m.len() == 256)
+            .expect("the grid is one cluster");
+        for run in [4usize, 16, 64] {
+            let limit = 2.0 * (run as f32).sqrt();
+            for chunk in grid.chunks(run) {
+                let (lo, hi) = chunk.iter().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), &m| {
+                        let v = s.polygons[m as usize].vertices[0];
+                        (lo.min(v), hi.max(v))
+                    },
+                );
+                let side = (hi - lo).max_element();
+                assert!(side < limit, "a run of {run} spans {side} units");
+            }
+        }
+    }
+
+    /// A table's cells: a top facing up and an underside facing down,
+    /// the underside carrying most of the power (lit by a lamp beneath).
+    /// Every node's bin representatives lie in its own cells, in their
+    /// bin, where the bin's middle power falls; the root's representative
+    /// is on the underside, its +z bin's on the top.
+    #[test]
+    fn each_normal_bin_has_its_own_representative() {
+        let at = |c: usize| {
+            let p = Vec3::new((c % 4) as f32, 0.0, 0.0);
+            (p, p + Vec3::ONE)
+        };
+        let mut cells: Vec<Cell> = Vec::new();
+        for k in 0..8 {
+            let up = k % 2 == 1;
+            cells.push(Cell {
+                normal: if up { Vec3::Z } else { Vec3::NEG_Z },
+                ..cell(if up { 1.0 } else { 5.0 })
+            });
+        }
+        let strata = Strata::build(&cells, 2, at);
+        for n in &strata.nodes {
+            for (b, &r) in n.bin_representatives.iter().enumerate() {
+                let in_bin: Vec<usize> = (n.cells.start as usize..n.cells.end as usize)
+                    .filter(|&c| Stratum::bin_of(cells[c].normal) == b)
+                    .collect();
+                if in_bin.is_empty() {
+                    assert_eq!(r, u32::MAX);
+                    continue;
+                }
+                assert!(
+                    in_bin.contains(&(r as usize)),
+                    "bin {b}: {r} not among {in_bin:?}"
+                );
+                let total: f64 = in_bin.iter().map(|&c| cells[c].power).sum();
+                let before: f64 = in_bin
+                    .iter()
+                    .filter(|&&c| c < r as usize)
+                    .map(|&c| cells[c].power)
+                    .sum();
+                assert!(before <= total * 0.5 && before + cells[r as usize].power > total * 0.5);
+            }
+        }
+        let root = &strata.nodes[0];
+        assert_eq!(cells[root.representative as usize].normal, Vec3::NEG_Z);
+        let up = root.bin_representatives[Stratum::bin_of(Vec3::Z)];
+        assert_eq!(cells[up as usize].normal, Vec3::Z);
     }
 
     #[test]
@@ -766,6 +928,7 @@ mod tests {
             centroid: centre,
             mean_normal: normal,
             bins: [(Rgb::BLACK, Vec3::ZERO); 6],
+            bin_representatives: [u32::MAX; 6],
         }
     }
 
@@ -780,18 +943,46 @@ mod tests {
         assert_eq!(floor.seen_from(ceiling, -Vec3::Z), Seen::FarBinned);
         // Every cell behind the plane of a receiver there facing up.
         assert_eq!(floor.seen_from(ceiling, Vec3::Z), Seen::Behind);
-        // A wall run 2 high, 10 away, seen from points of a floor facing
-        // up: from 0.2 below its foot the receiver's cosine varies too
-        // much over it (the centre 1.2 above the plane, half depth 1); from
-        // 1 below, enough in front (2 against 1.5).
+        // A wall run 2 high (diameter 2.24), 6 away, seen from points of a
+        // floor facing up: from 0.2 below its foot the receiver's cosine
+        // varies too much over it (the centre 1.2 above the plane, half
+        // depth 1); from 1 below, enough in front (2 against 1.5).
         let wall = flat((Vec3::ZERO, Vec3::new(1.0, 0.0, 2.0)), Vec3::NEG_Y);
         assert_eq!(
-            wall.seen_from(Vec3::new(0.5, -10.0, -0.2), Vec3::Z),
+            wall.seen_from(Vec3::new(0.5, -6.0, -0.2), Vec3::Z),
             Seen::Near
         );
         assert_ne!(
-            wall.seen_from(Vec3::new(0.5, -10.0, -1.0), Vec3::Z),
+            wall.seen_from(Vec3::new(0.5, -6.0, -1.0), Vec3::Z),
             Seen::Near
         );
+    }
+
+    #[test]
+    fn a_stratum_resting_on_the_plane_is_far_from_farther() {
+        // A chair-sized box (diameter 1.5) standing on a floor (z = 0),
+        // seen from points of the floor: its centre at half its depth, so
+        // never in front by the depth ratio; nothing of it is behind.
+        let chair = flat((Vec3::ZERO, Vec3::new(0.5, 0.5, 1.3)), Vec3::NEG_Y);
+        let diameter = (chair.bounds.1 - chair.bounds.0).length();
+        let near = STRATUM_NEAR_RATIO * diameter;
+        let at = |k: f32| Vec3::new(0.25, -k * near, 0.0);
+        // Beyond twice the near distance: in front, one far term.
+        assert_ne!(
+            chair.seen_from(at(RESTING_NEAR_FACTOR * 1.05), Vec3::Z),
+            Seen::Near
+        );
+        // Past the near distance but within twice it: still descends.
+        assert_eq!(
+            chair.seen_from(at(RESTING_NEAR_FACTOR * 0.95), Vec3::Z),
+            Seen::Near
+        );
+        // The same box sunk 0.1 into the floor has a part behind the
+        // plane: it descends however far.
+        let sunk = flat(
+            (Vec3::new(0.0, 0.0, -0.1), Vec3::new(0.5, 0.5, 1.2)),
+            Vec3::NEG_Y,
+        );
+        assert_eq!(sunk.seen_from(at(20.0), Vec3::Z), Seen::Near);
     }
 }

@@ -145,6 +145,10 @@ pub const WEAK_STRATUM_SHARE: f64 = 3e-3;
 /// fewer).
 pub const MIN_STRATA: usize = 8;
 
+/// Shared-ray keys per stratum node ([`facets::Memo`]): one per normal
+/// bin a far term may cast from, and one for the node's representative.
+const RAY_SLOTS: u32 = 7;
+
 /// The share of the ambient term ([`Progressive::ambient`]) times its
 /// reflectance that a point may expect to receive later, and so send ahead
 /// when it shoots ([`SolverOptions::overshoot`], [`Expectation`]). The
@@ -1546,9 +1550,12 @@ impl<'a> Progressive<'a> {
                         },
                     );
                 // A small facet's vertices share one ray per node.
-                let mut blocked = |from: glam::Vec3, own: PolygonId, exact_r2: f32| {
+                // Keyed by node and by the cell the ray leaves from (the
+                // node's representative, or a normal bin's).
+                let mut blocked = |from: glam::Vec3, own: PolygonId, exact_r2: f32, slot: u32| {
+                    let key = n * RAY_SLOTS + slot;
                     let (hit, cast) = facets
-                        .shared_ray(memo, visibility, (own, j), n, from, exact_r2)
+                        .shared_ray(memo, visibility, (own, j), key, from, exact_r2)
                         .unwrap_or_else(|| ray_blocked(visibility, blockers, from, x, (own, j)));
                     rays += cast;
                     hit
@@ -1600,7 +1607,7 @@ impl<'a> Progressive<'a> {
                             near_field,
                             |_, from| {
                                 let exact_r2 = cell_samples[node.representative as usize].exact_r2;
-                                blocked(from, rep.polygon, exact_r2)
+                                blocked(from, rep.polygon, exact_r2, RAY_SLOTS - 1)
                             },
                         );
                         sum += f;
@@ -1611,8 +1618,8 @@ impl<'a> Progressive<'a> {
                 }
                 // Far: the node's power from its centroid, with its
                 // mean normal (or, binned, each normal bin's); the ray
-                // from the representative.
-                let sample = &cell_samples[node.representative as usize];
+                // from the representative (binned, from the
+                // representative of the bin that brings the most).
                 let d = x - node.centroid;
                 let r2 = d.length_squared();
                 let cos_x = -nx.dot(d);
@@ -1620,11 +1627,19 @@ impl<'a> Progressive<'a> {
                     continue;
                 }
                 let mut power = Rgb::BLACK;
+                let (mut from, mut slot) = (node.representative, RAY_SLOTS - 1);
                 if binned || lumped.is_some() {
-                    for (p, normal) in &node.bins {
+                    let mut most = 0.0;
+                    for (b, (p, normal)) in node.bins.iter().enumerate() {
                         let cos_s = normal.dot(d);
                         if cos_s > 0.0 {
-                            power += *p * f64::from(cos_s);
+                            let brings = *p * f64::from(cos_s);
+                            power += brings;
+                            let at = node.bin_representatives[b];
+                            if brings.mean() > most && at != u32::MAX {
+                                most = brings.mean();
+                                (from, slot) = (at, b as u32);
+                            }
                         }
                     }
                 } else {
@@ -1638,7 +1653,9 @@ impl<'a> Progressive<'a> {
                 }
                 pairs += 1;
                 // Far (or lumped, its light bounded): no vertex near a cell.
-                if !blocked(sample.position, rep.polygon, 0.0) {
+                let origin = &cells[from as usize];
+                let sample = &cell_samples[from as usize];
+                if !blocked(sample.position, origin.polygon, 0.0, slot) {
                     let r2 = f64::from(r2);
                     let term = power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
                     // A lumped stratum may be close: its term is held to
