@@ -33,7 +33,12 @@
 //! mean normal (exact for the cosine at the shooter while every cell
 //! faces the receiver; no cell is ever treated as isotropic), and the
 //! visibility of one ray from its representative cell (the one where the
-//! node's middle power falls, a point on a real surface). A stratum wholly
+//! node's middle power falls, a point on a real surface). A node whose
+//! cells face every way (a chair) is taken from far by normal bins, each
+//! with its own cosine and its own ray from a cell of the bin. The
+//! members of a cluster are listed in the leaf order of a hierarchy
+//! carried down to single polygons, so that strata (runs of that order)
+//! are compact. A stratum wholly
 //! behind is skipped; any other descends to its halves, and a single cell
 //! takes the exact rules of a polygon's shot (near field included).
 
@@ -324,9 +329,9 @@ pub struct Stratum {
     pub bins: [(Rgb, Vec3); 6],
     /// Per normal bin: the cell where the bin's middle power falls (in
     /// cell order; `u32::MAX` for an empty bin). A far term taken by bins
-    /// casts its ray from the bin bringing the most, so the ray starts on
-    /// a cell that faces the receiver (the node's representative may lie
-    /// on a table's underside, whose ray to the ceiling the top blocks).
+    /// casts one ray per bin facing the receiver, from that bin's cell:
+    /// the node's representative may lie on a table's underside, whose
+    /// ray to the ceiling the top blocks.
     pub bin_representatives: [u32; 6],
 }
 
@@ -340,8 +345,8 @@ pub enum Seen {
     /// receiver is far enough for one term from the representative.
     Far,
     /// Every cell lies in front of the receiver, far enough away, but
-    /// their normals are too spread for one cosine: one term per normal
-    /// bin ([`Stratum::bins`]).
+    /// their normals are too spread for one cosine: one term and one ray
+    /// per normal bin facing the receiver ([`Stratum::bins`]).
     FarBinned,
     /// Anything else: take the halves (or, for one cell, its exact rules).
     Near,

@@ -1562,6 +1562,7 @@ impl<'a> Progressive<'a> {
                 };
                 let node = &strata.nodes[n as usize];
                 let rep = &cells[node.representative as usize];
+                let rep_sample = &cell_samples[node.representative as usize];
                 let seen = node.seen_from(x, nx);
                 if seen == Seen::Behind {
                     continue;
@@ -1617,54 +1618,63 @@ impl<'a> Progressive<'a> {
                     _ => {}
                 }
                 // Far: the node's power from its centroid, with its
-                // mean normal (or, binned, each normal bin's); the ray
-                // from the representative (binned, from the
-                // representative of the bin that brings the most).
+                // mean normal and one ray from its representative; or,
+                // binned (cells facing every way), each normal bin's
+                // power with its own cosine and its own ray, from the
+                // bin's representative (a cell facing the receiver: the
+                // node's may lie on a table's underside, whose ray to
+                // the ceiling the top blocks; one ray for all bins would
+                // give the whole node the visibility of one face).
                 let d = x - node.centroid;
                 let r2 = d.length_squared();
                 let cos_x = -nx.dot(d);
                 if cos_x <= 0.0 || r2 <= 0.0 {
                     continue;
                 }
-                let mut power = Rgb::BLACK;
-                let (mut from, mut slot) = (node.representative, RAY_SLOTS - 1);
+                let geometry = {
+                    let r2 = f64::from(r2);
+                    f64::from(cos_x) / (std::f64::consts::PI * r2 * r2)
+                };
+                // (power it brings, whether a ray finds it visible)
+                let (mut power, mut seen) = (Rgb::BLACK, Rgb::BLACK);
                 if binned || lumped.is_some() {
-                    let mut most = 0.0;
                     for (b, (p, normal)) in node.bins.iter().enumerate() {
                         let cos_s = normal.dot(d);
-                        if cos_s > 0.0 {
-                            let brings = *p * f64::from(cos_s);
-                            power += brings;
-                            let at = node.bin_representatives[b];
-                            if brings.mean() > most && at != u32::MAX {
-                                most = brings.mean();
-                                (from, slot) = (at, b as u32);
-                            }
+                        let at = node.bin_representatives[b];
+                        if cos_s <= 0.0 || at == u32::MAX {
+                            continue;
+                        }
+                        let brings = *p * f64::from(cos_s);
+                        power += brings;
+                        let (origin, sample) = (&cells[at as usize], &cell_samples[at as usize]);
+                        if !blocked(sample.position, origin.polygon, 0.0, b as u32) {
+                            seen += brings;
                         }
                     }
                 } else {
                     let cos_s = node.mean_normal.dot(d);
-                    if cos_s > 0.0 {
-                        power = node.power * f64::from(cos_s);
+                    if cos_s <= 0.0 {
+                        continue;
+                    }
+                    power = node.power * f64::from(cos_s);
+                    // Far: no vertex near a cell.
+                    if !blocked(rep_sample.position, rep.polygon, 0.0, RAY_SLOTS - 1) {
+                        seen = power;
                     }
                 }
                 if power.is_black() {
                     continue;
                 }
                 pairs += 1;
-                // Far (or lumped, its light bounded): no vertex near a cell.
-                let origin = &cells[from as usize];
-                let sample = &cell_samples[from as usize];
-                if !blocked(sample.position, origin.polygon, 0.0, slot) {
-                    let r2 = f64::from(r2);
-                    let term = power * (f64::from(cos_x) / (std::f64::consts::PI * r2 * r2));
-                    // A lumped stratum may be close: its term is held to
-                    // the bound on what it can bring.
-                    sum += match lumped {
-                        Some(cap) if term.mean() > cap => term * (cap / term.mean()),
-                        _ => term,
-                    };
-                }
+                let term = seen * geometry;
+                // A lumped stratum may be close: its term is held to the
+                // bound on what it can bring (in the share its visible
+                // bins have of it).
+                let whole = power.mean() * geometry;
+                sum += match lumped {
+                    Some(cap) if whole > cap => term * (cap / whole),
+                    _ => term,
+                };
             }
             (reflectance[j.index()] * sum, pairs, rays)
         };
