@@ -1624,7 +1624,9 @@ impl<'a> Progressive<'a> {
                 // bin's representative (a cell facing the receiver: the
                 // node's may lie on a table's underside, whose ray to
                 // the ceiling the top blocks; one ray for all bins would
-                // give the whole node the visibility of one face).
+                // give the whole node the visibility of one face). A
+                // lumped node, whose light is bounded within the
+                // allowance, takes one ray, from the bin bringing most.
                 let d = x - node.centroid;
                 let r2 = d.length_squared();
                 let cos_x = -nx.dot(d);
@@ -1637,7 +1639,28 @@ impl<'a> Progressive<'a> {
                 };
                 // (power it brings, whether a ray finds it visible)
                 let (mut power, mut seen) = (Rgb::BLACK, Rgb::BLACK);
-                if binned || lumped.is_some() {
+                if lumped.is_some() {
+                    let (mut most, mut from) = (0.0, None);
+                    for (b, (p, normal)) in node.bins.iter().enumerate() {
+                        let cos_s = normal.dot(d);
+                        let at = node.bin_representatives[b];
+                        if cos_s <= 0.0 || at == u32::MAX {
+                            continue;
+                        }
+                        let brings = *p * f64::from(cos_s);
+                        power += brings;
+                        if brings.mean() > most {
+                            most = brings.mean();
+                            from = Some((at, b as u32));
+                        }
+                    }
+                    if let Some((at, b)) = from {
+                        let (origin, sample) = (&cells[at as usize], &cell_samples[at as usize]);
+                        if !blocked(sample.position, origin.polygon, 0.0, b) {
+                            seen = power;
+                        }
+                    }
+                } else if binned {
                     for (b, (p, normal)) in node.bins.iter().enumerate() {
                         let cos_s = normal.dot(d);
                         let at = node.bin_representatives[b];
