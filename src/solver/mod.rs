@@ -1639,7 +1639,8 @@ impl<'a> Progressive<'a> {
                 };
                 // (power it brings, whether a ray finds it visible)
                 let (mut power, mut seen) = (Rgb::BLACK, Rgb::BLACK);
-                if lumped.is_some() {
+                if binned || lumped.is_some() {
+                    let one_ray = lumped.is_some();
                     let (mut most, mut from) = (0.0, None);
                     for (b, (p, normal)) in node.bins.iter().enumerate() {
                         let cos_s = normal.dot(d);
@@ -1649,29 +1650,22 @@ impl<'a> Progressive<'a> {
                         }
                         let brings = *p * f64::from(cos_s);
                         power += brings;
-                        if brings.mean() > most {
-                            most = brings.mean();
-                            from = Some((at, b as u32));
+                        if one_ray {
+                            if brings.mean() > most {
+                                most = brings.mean();
+                                from = Some((at, b as u32));
+                            }
+                            continue;
+                        }
+                        let (origin, sample) = (&cells[at as usize], &cell_samples[at as usize]);
+                        if !blocked(sample.position, origin.polygon, 0.0, b as u32) {
+                            seen += brings;
                         }
                     }
                     if let Some((at, b)) = from {
                         let (origin, sample) = (&cells[at as usize], &cell_samples[at as usize]);
                         if !blocked(sample.position, origin.polygon, 0.0, b) {
                             seen = power;
-                        }
-                    }
-                } else if binned {
-                    for (b, (p, normal)) in node.bins.iter().enumerate() {
-                        let cos_s = normal.dot(d);
-                        let at = node.bin_representatives[b];
-                        if cos_s <= 0.0 || at == u32::MAX {
-                            continue;
-                        }
-                        let brings = *p * f64::from(cos_s);
-                        power += brings;
-                        let (origin, sample) = (&cells[at as usize], &cell_samples[at as usize]);
-                        if !blocked(sample.position, origin.polygon, 0.0, b as u32) {
-                            seen += brings;
                         }
                     }
                 } else {
