@@ -149,6 +149,9 @@ pub const MIN_STRATA: usize = 8;
 /// bin a far term may cast from, and one for the node's representative.
 const RAY_SLOTS: u32 = 7;
 
+/// The shared-ray key slot of a ray from the node's representative.
+const REPRESENTATIVE_SLOT: u32 = RAY_SLOTS - 1;
+
 /// The share of the ambient term ([`Progressive::ambient`]) times its
 /// reflectance that a point may expect to receive later, and so send ahead
 /// when it shoots ([`SolverOptions::overshoot`], [`Expectation`]). The
@@ -1603,12 +1606,12 @@ impl<'a> Progressive<'a> {
                             x,
                             nx,
                             mesh.polygons[rep.polygon.index()].normal,
-                            std::slice::from_ref(&cell_samples[node.representative as usize]),
+                            std::slice::from_ref(rep_sample),
                             |_| rep.unshot,
                             near_field,
                             |_, from| {
-                                let exact_r2 = cell_samples[node.representative as usize].exact_r2;
-                                blocked(from, rep.polygon, exact_r2, RAY_SLOTS - 1)
+                                let exact_r2 = rep_sample.exact_r2;
+                                blocked(from, rep.polygon, exact_r2, REPRESENTATIVE_SLOT)
                             },
                         );
                         sum += f;
@@ -1675,7 +1678,7 @@ impl<'a> Progressive<'a> {
                     }
                     power = node.power * f64::from(cos_s);
                     // Far: no vertex near a cell.
-                    if !blocked(rep_sample.position, rep.polygon, 0.0, RAY_SLOTS - 1) {
+                    if !blocked(rep_sample.position, rep.polygon, 0.0, REPRESENTATIVE_SLOT) {
                         seen = power;
                     }
                 }
