@@ -238,6 +238,8 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     h.word(u64::from(super::facets::NEAR_RATIO.to_bits()));
     h.word(super::probes::SKY_PROBES as u64);
     h.word(super::probes::MIN_PROBES as u64);
+    h.word(u64::from(super::far_shooters::FAR_SHOOTER_RATIO.to_bits()));
+    h.word(super::far_shooters::FAR_PROBES as u64);
     h.word(options.overshoot as u64);
     h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
     h.word(match options.unshot {

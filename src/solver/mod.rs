@@ -57,6 +57,10 @@
 //! vertex asks a few of a sky facet's directions first and, when they
 //! agree, takes their answer for all of them.
 //!
+//! **Far shooters** ([`far_shooters`], with the same switch): a vertex
+//! many diameters from a polygon shooting alone (a lamp) probes a few of
+//! its samples first and, when they agree, takes their answer for all.
+//!
 //! Emission and reflection are from the front only. Receivers are
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
@@ -66,6 +70,7 @@ pub mod checkpoint;
 pub mod cluster;
 pub mod distribution;
 pub mod facets;
+pub mod far_shooters;
 pub mod formfactor;
 pub mod gather;
 pub mod hemicube;
@@ -80,6 +85,7 @@ use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
 use cluster::{Cell, Clusters, Seen, Strata};
 use facets::{Facets, Scratch};
+use far_shooters::FarShooter;
 use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use receivers::CoarseGrid;
@@ -452,6 +458,10 @@ pub struct Progressive<'a> {
     /// Per polygon: a sky facet's probe samples ([`probes`]), empty for
     /// every other polygon and when probing is off.
     probes: Vec<Vec<u32>>,
+    /// Per polygon: where it is far enough to be probed when it shoots
+    /// alone, and its probes ([`far_shooters`]); `None` for sky facets,
+    /// polygons of few samples and when the approximation is off.
+    far_shooters: Vec<Option<FarShooter>>,
     /// Per polygon: scratch, its candidates in runs of one culling group
     /// with the group's bounds.
     candidate_runs: Vec<Vec<crate::visibility::CandidateRun>>,
@@ -594,6 +604,16 @@ impl<'a> Progressive<'a> {
                 }
             })
             .collect();
+        let far_shooters = mesh
+            .polygons
+            .iter()
+            .zip(&samples)
+            .map(|(pm, own)| {
+                (approximate && !pm.sky)
+                    .then(|| FarShooter::new(own))
+                    .flatten()
+            })
+            .collect();
         let mut solver = Progressive {
             mesh: mesh_ref.clone(),
             visibility,
@@ -631,6 +651,7 @@ impl<'a> Progressive<'a> {
             coarse_delta: Vec::new(),
             facets: Facets::new(mesh, approximate),
             probes: sky_probes,
+            far_shooters,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,
             tiles,
@@ -894,6 +915,15 @@ impl<'a> Progressive<'a> {
     #[cfg(test)]
     pub(crate) fn without_sky_probes(mut self) -> Self {
         self.probes.iter_mut().for_each(Vec::clear);
+        self
+    }
+
+    /// This solver with every sample of a far shooter asked of every
+    /// vertex (no [`far_shooters`] probes), all else alike: the twin
+    /// probing is tested against.
+    #[cfg(test)]
+    pub(crate) fn without_far_probes(mut self) -> Self {
+        self.far_shooters.iter_mut().for_each(|f| *f = None);
         self
     }
 
@@ -1215,6 +1245,7 @@ impl<'a> Progressive<'a> {
         // pairs and rays it took.
         let facets = &self.facets;
         let probes = &self.probes[i][..];
+        let far_shooter = self.far_shooters[i].as_ref();
         let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
             let x = mesh.sample_positions[l];
             let tile = tile_of[l] as usize * groups;
@@ -1253,11 +1284,12 @@ impl<'a> Progressive<'a> {
                 }
             };
             // A sky facet's probes, when they agree, stand for all its
-            // directions.
-            let verdict = if probes.is_empty() {
-                None
-            } else {
-                probes::verdict(probes, samples, x, nx, &mut ray)
+            // directions; so do a far shooter's for all its samples.
+            let far_probes = far_shooter.and_then(|f| f.probes_from(x));
+            let verdict = match (probes, far_probes) {
+                ([], None) => None,
+                ([], Some(far)) => probes::verdict(far, samples, x, nx, &mut ray),
+                (sky, _) => probes::verdict(sky, samples, x, nx, &mut ray),
             };
             let (f, pairs) = distribution::shot_point_to_samples(
                 directional,
@@ -2217,6 +2249,8 @@ fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
         .collect()
 }
 
+#[cfg(test)]
+mod far_shooter_tests;
 #[cfg(test)]
 mod overshoot_tests;
 #[cfg(test)]
