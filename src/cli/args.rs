@@ -131,9 +131,10 @@ pub struct Args {
     /// matter (within 0.3 % of what the vertex holds). A facet under half
     /// an element across asks one shadow ray per shooter sample for all
     /// its vertices, in every step, and a vertex asks 16 of a sky facet's
-    /// directions first, the other 240 only when those disagree. Emitters'
-    /// shots are otherwise always exact. This is the exact twin, for
-    /// comparison.
+    /// directions first, the other 240 only when those disagree; a vertex
+    /// six or more diameters from a lamp asks four of its samples first,
+    /// the others only when those disagree. Emitters' shots are otherwise
+    /// always exact. This is the exact twin, for comparison.
     #[arg(long)]
     pub(crate) exact_receivers: bool,
 

@@ -23,11 +23,12 @@
 //! `D · a / (R · D)`, so about `a / R`, apart, which a chair leg can slip
 //! through. Such a leg then hides none of the lamp from a vertex it should
 //! partly shade, by the leg's share of the lamp seen from there.
-//! Measured on the 60-table hall (`docs/accuracy.md`): one ray from the
-//! middle instead of probes put the picture 0.44 % from the original
-//! algorithm (0.31 % before), spots beside every leg; four probes from 4
-//! diameters 0.32 %, from 6 diameters 0.29 %, and a third of the lamps'
-//! rays.
+//! Measured on the 60-table hall against the unclustered solve
+//! (`docs/accuracy.md`, Far lamps probed): the picture 0.31 % before,
+//! 0.29 % with four probes from 6 diameters, the lamps' steps casting 38 %
+//! of their rays; from 4 diameters 0.32 % and 32 %; one ray from the
+//! middle instead of probes 0.44 % and 17 %, with spots beside every
+//! leg.
 //!
 //! It goes with the other receiver approximations: off with
 //! `--exact-receivers` and `--no-clustering`. A vertex's answer depends
