@@ -2095,7 +2095,8 @@ where
             if receivers::accept(corners, first[c], cell.check_weights, held[c], spent_now[c])
                 .is_some()
             {
-                *delta = receivers::blend(corners, cell.weights);
+                *delta =
+                    receivers::interpolate(corners, cell.weights, first[c], cell.check_weights);
                 return (0, 0);
             }
             let (d, pairs, rays) = exact(l, j, scratch);
