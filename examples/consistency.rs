@@ -1,0 +1,261 @@
+//! Checks how well a converged solution satisfies the radiosity equation
+//! on chosen polygons, by Monte Carlo, with nothing of the solver's form
+//! factors or visibility (`docs/accuracy.md`):
+//!
+//! ```sh
+//! cargo run --release --example hall -- 1 > hall1.sc
+//! cargo run --release --example consistency -- hall1.sc 0.25 44,48,49
+//! ```
+//!
+//! Arguments: the scene, `lenmax` (`-` for the program's default), the
+//! polygons to check (indices, comma-separated, as `cluster_compare`'s
+//! `CC_LIST=1` prints them) and optionally the points per polygon
+//! (default 20,000).
+//!
+//! Solves the scene twice, without clustering or overshooting (the
+//! original algorithm) and with the defaults. For each solution and
+//! polygon it takes random points on the polygon and, at each, one
+//! cosine-weighted direction over its front hemisphere, traced to the
+//! nearest polygon by brute force. A converged solution should satisfy
+//! `B(x) = E(x) + ρ(x) · B(y)` in the mean over such pairs (the
+//! irradiance over π is the mean of the radiosity seen along
+//! cosine-weighted directions), with `B` both sides interpolated over the
+//! element's triangles as the picture draws it. It prints the polygon's
+//! mean `B(x)`, the mean right-hand side, their difference relative to
+//! the right-hand side and that estimate's standard error: the solution
+//! whose difference is beyond its error is the one that is off there.
+
+use glam::DVec3;
+use radiosity::color::Rgb;
+use radiosity::config::{RunConfig, SceneSource};
+use radiosity::mesh::Mesh;
+use radiosity::prepare;
+use radiosity::scene::Scene;
+use radiosity::session::{Session, SessionOptions};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+/// A small, seedable generator (SplitMix64), so each run is the same.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The scene's polygons for brute-force ray casting, and a solution.
+struct Tracer<'a> {
+    scene: &'a Scene,
+    mesh: &'a Mesh,
+    radiosity: &'a [Rgb],
+}
+
+impl Tracer<'_> {
+    /// The nearest polygon hit by the ray `o + t d` (`t > 1e-9`): its
+    /// index and `t`.
+    fn hit(&self, o: DVec3, d: DVec3) -> Option<(usize, f64)> {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, p) in self.scene.polygons.iter().enumerate() {
+            let n = p.normal.as_dvec3();
+            let denom = n.dot(d);
+            if denom.abs() < 1e-12 {
+                continue;
+            }
+            let v0 = p.vertices[0].as_dvec3();
+            let t = n.dot(v0 - o) / denom;
+            if t <= 1e-9 || best.is_some_and(|b| t >= b.1) {
+                continue;
+            }
+            let x = o + d * t;
+            let k = p.vertices.len();
+            let inside = (0..k).all(|j| {
+                let a = p.vertices[j].as_dvec3();
+                let b = p.vertices[(j + 1) % k].as_dvec3();
+                n.dot((b - a).cross(x - a)) >= -1e-12
+            });
+            if inside {
+                best = Some((i, t));
+            }
+        }
+        best
+    }
+
+    /// The radiosity at `x` on polygon `p`, interpolated over the
+    /// element's triangles as the picture draws it.
+    fn radiosity_at(&self, p: usize, x: DVec3) -> Rgb {
+        let pm = &self.mesh.polygons[p];
+        let n = pm.normal.as_dvec3();
+        let mut nearest = (f64::INFINITY, Rgb::BLACK);
+        for e in &self.mesh.elements[pm.elements.start as usize..pm.elements.end as usize] {
+            for [a, b, c] in e.triangles() {
+                let (pa, pb, pc) = (
+                    self.mesh.positions[a.index()].as_dvec3(),
+                    self.mesh.positions[b.index()].as_dvec3(),
+                    self.mesh.positions[c.index()].as_dvec3(),
+                );
+                let area = n.dot((pb - pa).cross(pc - pa));
+                if area <= 0.0 {
+                    continue;
+                }
+                let wa = n.dot((pb - x).cross(pc - x)) / area;
+                let wb = n.dot((pc - x).cross(pa - x)) / area;
+                let wc = 1.0 - wa - wb;
+                let outside = (-wa).max(-wb).max(-wc);
+                let value = self.radiosity[a.index()] * wa.max(0.0)
+                    + self.radiosity[b.index()] * wb.max(0.0)
+                    + self.radiosity[c.index()] * wc.max(0.0);
+                if outside <= 0.0 {
+                    return value;
+                }
+                if outside < nearest.0 {
+                    nearest = (outside, value);
+                }
+            }
+        }
+        nearest.1
+    }
+
+    /// A uniformly random point of polygon `p` (a fan of triangles from
+    /// its first vertex, chosen by area), kept a millionth of the way in
+    /// from its edges.
+    fn point_on(&self, p: usize, rng: &mut Rng) -> DVec3 {
+        let v: Vec<DVec3> = self.scene.polygons[p]
+            .vertices
+            .iter()
+            .map(|v| v.as_dvec3())
+            .collect();
+        let areas: Vec<f64> = (1..v.len() - 1)
+            .map(|k| (v[k] - v[0]).cross(v[k + 1] - v[0]).length())
+            .collect();
+        let mut pick = rng.next() * areas.iter().sum::<f64>();
+        let mut k = 0;
+        while k + 1 < areas.len() && pick > areas[k] {
+            pick -= areas[k];
+            k += 1;
+        }
+        let (mut s, mut t) = (rng.next(), rng.next());
+        if s + t > 1.0 {
+            (s, t) = (1.0 - s, 1.0 - t);
+        }
+        let (s, t) = (s.clamp(1e-6, 1.0), t.clamp(1e-6, 1.0));
+        let w0 = (1.0 - s - t).max(1e-6);
+        (v[0] * w0 + v[k + 1] * s + v[k + 2] * t) / (w0 + s + t)
+    }
+}
+
+/// Per polygon: (mean luminance of `B(x)`, of `E + ρ B(y)`, the standard
+/// error of the difference's mean).
+fn check(tracer: &Tracer, polygons: &[usize], points: usize) -> Vec<(f64, f64, f64)> {
+    polygons
+        .par_iter()
+        .map(|&p| {
+            let poly = &tracer.scene.polygons[p];
+            let material = &tracer.scene.materials[poly.material.index()];
+            let (e, rho) = (material.emission(), material.reflectance());
+            let n = poly.normal.as_dvec3();
+            let (u, w) = n.any_orthonormal_pair();
+            let mut rng = Rng(0x5eed ^ p as u64);
+            let (mut sum_b, mut sum_rhs, mut sum_d2) = (0.0, 0.0, 0.0);
+            let mut bins = [(0.0f64, 0.0f64, 0usize); 10];
+            let (lo, hi) = poly
+                .vertices
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(f64::from(v.y)), hi.max(f64::from(v.y)))
+                });
+            for _ in 0..points {
+                let x = tracer.point_on(p, &mut rng);
+                let b = tracer.radiosity_at(p, x).luminance();
+                // A cosine-weighted direction (Malley's method).
+                let (r, phi) = (rng.next().sqrt(), 2.0 * PI * rng.next());
+                let d = u * (r * phi.cos()) + w * (r * phi.sin()) + n * (1.0 - r * r).sqrt();
+                let seen = match tracer.hit(x + n * 1e-9, d) {
+                    // Only a polygon's front radiates.
+                    Some((q, t)) if tracer.scene.polygons[q].normal.as_dvec3().dot(d) < 0.0 => {
+                        tracer.radiosity_at(q, x + d * t)
+                    }
+                    _ => Rgb::BLACK,
+                };
+                let rhs = (e + rho * seen).luminance();
+                sum_b += b;
+                sum_rhs += rhs;
+                sum_d2 += (rhs - b) * (rhs - b);
+                if hi > lo {
+                    let k = (((x.y - lo) / (hi - lo)) * 10.0).clamp(0.0, 9.0) as usize;
+                    bins[k].0 += b;
+                    bins[k].1 += rhs;
+                    bins[k].2 += 1;
+                }
+            }
+            if std::env::var_os("BINS").is_some() {
+                let row: Vec<String> = bins
+                    .iter()
+                    .map(|(b, r, n)| format!("{:.4}/{:.4}", b / *n as f64, r / *n as f64))
+                    .collect();
+                eprintln!("polygon {p} by height: {}", row.join(" "));
+            }
+            let k = points as f64;
+            let mean_d = (sum_rhs - sum_b) / k;
+            let var = (sum_d2 / k - mean_d * mean_d).max(0.0);
+            (sum_b / k, sum_rhs / k, (var / k).sqrt())
+        })
+        .collect()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() < 3 {
+        eprintln!("usage: consistency SCENE LENMAX|- POLYGON[,POLYGON...] [POINTS]");
+        std::process::exit(2);
+    }
+    let mut config = RunConfig::new(SceneSource::File(PathBuf::from(&args[0])));
+    config.lenmax = args[1].parse().ok();
+    let polygons: Vec<usize> = args[2]
+        .split(',')
+        .map(|p| p.trim().parse().expect("a polygon index"))
+        .collect();
+    let points: usize = args.get(3).map_or(20_000, |p| p.parse().expect("a count"));
+    let prepared = prepare::prepare(&config).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2);
+    });
+    let count = prepared.scene.polygons.len();
+    if let Some(p) = polygons.iter().find(|&&p| p >= count) {
+        eprintln!("polygon {p} is not in the scene ({count} polygons)");
+        std::process::exit(2);
+    }
+    println!("| solver | polygon | line | B | E + ρ B(seen) | B off by | ± |");
+    println!("|---|---|---|---|---|---|---|");
+    for (clustering, overshoot, label) in [
+        (false, false, "--no-clustering --no-overshoot"),
+        (true, true, "default"),
+    ] {
+        let mut c = config.clone();
+        c.solver.clustering = clustering;
+        c.solver.overshoot = overshoot;
+        let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
+        session
+            .run_to_end(&AtomicBool::new(false))
+            .expect("an uncancelled solve");
+        let tracer = Tracer {
+            scene: &prepared.scene,
+            mesh: session.mesh(),
+            radiosity: session.radiosity(),
+        };
+        for (&p, (b, rhs, err)) in polygons.iter().zip(check(&tracer, &polygons, points)) {
+            println!(
+                "| {label} | {p} | {} | {b:.5} | {rhs:.5} | {:+.2} % | {:.2} % |",
+                prepared.scene.polygons[p].origin.line,
+                (b / rhs - 1.0) * 100.0,
+                err / rhs * 100.0
+            );
+        }
+    }
+}
