@@ -481,6 +481,16 @@ where
             // A receiver in the shooter's plane at its edge still sees it
             // (half of its hemisphere, at a right-angled corner).
             Some(cell) if near_field && r2 < s.exact_r2 => point_to_polygon(x, nx, &cell),
+            // A cell reaching past the receiver's plane from behind it: a
+            // quadrature point in front would stand for its whole share.
+            // Wholly behind (the common case: a floor cell behind a
+            // box's side) it brings nothing.
+            Some(cell) if near_field && r2 < s.near_r2 && cos_x <= 0.0 => {
+                if cell.iter().all(|c| nx.dot(*c - x) <= 0.0) {
+                    continue;
+                }
+                point_to_polygon(x, nx, &cell)
+            }
             // The cosines vary over the cell: each point has its own.
             Some(_) if near_field && r2 < s.near_r2 => quadrature_sum(x, nx, ns, &s.quadrature),
             _ if cos_s <= 0.0 || cos_x <= 0.0 => continue,
@@ -498,12 +508,42 @@ where
         if term <= 0.0 {
             continue;
         }
+        // A near cell whose sample lies behind the receiver's plane still
+        // lights it by its part in front (a floor cell around a table
+        // leg, seen from the leg's inner face): the ray goes from that
+        // part, since from the sample it would pass through the leg.
+        let from = match s.cell {
+            Some(cell) if cos_x <= 0.0 => front_point(x, nx, &cell).unwrap_or(s.position),
+            _ => s.position,
+        };
         rays += 1;
-        if !occluded(k, s.position) {
+        if !occluded(k, from) {
             sum += weight(k) * term;
         }
     }
     (sum, rays)
+}
+
+/// The mean of the corners of the part of `cell` (3 or 4 corners, a
+/// triangle repeating its last) strictly in front of the plane through
+/// `x` with unit normal `n`: a point of the cell that `x`'s side sees,
+/// inside it since the cell is convex. `None` when no part is in front.
+pub fn front_point(x: Vec3, n: Vec3, cell: &[Vec3; 4]) -> Option<Vec3> {
+    let (mut sum, mut count) = (Vec3::ZERO, 0.0f32);
+    for k in 0..4 {
+        let (a, b) = (cell[k], cell[(k + 1) % 4]);
+        let (da, db) = (n.dot(a - x), n.dot(b - x));
+        if da > 0.0 {
+            sum += a;
+            count += 1.0;
+        }
+        if (da > 0.0) != (db > 0.0) && da != db {
+            sum += a + (b - a) * (da / (da - db));
+            count += 1.0;
+        }
+    }
+    let p = sum / count;
+    (count > 0.0 && n.dot(p - x) > 0.0).then_some(p)
 }
 
 /// The point terms `cosθ_i cosθ_j a / (π r²)` at a cell's quadrature

@@ -158,6 +158,10 @@ const RAY_SLOTS: u32 = 7;
 /// The shared-ray key slot of a ray from the node's representative.
 const REPRESENTATIVE_SLOT: u32 = RAY_SLOTS - 1;
 
+/// Not a shared-ray slot: a ray the vertex asks alone, by the full
+/// search (from a point of a near cell other than its sample).
+const OWN_RAY_SLOT: u32 = u32::MAX;
+
 /// The share of the ambient term ([`Progressive::ambient`]) times its
 /// reflectance that a point may expect to receive later, and so send ahead
 /// when it shoots ([`SolverOptions::overshoot`], [`Expectation`]). The
@@ -1254,6 +1258,13 @@ impl<'a> Progressive<'a> {
             let nx = mesh.polygons[j.index()].normal;
             // Whether sample `k` at `s` is hidden from this vertex.
             let mut ray = |k: usize, s: glam::Vec3| -> bool {
+                // A ray from elsewhere than the sample (the part of a near
+                // cell in front of the vertex) is the vertex's own and
+                // outside the shafts, which were built from the samples.
+                if s != samples[k].position {
+                    rays += 1;
+                    return visibility.occluded(s, x, (shooter, j));
+                }
                 // A small facet's vertices share one ray per sample.
                 if let Some((hit, cast)) = facets.shared_ray(
                     memo,
@@ -1588,6 +1599,10 @@ impl<'a> Progressive<'a> {
                 // Keyed by node and by the cell the ray leaves from (the
                 // node's representative, or a normal bin's).
                 let mut blocked = |from: glam::Vec3, own: PolygonId, exact_r2: f32, slot: u32| {
+                    if slot == OWN_RAY_SLOT {
+                        rays += 1;
+                        return visibility.occluded(from, x, (own, j));
+                    }
                     let key = n * RAY_SLOTS + slot;
                     let (hit, cast) = facets
                         .shared_ray(memo, visibility, (own, j), key, from, exact_r2)
@@ -1643,7 +1658,14 @@ impl<'a> Progressive<'a> {
                             near_field,
                             |_, from| {
                                 let exact_r2 = rep_sample.exact_r2;
-                                blocked(from, rep.polygon, exact_r2, REPRESENTATIVE_SLOT)
+                                // Not the sample: a near cell's part in
+                                // front of the vertex, asked alone.
+                                let slot = if from == rep_sample.position {
+                                    REPRESENTATIVE_SLOT
+                                } else {
+                                    OWN_RAY_SLOT
+                                };
+                                blocked(from, rep.polygon, exact_r2, slot)
                             },
                         );
                         sum += f;

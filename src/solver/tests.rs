@@ -1002,6 +1002,73 @@ fn small_shooter_standing_on_the_receiver_matches_lambert() {
     assert!(worst < 0.01, "worst relative error {worst}");
 }
 
+/// A thin leg standing on a glowing floor, off the floor cells' grid: each
+/// side face of the leg sees, unoccluded, the part of the floor in front
+/// of its plane, so every vertex's radiosity after the floor's shot is
+/// `rho · e · F` with `F` Lambert's form factor to that part. A floor
+/// cell under the leg reaches past some faces' planes with its sample
+/// behind them: a ray from that sample to the face passes through the
+/// leg, and the cell's light, the largest share near the foot, was lost
+/// (the faces 40 to 50 % dark on a chair in a hall, both modes). The ray
+/// now leaves from the cell's part in front, and such a cell within the
+/// quadrature's reach takes the exact form factor of that part.
+/// Measured: worst vertex 0.02 % (two faces up to 9.8 % low before).
+#[test]
+fn a_leg_on_a_glowing_floor_sees_the_floor_around_it() {
+    use super::formfactor::point_to_polygon;
+    let (x0, x1, y0, y1, h) = (0.31f32, 0.34f32, 0.31f32, 0.34f32, 0.3f32);
+    // The four sides, counter-clockwise seen from outside.
+    let sides = [
+        [[x0, y0, 0.], [x0, y0, h], [x0, y1, h], [x0, y1, 0.]], // -x
+        [[x1, y0, 0.], [x1, y1, 0.], [x1, y1, h], [x1, y0, h]], // +x
+        [[x0, y0, 0.], [x1, y0, 0.], [x1, y0, h], [x0, y0, h]], // -y
+        [[x0, y1, 0.], [x0, y1, h], [x1, y1, h], [x1, y1, 0.]], // +y
+    ];
+    let mut polygons = vec![polygon(0, &BOTTOM)];
+    polygons.extend(sides.iter().map(|f| polygon(1, f)));
+    let s = scene(
+        polygons,
+        vec![grey("floor", 1.0, 0.0), grey("leg", 0.0, 0.5)],
+    );
+    for (k, n) in [-glam::Vec3::X, glam::Vec3::X, -glam::Vec3::Y, glam::Vec3::Y]
+        .iter()
+        .enumerate()
+    {
+        assert!(
+            s.polygons[k + 1].normal.dot(*n) > 0.99,
+            "side {k} faces out"
+        );
+    }
+    let floor: Vec<glam::Vec3> = BOTTOM.iter().map(|&c| glam::Vec3::from(c)).collect();
+    for clustering in [false, true] {
+        let solved = solve(
+            &s,
+            0.1,
+            crate::mesh::DEFAULT_INSET,
+            SolverOptions {
+                max_steps: Some(1),
+                clustering,
+                ..Default::default()
+            },
+        );
+        let mut worst = 0.0f64;
+        for side in 1..=4 {
+            let pm = &solved.mesh.polygons[side];
+            for l in pm.vertices.clone() {
+                let x = solved.mesh.sample_positions[l as usize];
+                let exact = 0.5 * point_to_polygon(x, pm.normal, &floor);
+                let got = solved.radiosity[l as usize].r;
+                worst = worst.max((got - exact).abs() / exact);
+            }
+        }
+        eprintln!("clustering {clustering}: worst vertex {worst}");
+        assert!(
+            worst < 0.01,
+            "clustering {clustering}: worst vertex {worst}"
+        );
+    }
+}
+
 /// Reciprocity: for two unequal polygons, `A_i F_ij = A_j F_ji` within 1 %.
 #[test]
 fn reciprocity_of_measured_form_factors() {
