@@ -33,10 +33,11 @@
 //! `Σ|E_gather − E_mc| / Σ E_mc`, the largest relative difference, the
 //! Monte Carlo standard error, and the seconds each took.
 
+#[path = "support/tracer.rs"]
+mod tracer;
+
 use glam::{DVec3, Vec3};
-use radiosity::color::Rgb;
 use radiosity::config::{RunConfig, SceneSource};
-use radiosity::mesh::Mesh;
 use radiosity::prepare;
 use radiosity::scene::{Scene, Units};
 use radiosity::session::{Session, SessionOptions};
@@ -46,31 +47,10 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
+use tracer::{Rng, Tracer};
 
 /// Random points per luminaire for the direct light.
 const LIGHT_SAMPLES: usize = 1024;
-
-/// A small, seedable generator (SplitMix64), so the reference is the same
-/// on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// The scene's polygons for brute-force ray casting, and the solution for
-/// the radiosity lookup.
-struct Tracer<'a> {
-    scene: &'a Scene,
-    mesh: &'a Mesh,
-    radiosity: &'a [Rgb],
-}
 
 /// The material of a polygon.
 trait MaterialOf {
@@ -80,78 +60,6 @@ trait MaterialOf {
 impl MaterialOf for Scene {
     fn material_of_polygon(&self, p: &radiosity::scene::Polygon) -> &radiosity::scene::Material {
         &self.materials[p.material.index()]
-    }
-}
-
-impl Tracer<'_> {
-    /// The nearest polygon hit by the ray `o + t d` (`t > 1e-6`): its
-    /// index and `t`.
-    fn hit(&self, o: DVec3, d: DVec3) -> Option<(usize, f64)> {
-        let mut best: Option<(usize, f64)> = None;
-        for (i, p) in self.scene.polygons.iter().enumerate() {
-            let n = p.normal.as_dvec3();
-            let denom = n.dot(d);
-            if denom.abs() < 1e-12 {
-                continue;
-            }
-            let v0 = p.vertices[0].as_dvec3();
-            let t = n.dot(v0 - o) / denom;
-            if t <= 1e-6 || best.is_some_and(|b| t >= b.1) {
-                continue;
-            }
-            let x = o + d * t;
-            let k = p.vertices.len();
-            let inside = (0..k).all(|j| {
-                let a = p.vertices[j].as_dvec3();
-                let b = p.vertices[(j + 1) % k].as_dvec3();
-                n.dot((b - a).cross(x - a)) >= -1e-9
-            });
-            if inside {
-                best = Some((i, t));
-            }
-        }
-        best
-    }
-
-    /// True when something lies strictly between `a` and `b`.
-    fn blocked(&self, a: DVec3, b: DVec3) -> bool {
-        let d = b - a;
-        self.hit(a, d).is_some_and(|(_, t)| t < 1.0 - 1e-6)
-    }
-
-    /// The radiosity at `x` on polygon `p`, interpolated over the
-    /// element's triangles as the picture draws it.
-    fn radiosity_at(&self, p: usize, x: DVec3) -> Rgb {
-        let pm = &self.mesh.polygons[p];
-        let n = pm.normal.as_dvec3();
-        let mut nearest = (f64::INFINITY, Rgb::BLACK);
-        for e in &self.mesh.elements[pm.elements.start as usize..pm.elements.end as usize] {
-            for [a, b, c] in e.triangles() {
-                let (pa, pb, pc) = (
-                    self.mesh.positions[a.index()].as_dvec3(),
-                    self.mesh.positions[b.index()].as_dvec3(),
-                    self.mesh.positions[c.index()].as_dvec3(),
-                );
-                let area = n.dot((pb - pa).cross(pc - pa));
-                if area <= 0.0 {
-                    continue;
-                }
-                let wa = n.dot((pb - x).cross(pc - x)) / area;
-                let wb = n.dot((pc - x).cross(pa - x)) / area;
-                let wc = 1.0 - wa - wb;
-                let outside = (-wa).max(-wb).max(-wc);
-                let value = self.radiosity[a.index()] * wa.max(0.0)
-                    + self.radiosity[b.index()] * wb.max(0.0)
-                    + self.radiosity[c.index()] * wc.max(0.0);
-                if outside <= 0.0 {
-                    return value;
-                }
-                if outside < nearest.0 {
-                    nearest = (outside, value);
-                }
-            }
-        }
-        nearest.1
     }
 }
 
@@ -180,6 +88,7 @@ fn main() {
         scene,
         mesh,
         radiosity,
+        t_min: 1e-6,
     };
 
     // The floor grid: cell centres over the bounds at y = 0, facing up,
