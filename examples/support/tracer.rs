@@ -38,9 +38,11 @@ pub struct Tracer<'a> {
 
 impl Tracer<'_> {
     /// The nearest polygon hit by the ray `o + t d` (`t > t_min`): its
-    /// index and `t`.
+    /// index and `t`. Of polygons hit at the same place (a two-sided
+    /// face and its back copy) the one facing the ray's origin.
     pub fn hit(&self, o: DVec3, d: DVec3) -> Option<(usize, f64)> {
         let mut best: Option<(usize, f64)> = None;
+        let facing = |i: usize| self.scene.polygons[i].normal.as_dvec3().dot(d) < 0.0;
         for (i, p) in self.scene.polygons.iter().enumerate() {
             let n = p.normal.as_dvec3();
             let denom = n.dot(d);
@@ -49,8 +51,14 @@ impl Tracer<'_> {
             }
             let v0 = p.vertices[0].as_dvec3();
             let t = n.dot(v0 - o) / denom;
-            if t <= self.t_min || best.is_some_and(|b| t >= b.1) {
+            if t <= self.t_min {
                 continue;
+            }
+            if let Some((b, tb)) = best {
+                let tie = (t - tb).abs() <= 1e-9 * tb.max(1.0);
+                if t > tb && !tie || tie && (facing(b) || denom > 0.0) {
+                    continue;
+                }
             }
             let x = o + d * t;
             let k = p.vertices.len();
