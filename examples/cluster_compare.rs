@@ -11,6 +11,7 @@
 //!
 //! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
 //! absent for the program's default) and the threshold (default 0.001).
+//! `CC_SHOOTER_SAMPLES=N` makes every mode shoot from at most N cells.
 //! Solves in each mode (`CC_SKIP_BRUTE=1` skips the slow reference, and
 //! the solve with exact receivers is then the reference) and prints for
 //! each the steps, rays and solve seconds, and for all but the reference
@@ -44,6 +45,13 @@ fn main() {
     config.lenmax = args.get(1).and_then(|l| l.parse().ok());
     if let Some(t) = args.get(2).and_then(|t| t.parse().ok()) {
         config.solver.threshold = t;
+    }
+    // CC_SHOOTER_SAMPLES=N: every mode shoots from at most N cells.
+    if let Some(n) = std::env::var("CC_SHOOTER_SAMPLES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+    {
+        config.solver.shooter_samples = radiosity::solver::ShooterSamples::AtMost(n);
     }
     let prepared: Prepared = match prepare::prepare(&config) {
         Ok(p) => p,

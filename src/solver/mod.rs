@@ -1107,10 +1107,16 @@ impl<'a> Progressive<'a> {
                     .iter()
                     .any(|&x| shooter.normal.dot(x - origin) > 0.0);
                 let x0 = mesh.sample_positions[range.start];
+                // A cell counts by its corners: the floor cell under a
+                // table leg facing a wall has its sample behind the leg's
+                // face and a part in front of it, which lights the face
+                // ([`formfactor::front_point`]).
                 in_front
-                    && self.samples[i]
-                        .iter()
-                        .any(|s| pm.normal.dot(s.position - x0) > 0.0)
+                    && self.samples[i].iter().any(|s| {
+                        pm.normal.dot(s.position - x0) > 0.0
+                            || s.cell
+                                .is_some_and(|c| c.iter().any(|&p| pm.normal.dot(p - x0) > 0.0))
+                    })
             };
             self.receives[j] = j != i
                 && !self.reflectance[j].is_black()
