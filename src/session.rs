@@ -72,7 +72,9 @@ impl SessionOptions {
 /// What one [`Session::advance`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Event {
-    /// One shooting step on the current mesh.
+    /// One shooting step on the current mesh, or a part of one
+    /// ([`crate::solver::SolverOptions::part_budget`]; see
+    /// [`StepReport::complete`]).
     Step(StepReport),
     /// The current pass stopped: converged, or at the step limit. The
     /// session's radiosity is this pass's final solution on
@@ -86,8 +88,8 @@ pub enum Event {
     Refused(Refused),
     /// The solve is over; every later call says so again.
     Finished,
-    /// `cancel` was set during a step; the state is as before that step,
-    /// and the next call tries the step again.
+    /// `cancel` was set during a step; the state is as before that step
+    /// (or that part), and the next call tries it again.
     Cancelled,
 }
 

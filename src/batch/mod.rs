@@ -444,7 +444,8 @@ fn solve<'p>(
             });
         }
         match session.advance(cancel)? {
-            Event::Step(report) => {
+            // A batch run asks for no parts: every report ends a step.
+            Event::Step(report) if report.complete => {
                 records.push(StepRecord {
                     step: report.step,
                     shooter: report.shooter.0,
@@ -460,7 +461,7 @@ fn solve<'p>(
                 }
                 progress.step(&report, session.solver().rays());
             }
-            Event::Stopped(_) | Event::Cancelled => {}
+            Event::Step(_) | Event::Stopped(_) | Event::Cancelled => {}
             Event::Refined(report) => {
                 // A bar of its own for each pass, under the line saying
                 // what the last pass did.

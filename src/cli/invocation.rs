@@ -213,6 +213,9 @@ impl TryFrom<Args> for Invocation {
                 receiver_interpolation: !args.exact_receivers,
                 hemicube_res: args.hemicube_res,
                 overshoot: !args.no_overshoot,
+                // A window asks for parts ([`crate::viewer`]); a batch run
+                // has no picture between steps.
+                part_budget: None,
             },
             size: args.size,
             exposure,
@@ -377,6 +380,7 @@ mod tests {
                 receiver_interpolation: false,
                 hemicube_res: crate::solver::hemicube::HemicubeRes::default(),
                 overshoot: false,
+                part_budget: None,
             }
         );
         assert_eq!(c.size, Some((32, 24)));

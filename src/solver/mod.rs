@@ -74,6 +74,7 @@ pub mod far_shooters;
 pub mod formfactor;
 pub mod gather;
 pub mod hemicube;
+pub mod parts;
 pub mod probes;
 pub mod receivers;
 mod unshot;
@@ -89,6 +90,7 @@ use far_shooters::FarShooter;
 use formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use receivers::CoarseGrid;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use unshot::{Shot, UnshotField};
 
@@ -154,6 +156,14 @@ pub const MIN_STRATA: usize = 8;
 /// Shared-ray keys per stratum node ([`facets::Memo`]): one per normal
 /// bin a far term may cast from, and one for the node's representative.
 const RAY_SLOTS: u32 = 7;
+
+/// Vertices of one polygon a worker takes at once in a gather pass
+/// ([`par_runs`]): a small facet's three or four.
+const PAR_RUN: usize = 4;
+
+/// Vertices from which the check charges of a gather
+/// ([`gather_passes`]) are made in parallel.
+const PARALLEL_CHARGES: usize = 8_192;
 
 /// The shared-ray key slot of a ray from the node's representative.
 const REPRESENTATIVE_SLOT: u32 = RAY_SLOTS - 1;
@@ -277,6 +287,11 @@ pub struct SolverOptions {
     /// Pixels across a hemicube's top face, for
     /// [`FormFactorMethod::Hemicube`] (ignored by the other methods).
     pub hemicube_res: hemicube::HemicubeRes,
+    /// Deliver a step in parts of about this much solver time each
+    /// ([`parts`]): a window's picture then moves while a long step runs.
+    /// The finished step is bit-identical to one in a piece; `None` (the
+    /// default) runs every step in one piece.
+    pub part_budget: Option<std::time::Duration>,
     /// Overshoot (Feda and Purgathofer 1992): a step also sends out the
     /// light each point of its shooters is expected to receive later
     /// ([`Expectation`]), leaving their unshot radiosity negative until
@@ -315,6 +330,7 @@ impl Default for SolverOptions {
             receiver_interpolation: true,
             hemicube_res: hemicube::HemicubeRes::default(),
             overshoot: true,
+            part_budget: None,
         }
     }
 }
@@ -335,7 +351,9 @@ pub struct StepReport {
     /// [`Progressive::unshot_power`] says); negative for a step that shot
     /// negative light ([`SolverOptions::overshoot`]).
     pub shot_power: f64,
-    /// Unshot power left after the step, as a fraction of the initial.
+    /// Unshot power left after the step, as a fraction of the initial
+    /// (for a part of a step not finished, what the last finished step
+    /// left).
     pub unshot_fraction: f64,
     /// Shadow rays cast in this step.
     pub rays: u64,
@@ -347,6 +365,92 @@ pub struct StepReport {
     /// Of those, the ones whose shaft to the shooter held no polygon, so
     /// no ray was cast to them (0 without shaft culling).
     pub clear_receivers: u64,
+    /// Which part of the step this report ends, from 1
+    /// ([`SolverOptions::part_budget`]); the counts above are the step's
+    /// so far.
+    pub part: u32,
+    /// Whether the step is finished (always, without a part budget).
+    pub complete: bool,
+}
+
+/// A step begun: what it shoots, how, and how far it has got.
+#[derive(Clone, Debug)]
+struct Underway {
+    /// The shooting cluster (without clustering, the polygon's own).
+    cluster: usize,
+    /// Its member holding the most unshot power.
+    shooter: PolygonId,
+    /// What [`Progressive::choose_shooter`] found it to send, signed.
+    shot_power: f64,
+    /// The expected light the shooters were read with.
+    expected: Expectation,
+    how: How,
+    /// The receivers' chunks and how far they have been taken.
+    plan: parts::Plan,
+    /// Whether the shooters' unshot radiosity has been spent (with the
+    /// first receivers applied).
+    spent: bool,
+    /// Counts so far.
+    gathered: Gathered,
+    receivers: u64,
+    clear: u64,
+    /// Parts reported so far, the one running included.
+    part: u32,
+    /// The unshot fraction the last finished step left.
+    fraction_before: f64,
+}
+
+/// How a step shoots.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum How {
+    /// One polygon from its own samples.
+    Alone,
+    /// A cluster (or a polygon of weak light) from strata, descending from
+    /// the strata tree's top when `from_top`.
+    Cluster { from_top: bool },
+}
+
+/// What [`Progressive::begin_step`] did.
+enum Begun {
+    /// The whole step (a hemicube step).
+    Done(StepReport),
+    /// The shooter is read and its receivers marked.
+    Underway(Underway),
+}
+
+/// What a gather writes, per mesh vertex ([`gather_passes`]).
+struct Sums<'b> {
+    /// The step's `Δrad`.
+    delta: &'b mut [Rgb],
+    /// The first pass's `Δrad`, which the second reads.
+    first: &'b mut [Rgb],
+    /// The interpolation error charged to check vertices
+    /// ([`Progressive::charges`]).
+    spent: &'b mut [Rgb],
+}
+
+/// The vertices a gather call takes and the passes it runs over them
+/// ([`gather_passes`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Work {
+    /// Mesh vertices: whole polygons with [`Stage::All`], else some of
+    /// one polygon's.
+    vertices: Range<usize>,
+    stage: Stage,
+}
+
+/// Which passes a gather call runs ([`gather_passes`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Stage {
+    /// Whole polygons: both passes and the check charges.
+    All,
+    /// The first pass over some of one polygon's vertices; with `copy`,
+    /// the last such piece, then keeps the polygon's first-pass values
+    /// for the second.
+    Exact { copy: Option<Range<usize>> },
+    /// The second pass over some of one polygon's vertices; with
+    /// `charge`, the last such piece, then charges the polygon's checks.
+    Interpolated { charge: Option<Range<usize>> },
 }
 
 /// What the gather phase of a step counted.
@@ -356,6 +460,13 @@ struct Gathered {
     pairs: u64,
     /// Shadow rays cast.
     rays: u64,
+}
+
+impl Gathered {
+    fn add(&mut self, other: Gathered) {
+        self.pairs += other.pairs;
+        self.rays += other.rays;
+    }
 }
 
 /// A solver state that breaks [`Progressive`]'s invariants: found by
@@ -510,6 +621,12 @@ pub struct Progressive<'a> {
     initial_unshot_power: f64,
     steps: u64,
     rays: u64,
+    /// The step begun and not finished, when steps come in parts
+    /// ([`SolverOptions::part_budget`]).
+    underway: Option<Underway>,
+    /// The unshot fraction after the last finished step (1 before the
+    /// first), which a part of a step not finished reports.
+    last_fraction: f64,
     /// The hemicube's tables and scratch, with
     /// [`FormFactorMethod::Hemicube`].
     hemicube: Option<hemicube::Shooting>,
@@ -652,7 +769,7 @@ impl<'a> Progressive<'a> {
                 .iter()
                 .map(|pm| CoarseGrid::detect(mesh, pm))
                 .collect(),
-            coarse_delta: Vec::new(),
+            coarse_delta: vec![Rgb::BLACK; mesh.vertex_count()],
             facets: Facets::new(mesh, approximate),
             probes: sky_probes,
             far_shooters,
@@ -665,6 +782,8 @@ impl<'a> Progressive<'a> {
             initial_unshot_power: 0.0,
             steps: 0,
             rays: 0,
+            underway: None,
+            last_fraction: 1.0,
             hemicube: (options.form_factor == FormFactorMethod::Hemicube)
                 .then(|| hemicube::Shooting::new(scene, mesh, options.hemicube_res)),
         };
@@ -874,9 +993,12 @@ impl<'a> Progressive<'a> {
         (self.receiver_pairs, self.clear_receiver_pairs)
     }
 
-    /// Why the solve should stop now, or `None` to go on.
+    /// Why the solve should stop now, or `None` to go on (always while a
+    /// step is under way: [`Progressive::in_step`]).
     pub fn stop_reason(&self) -> Option<StopReason> {
-        if self.unshot_fraction() <= self.options.threshold || self.unshot_power() <= 0.0 {
+        if self.underway.is_some() {
+            None
+        } else if self.unshot_fraction() <= self.options.threshold || self.unshot_power() <= 0.0 {
             Some(StopReason::Converged)
         } else if self.options.max_steps.is_some_and(|m| self.steps >= m) {
             Some(StopReason::MaxSteps)
@@ -894,6 +1016,9 @@ impl<'a> Progressive<'a> {
     /// with the most unshot power, or of the cluster with the most, its
     /// member with the most; `None` when nothing is left to shoot.
     pub fn next_shooter(&self) -> Option<PolygonId> {
+        if let Some(u) = &self.underway {
+            return Some(u.shooter);
+        }
         let expected = self.expectation();
         self.choose_shooter(expected)
             .map(|(cluster, _, negative)| self.strongest_member(cluster, negative, expected))
@@ -950,7 +1075,9 @@ impl<'a> Progressive<'a> {
         PolygonId(best.0)
     }
 
-    /// One shooting step from the polygon with the most unshot power.
+    /// One shooting step from the polygon with the most unshot power, or
+    /// with a [`SolverOptions::part_budget`] one part of it (the report
+    /// says whether the step is `complete`; the next call continues it).
     /// Returns `None` (and does nothing) when no polygon has unshot power.
     /// Does not look at the threshold or step limit: see
     /// [`Progressive::is_done`].
@@ -959,10 +1086,32 @@ impl<'a> Progressive<'a> {
     }
 
     /// [`Progressive::step`] that gives up as soon as `cancel` is set (from
-    /// another thread), leaving the state exactly as before the step and
-    /// returning `None`. A window uses it to quit promptly during a long
-    /// step.
+    /// another thread) and returns `None`, leaving the state exactly as
+    /// before the step, or, in a step delivered in parts, as after its
+    /// last part (the next call continues it). A window uses it to quit
+    /// promptly during a long step.
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+        if self.underway.is_none() {
+            match self.begin_step(cancel)? {
+                Begun::Done(report) => return Some(report),
+                Begun::Underway(u) => self.underway = Some(u),
+            }
+        }
+        self.continue_step(cancel)
+    }
+
+    /// Whether a step delivered in parts ([`SolverOptions::part_budget`])
+    /// has begun and not finished: the next [`Progressive::step`]
+    /// continues it. The solution then holds the receivers done so far.
+    pub fn in_step(&self) -> bool {
+        self.underway.is_some()
+    }
+
+    /// Phases 1 and 2 of a step, and with hemicubes the whole step:
+    /// chooses the shooter, reads what it sends and marks its receivers.
+    /// `None` when nothing is due or, for a hemicube step, once `cancel`
+    /// is set.
+    fn begin_step(&mut self, cancel: &AtomicBool) -> Option<Begun> {
         let expected = self.expectation();
         let (cluster, shot_power, negative) = self.choose_shooter(expected)?;
         let shooter = self.strongest_member(cluster, negative, expected);
@@ -978,7 +1127,23 @@ impl<'a> Progressive<'a> {
                 || roots >= self.samples[shooter.index()].len());
         let by_hemicube = self.hemicube.is_some() && !self.mesh.polygons[shooter.index()].sky;
         let shot = self.polygon_shot(shooter.index(), negative, expected);
-        let gathered = if by_hemicube {
+        let signed = if negative { -shot_power } else { shot_power };
+        let mut underway = Underway {
+            cluster,
+            shooter,
+            shot_power: signed,
+            expected,
+            how: How::Alone,
+            plan: parts::Plan::new(1, false, false),
+            spent: false,
+            gathered: Gathered { pairs: 0, rays: 0 },
+            receivers: 0,
+            clear: 0,
+            part: 0,
+            fraction_before: self.last_fraction,
+        };
+        if by_hemicube {
+            // A hemicube step renders all its receivers at once: one part.
             self.read_shooter(shooter, shot);
             self.mark_receivers(shooter.index());
             let hemicubes = if self.options.clustering {
@@ -986,19 +1151,181 @@ impl<'a> Progressive<'a> {
             } else {
                 usize::MAX
             };
-            self.gather_hemicube(shooter, shot, hemicubes, cancel)?
-        } else if alone {
+            let gathered = self.gather_hemicube(shooter, shot, hemicubes, cancel)?;
+            let polygons = 0..self.mesh.polygons.len();
+            self.apply_chunk(&mut underway, polygons);
+            underway.gathered = gathered;
+            underway.part = 1;
+            return Some(Begun::Done(self.finish_step(&underway)));
+        }
+        let in_parts = self.options.part_budget.is_some();
+        if alone {
             self.read_shooter(shooter, shot);
-            self.cull(shooter);
-            self.gather(shooter, cancel)?
+            self.mark_receivers(shooter.index());
+            self.group_points.clear();
+            self.group_points
+                .extend(self.samples[shooter.index()].iter().map(|s| s.position));
+            // Reflected light may be interpolated across receiving grids;
+            // an emitter's shot, which draws the sharpest shadows, never is.
+            let interpolating = self.clustered
+                && self.options.receiver_interpolation
+                && self.emission[shooter.index()].is_black();
+            let per_vertex = self.samples[shooter.index()].len();
+            underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
         } else {
             self.read_cluster(cluster, roots, negative, expected);
-            self.cull_cluster(cluster);
+            self.mark_cluster_receivers();
             let from_top = roots < self.step_roots(f64::INFINITY);
-            self.gather_cluster(cluster, from_top, cancel)?
-        };
-        let shot_power = if negative { -shot_power } else { shot_power };
-        Some(self.apply(cluster, shooter, shot_power, expected, gathered))
+            underway.how = How::Cluster { from_top };
+            let per_vertex = self.strata.roots.len();
+            let interpolating = self.options.receiver_interpolation;
+            underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
+        }
+        Some(Begun::Underway(underway))
+    }
+
+    /// Gathers and applies chunks of the step under way until every
+    /// receiver is done (the step's report, `complete`) or, with a
+    /// [`SolverOptions::part_budget`], until the next chunk would take the
+    /// part past it (a report of the part). `None` once `cancel` is set:
+    /// the chunk in hand is dropped, and a step none of whose chunks was
+    /// applied is forgotten, leaving the state exactly as before it.
+    fn continue_step(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+        // On a worker of the thread pool: a part runs many short parallel
+        // loops, and each one called from outside the pool would wait for
+        // sleeping workers to wake and for the caller to be woken back.
+        if rayon::current_thread_index().is_none() {
+            return rayon::scope(|_| self.continue_step(cancel));
+        }
+        let mut u = self.underway.take()?;
+        let start = std::time::Instant::now();
+        let mut longest = std::time::Duration::ZERO;
+        u.part += 1;
+        loop {
+            let chunk_start = std::time::Instant::now();
+            let Some((chunk, after, work)) = self.next_chunk(&u) else {
+                break;
+            };
+            let piece = matches!(chunk, parts::Chunk::Piece { .. });
+            if self.run_chunk(&mut u, chunk, cancel).is_none() {
+                u.part -= 1;
+                if u.spent {
+                    self.underway = Some(u);
+                }
+                return None;
+            }
+            let took = chunk_start.elapsed();
+            u.plan.advance(after);
+            u.plan.observe(piece, work, took);
+            longest = longest.max(took);
+            if self.next_chunk(&u).is_none() {
+                break;
+            }
+            if let Some(budget) = self.options.part_budget {
+                if start.elapsed() + longest >= budget {
+                    let report = self.part_report(&u, false);
+                    self.underway = Some(u);
+                    return Some(report);
+                }
+            }
+        }
+        Some(self.finish_step(&u))
+    }
+
+    /// The next chunk of step `u` ([`parts::Plan::next`]).
+    /// The shooting cluster's own members count as near ones: their sums
+    /// descend to the cells around them.
+    fn next_chunk(&self, u: &Underway) -> Option<(parts::Chunk, parts::Cursor, u64)> {
+        let clustered = matches!(u.how, How::Cluster { .. });
+        let member = |j: usize| clustered && self.clusters.of(PolygonId(j as u32)) == u.cluster;
+        u.plan.next(&self.mesh.polygons, &self.receives, member)
+    }
+
+    /// Culls, gathers and (once its polygons are whole) applies one chunk
+    /// of the step `u`; `None` once `cancel` is set, with nothing of the
+    /// chunk applied.
+    fn run_chunk(
+        &mut self,
+        u: &mut Underway,
+        chunk: parts::Chunk,
+        cancel: &AtomicBool,
+    ) -> Option<()> {
+        match chunk {
+            parts::Chunk::Whole { polygons, vertices } => {
+                self.cull_chunk(u, polygons.clone());
+                let gathered = self.gather_chunk(u, vertices, Stage::All, cancel)?;
+                u.gathered.add(gathered);
+                self.apply_chunk(u, polygons);
+            }
+            parts::Chunk::Piece {
+                polygon,
+                vertices,
+                all,
+                pass,
+                first,
+                last,
+            } => {
+                let two_passes = u.plan.two_passes();
+                let stage = match pass {
+                    parts::Pass::Exact => {
+                        if first {
+                            self.cull_chunk(u, polygon..polygon + 1);
+                        }
+                        Stage::Exact {
+                            copy: (last && two_passes).then(|| all.clone()),
+                        }
+                    }
+                    parts::Pass::Interpolated => Stage::Interpolated {
+                        charge: last.then(|| all.clone()),
+                    },
+                };
+                let gathered = self.gather_chunk(u, vertices, stage, cancel)?;
+                u.gathered.add(gathered);
+                let done = last && (pass == parts::Pass::Interpolated || !two_passes);
+                if done {
+                    self.apply_chunk(u, polygon..polygon + 1);
+                }
+            }
+        }
+        Some(())
+    }
+
+    /// Phase 3 for the receiving polygons `polygons` of step `u`: with
+    /// shaft culling, the polygons in each one's shaft to the shooter (or
+    /// the cluster's bounds), then in each thin shaft between a receiver
+    /// tile and a group of shooter samples (or strata).
+    fn cull_chunk(&mut self, u: &Underway, polygons: Range<usize>) {
+        if !self.options.shaft_culling {
+            return;
+        }
+        match u.how {
+            How::Alone => {
+                self.cull_polygon_shafts(u.shooter, polygons.clone());
+                let groups = self.shooter_groups(u.shooter.index());
+                self.cull_tile_shafts_from(groups, 1, polygons);
+            }
+            How::Cluster { .. } => {
+                self.cull_cluster_shafts(u.cluster, polygons.clone());
+                let groups = self.strata.roots.len().div_ceil(SHOOTER_GROUP).max(1);
+                self.cull_tile_shafts_from(groups, 2, polygons);
+            }
+        }
+    }
+
+    /// Phase 4 for `vertices` in `stage`, by the step's kind.
+    fn gather_chunk(
+        &mut self,
+        u: &Underway,
+        vertices: Range<usize>,
+        stage: Stage,
+        cancel: &AtomicBool,
+    ) -> Option<Gathered> {
+        match u.how {
+            How::Alone => self.gather(u.shooter, vertices, stage, cancel),
+            How::Cluster { from_top } => {
+                self.gather_cluster(u.cluster, from_top, vertices, stage, cancel)
+            }
+        }
     }
 
     /// How many strata a clustered step shoots from at most, for a step
@@ -1070,19 +1397,6 @@ impl<'a> Progressive<'a> {
         );
     }
 
-    /// Phase 3, cull: marks the receivers of `shooter` and, with shaft
-    /// culling, finds the polygons in each receiver's shaft to it and then
-    /// in each thin shaft between a receiver tile and a group of shooter
-    /// samples. Only the gather reads what this leaves in the scratch
-    /// arrays.
-    fn cull(&mut self, shooter: PolygonId) {
-        self.mark_receivers(shooter.index());
-        if self.options.shaft_culling {
-            self.cull_polygon_shafts(shooter);
-            self.cull_tile_shafts(shooter);
-        }
-    }
-
     /// Shooter samples of polygon `i` are culled in groups of
     /// [`SHOOTER_GROUP`]: the number of groups, at least 1.
     fn shooter_groups(&self, i: usize) -> usize {
@@ -1128,67 +1442,38 @@ impl<'a> Progressive<'a> {
         }
     }
 
-    /// Per receiver: the polygons in its shaft to `shooter`
-    /// (`self.candidates`; empty for polygons that do not receive).
-    fn cull_polygon_shafts(&mut self, shooter: PolygonId) {
+    /// Per receiver among `polygons`: the polygons in its shaft to
+    /// `shooter` (`self.candidates`; empty for polygons that do not
+    /// receive).
+    fn cull_polygon_shafts(&mut self, shooter: PolygonId, polygons: Range<usize>) {
         let visibility = self.visibility;
         let receives = &self.receives;
         let small = &self.small;
-        self.candidates
+        let groups = &self.culling_groups;
+        let start = polygons.start;
+        self.candidates[polygons.clone()]
             .par_iter_mut()
+            .zip(self.candidate_runs[polygons].par_iter_mut())
             .enumerate()
-            .for_each(|(j, c)| {
+            .for_each(|(k, (c, runs))| {
+                let j = start + k;
                 if receives[j] && !small[j] {
                     visibility.shaft_candidates(shooter, PolygonId(j as u32), REFINE_MAX, c);
                 } else {
                     c.clear();
                 }
-            });
-        self.group_candidates();
-    }
-
-    /// Orders every receiver's candidates by culling group and records the
-    /// runs (`self.candidate_runs`), for [`Visibility::
-    /// refine_candidates_in_runs`].
-    fn group_candidates(&mut self) {
-        let groups = &self.culling_groups;
-        self.candidates
-            .par_iter_mut()
-            .zip(self.candidate_runs.par_iter_mut())
-            .for_each(|(c, runs)| {
-                runs.clear();
-                c.sort_unstable_by_key(|&p| (groups.of(PolygonId(p)), p));
-                let mut start = 0;
-                while start < c.len() {
-                    let g = groups.of(PolygonId(c[start]));
-                    let mut end = start + 1;
-                    while end < c.len() && groups.of(PolygonId(c[end])) == g {
-                        end += 1;
-                    }
-                    let (lo, hi) = groups.bounds(g);
-                    runs.push((start as u32..end as u32, (lo.as_dvec3(), hi.as_dvec3())));
-                    start = end;
-                }
+                group_candidates(groups, c, runs);
             });
     }
 
     /// Thin shafts between small groups of shooter samples and of receiver
-    /// vertices, searched among their polygons' candidates: per tile and
-    /// sample group, the polygons in the shaft between them
-    /// (`self.tile_candidates`).
-    fn cull_tile_shafts(&mut self, shooter: PolygonId) {
-        let i = shooter.index();
-        let groups = self.shooter_groups(i);
-        self.group_points.clear();
-        self.group_points
-            .extend(self.samples[i].iter().map(|s| s.position));
-        self.cull_tile_shafts_from(groups, 1);
-    }
-
-    /// [`Progressive::cull_tile_shafts`] from `self.group_points`, which
-    /// hold `per_sample` points for each sample (shooter sample or
-    /// stratum), in `groups` groups of [`SHOOTER_GROUP`] samples.
-    fn cull_tile_shafts_from(&mut self, groups: usize, per_sample: usize) {
+    /// vertices of `polygons`, searched among their polygons'
+    /// candidates: per tile and sample group, the polygons in the shaft
+    /// between them (`self.tile_candidates`). The shooter's points are in
+    /// `self.group_points`: `per_sample` points for each sample (shooter
+    /// sample or stratum), in `groups` groups of [`SHOOTER_GROUP`]
+    /// samples.
+    fn cull_tile_shafts_from(&mut self, groups: usize, per_sample: usize, polygons: Range<usize>) {
         let mesh: &Mesh = &self.mesh;
         let visibility = self.visibility;
         let group_len = SHOOTER_GROUP * per_sample;
@@ -1199,10 +1484,19 @@ impl<'a> Progressive<'a> {
         let tiles = &self.tiles;
         self.tile_candidates
             .resize_with(tiles.len() * groups, Vec::new);
-        self.tile_candidates
+        // The tiles of `polygons`: theirs are consecutive, as their
+        // vertices are.
+        let first = mesh.polygons[polygons.start].vertices.start as usize;
+        let end = mesh.polygons[polygons.end - 1].vertices.end as usize;
+        if first == end {
+            return;
+        }
+        let tile_range = self.tile_of[first] as usize..self.tile_of[end - 1] as usize + 1;
+        self.tile_candidates[tile_range.start * groups..tile_range.end * groups]
             .par_iter_mut()
             .enumerate()
-            .for_each(|(index, c)| {
+            .for_each(|(k, c)| {
+                let index = tile_range.start * groups + k;
                 let (t, g) = (index / groups, index % groups);
                 let Some(tile) = tiles.get(t) else {
                     c.clear();
@@ -1234,7 +1528,13 @@ impl<'a> Progressive<'a> {
     /// own sum and the first pass, so the bits do not depend on the thread
     /// count. Returns `None` once `cancel` is set, with the solution
     /// untouched (only scratch written).
-    fn gather(&mut self, shooter: PolygonId, cancel: &AtomicBool) -> Option<Gathered> {
+    fn gather(
+        &mut self,
+        shooter: PolygonId,
+        vertices: Range<usize>,
+        stage: Stage,
+        cancel: &AtomicBool,
+    ) -> Option<Gathered> {
         let i = shooter.index();
         let mesh: &Mesh = &self.mesh;
         let visibility = self.visibility;
@@ -1338,13 +1638,16 @@ impl<'a> Progressive<'a> {
             held: &self.radiosity,
         };
         gather_passes(
-            &mut self.delta,
-            &mut self.coarse_delta,
-            &mut self.spent,
+            Sums {
+                delta: &mut self.delta,
+                first: &mut self.coarse_delta,
+                spent: &mut self.spent,
+            },
             mesh,
             &cells,
             cancel,
             exact,
+            Work { vertices, stage },
         )
     }
 
@@ -1481,45 +1784,48 @@ impl<'a> Progressive<'a> {
         self.strata = Strata::build(&self.cells, k, |c| samples[c].bounds());
     }
 
-    /// Cluster step, phase 3: every polygon with some reflectance
-    /// receives, the cluster's own members included (they see each other);
-    /// with shaft culling, the polygons in each non-member's shaft to the
-    /// cluster's bounds, then in each thin shaft between a receiver tile
-    /// and a group of strata (by the strata's bounds). Members always test
-    /// their rays against the whole scene.
-    fn cull_cluster(&mut self, cluster: usize) {
+    /// Cluster step, marking: every polygon with some reflectance
+    /// receives, the cluster's own members included (they see each
+    /// other). Keeps the strata's bounds, two corners a stratum, for the
+    /// thin shafts ([`Progressive::cull_chunk`]).
+    fn mark_cluster_receivers(&mut self) {
         let mesh: &Mesh = &self.mesh;
         for (j, pm) in mesh.polygons.iter().enumerate() {
             self.receives[j] = !self.reflectance[j].is_black() && pm.vertex_count() > 0;
         }
-        if !self.options.shaft_culling {
-            return;
+        self.group_points.clear();
+        for &r in &self.strata.roots {
+            let s = &self.strata.nodes[r as usize];
+            self.group_points.extend([s.bounds.0, s.bounds.1]);
         }
+    }
+
+    /// Cluster step, phase 3 for `polygons`: the polygons in each
+    /// non-member's shaft to the cluster's bounds (members always test
+    /// their rays against the whole scene).
+    fn cull_cluster_shafts(&mut self, cluster: usize, polygons: Range<usize>) {
         let (lo, hi) = self.clusters.bounds(cluster);
         let bounds = (lo.as_dvec3(), hi.as_dvec3());
         let visibility = self.visibility;
         let receives = &self.receives;
         let clusters = &self.clusters;
         let small = &self.small;
-        self.candidates
+        let groups = &self.culling_groups;
+        let start = polygons.start;
+        self.candidates[polygons.clone()]
             .par_iter_mut()
+            .zip(self.candidate_runs[polygons].par_iter_mut())
             .enumerate()
-            .for_each(|(j, c)| {
+            .for_each(|(k, (c, runs))| {
+                let j = start + k;
                 let member = clusters.of(PolygonId(j as u32)) == cluster;
                 if receives[j] && !member && !small[j] {
                     visibility.box_shaft_candidates(bounds, PolygonId(j as u32), REFINE_MAX, c);
                 } else {
                     c.clear();
                 }
+                group_candidates(groups, c, runs);
             });
-        self.group_candidates();
-        self.group_points.clear();
-        for &r in &self.strata.roots {
-            let s = &self.strata.nodes[r as usize];
-            self.group_points.extend([s.bounds.0, s.bounds.1]);
-        }
-        let groups = self.strata.roots.len().div_ceil(SHOOTER_GROUP).max(1);
-        self.cull_tile_shafts_from(groups, 2);
     }
 
     /// Cluster step, phase 4: every receiving vertex's `Δrad`, summed over
@@ -1534,6 +1840,8 @@ impl<'a> Progressive<'a> {
         &mut self,
         cluster: usize,
         from_top: bool,
+        vertices: Range<usize>,
+        stage: Stage,
         cancel: &AtomicBool,
     ) -> Option<Gathered> {
         let mesh: &Mesh = &self.mesh;
@@ -1769,50 +2077,46 @@ impl<'a> Progressive<'a> {
             held: &self.radiosity,
         };
         gather_passes(
-            &mut self.delta,
-            &mut self.coarse_delta,
-            &mut self.spent,
+            Sums {
+                delta: &mut self.delta,
+                first: &mut self.coarse_delta,
+                spent: &mut self.spent,
+            },
             mesh,
             &cells,
             cancel,
             exact,
+            Work { vertices, stage },
         )
     }
 
-    /// Phase 5, apply: adds the gathered `Δrad` (subtracts it, for a step
-    /// of negative light: `shot_power < 0`) to every receiver's radiosity
-    /// and unshot radiosity (polygon by polygon in index order, so the sums
-    /// are the same whatever the thread count), takes what they sent from
-    /// the shooters' unshot radiosity ([`UnshotField::spend`], with the
-    /// `expected` light the step read them with) and counts the step.
-    /// `shot_power` is what [`Progressive::choose_shooter`] found the
-    /// shooter to send, signed.
-    fn apply(
-        &mut self,
-        cluster: usize,
-        shooter: PolygonId,
-        shot_power: f64,
-        expected: Expectation,
-        gathered: Gathered,
-    ) -> StepReport {
-        let negative = shot_power < 0.0;
-        let culling = self.options.shaft_culling;
-        let (mut receivers, mut clear) = (0u64, 0u64);
-        // Spent first: a cluster's members receive from each other in
-        // the step that empties them.
-        let members = self.clusters.members(cluster);
-        for &m in members {
-            let shot = self.polygon_shot(m as usize, negative, expected);
-            self.unshot
-                .spend(&self.mesh, m as usize, shot, &self.radiosity);
+    /// Phase 5, apply, for the receiving polygons `polygons` of step `u`:
+    /// adds the gathered `Δrad` (subtracts it, for a step of negative
+    /// light) to their radiosity and unshot radiosity (polygon by polygon
+    /// in index order, so the sums are the same whatever the thread
+    /// count). Before the step's first receivers, takes what the shooters
+    /// sent from their unshot radiosity ([`UnshotField::spend`], with the
+    /// `expected` light the step read them with): a cluster's members
+    /// receive from each other in the step that empties them.
+    fn apply_chunk(&mut self, u: &mut Underway, polygons: Range<usize>) {
+        let negative = u.shot_power < 0.0;
+        if !u.spent {
+            for &m in self.clusters.members(u.cluster) {
+                let shot = self.polygon_shot(m as usize, negative, u.expected);
+                self.unshot
+                    .spend(&self.mesh, m as usize, shot, &self.radiosity);
+            }
+            u.spent = true;
         }
+        let culling = self.options.shaft_culling;
         let mesh: &Mesh = &self.mesh;
-        for (j, pm) in mesh.polygons.iter().enumerate() {
+        for j in polygons {
             if !self.receives[j] {
                 continue;
             }
-            receivers += 1;
-            clear += (culling && !self.small[j] && self.candidates[j].is_empty()) as u64;
+            let pm = &mesh.polygons[j];
+            u.receivers += 1;
+            u.clear += (culling && !self.small[j] && self.candidates[j].is_empty()) as u64;
             for l in pm.vertices.clone() {
                 let l = l as usize;
                 if negative {
@@ -1828,23 +2132,41 @@ impl<'a> Progressive<'a> {
             }
             self.unshot.accumulate(mesh, j, &self.delta);
         }
-        let Gathered { pairs, rays } = gathered;
-        self.pairs += pairs;
-        self.receiver_pairs += receivers;
-        self.clear_receiver_pairs += clear;
-        self.steps += 1;
-        self.rays += rays;
+    }
+
+    /// The report of a part of step `u` that leaves it unfinished.
+    fn part_report(&self, u: &Underway, complete: bool) -> StepReport {
         StepReport {
-            step: self.steps,
-            shooter,
-            polygons: members.len() as u32,
-            shot_power,
-            unshot_fraction: self.unshot_fraction(),
-            rays,
-            pairs,
-            receivers,
-            clear_receivers: clear,
+            step: self.steps + u64::from(!complete),
+            shooter: u.shooter,
+            polygons: self.clusters.members(u.cluster).len() as u32,
+            shot_power: u.shot_power,
+            // Summing the unshot power visits every vertex: a part of a
+            // step not finished says what the last finished step left.
+            unshot_fraction: if complete {
+                self.unshot_fraction()
+            } else {
+                u.fraction_before
+            },
+            rays: u.gathered.rays,
+            pairs: u.gathered.pairs,
+            receivers: u.receivers,
+            clear_receivers: u.clear,
+            part: u.part,
+            complete,
         }
+    }
+
+    /// Counts the finished step `u` and reports it.
+    fn finish_step(&mut self, u: &Underway) -> StepReport {
+        self.pairs += u.gathered.pairs;
+        self.receiver_pairs += u.receivers;
+        self.clear_receiver_pairs += u.clear;
+        self.steps += 1;
+        self.rays += u.gathered.rays;
+        let report = self.part_report(u, true);
+        self.last_fraction = report.unshot_fraction;
+        report
     }
 
     /// The state a solve on `refined`, a refinement of this solve's mesh,
@@ -1950,8 +2272,16 @@ impl<'a> Progressive<'a> {
     }
 
     /// A copy of everything [`Progressive::restore`] needs to continue
-    /// this solve bit for bit (see [`checkpoint`]).
+    /// this solve bit for bit (see [`checkpoint`]). Taken between steps:
+    /// in the middle of a step delivered in parts
+    /// ([`Progressive::in_step`]) it would hold the receivers done so far
+    /// and not the rest (checkpoints are saved by batch runs, which do not
+    /// ask for parts).
     pub fn state(&self) -> checkpoint::SolverState {
+        debug_assert!(
+            self.underway.as_ref().is_none_or(|u| !u.spent),
+            "a solver state taken in the middle of a step"
+        );
         checkpoint::SolverState {
             radiosity: self.radiosity.clone(),
             unshot: self.unshot().to_vec(),
@@ -2001,6 +2331,8 @@ impl<'a> Progressive<'a> {
         };
         self.radiosity = state.radiosity;
         self.unshot.set_values(state.unshot);
+        self.underway = None;
+        self.last_fraction = self.unshot_fraction();
         self.steps = state.steps;
         self.rays = state.rays;
         Ok(())
@@ -2064,53 +2396,82 @@ impl Interpolating<'_> {
 /// otherwise; last, each check vertex of a cell accepted by the weak rule
 /// is charged its error in `spent`. Writes `delta` (black for
 /// non-receivers). Each vertex depends only on itself and the
-/// first pass, so the bits do not depend on the thread count. `None` once
-/// `cancel` is set, with only scratch written.
+/// first pass, so the bits do not depend on the thread count, nor on how
+/// `work` cuts a step ([`parts`]): over whole polygons it runs all three,
+/// over a piece of one polygon the pass its [`Stage`] names (the first
+/// pass's values kept, in `coarse_delta`, and the charges made, once the
+/// polygon's last piece of that pass is done). `None` once `cancel` is
+/// set, with only scratch written.
 fn gather_passes<E>(
-    delta: &mut [Rgb],
-    coarse_delta: &mut Vec<Rgb>,
-    spent: &mut [Rgb],
+    sums: Sums,
     mesh: &Mesh,
     cells: &Interpolating,
     cancel: &AtomicBool,
     exact: E,
+    work: Work,
 ) -> Option<Gathered>
 where
     E: Fn(usize, PolygonId, &mut Scratch) -> (Rgb, u64, u64) + Sync,
 {
     let (receives, held) = (cells.receives, cells.held);
-    let (pairs, rays) = delta
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(64)
-        // One scratch per worker, reused from vertex to vertex.
-        .map_init(Scratch::default, |scratch: &mut Scratch, (l, delta)| {
-            let j = mesh.vertex_polygon[l];
-            if !receives[j.index()] || cancel.load(Ordering::Relaxed) || cells.cell(l, j).is_some()
-            {
-                *delta = Rgb::BLACK;
-                return (0, 0);
-            }
-            let (d, pairs, rays) = exact(l, j, scratch);
-            *delta = d;
-            (pairs, rays)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    if cancel.load(Ordering::Relaxed) {
-        return None;
+    let Work { vertices, stage } = work;
+    let Sums {
+        delta,
+        first: coarse_delta,
+        spent,
+    } = sums;
+    let start = vertices.start;
+    let mut gathered = Gathered { pairs: 0, rays: 0 };
+    if let Stage::All | Stage::Exact { .. } = stage {
+        let (pairs, rays) = par_runs(
+            mesh,
+            &mut delta[vertices.clone()],
+            start,
+            |scratch, l, delta| {
+                let j = mesh.vertex_polygon[l];
+                if !receives[j.index()]
+                    || cancel.load(Ordering::Relaxed)
+                    || cells.cell(l, j).is_some()
+                {
+                    *delta = Rgb::BLACK;
+                    return (0, 0);
+                }
+                let (d, pairs, rays) = exact(l, j, scratch);
+                *delta = d;
+                (pairs, rays)
+            },
+        );
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
+        gathered.add(Gathered { pairs, rays });
+        if !cells.on {
+            return Some(gathered);
+        }
+        // The first pass's values, which the second reads (over the whole
+        // polygon, once its last piece is done).
+        let keep = match &stage {
+            Stage::All => Some(vertices.clone()),
+            Stage::Exact { copy } => copy.clone(),
+            Stage::Interpolated { .. } => None,
+        };
+        if let Some(r) = keep {
+            coarse_delta[r.clone()].copy_from_slice(&delta[r]);
+        }
+        if let Stage::Exact { .. } = stage {
+            return Some(gathered);
+        }
     }
     if !cells.on {
-        return Some(Gathered { pairs, rays });
+        return Some(gathered);
     }
-    coarse_delta.clear();
-    coarse_delta.extend_from_slice(delta);
-    let first = &coarse_delta[..];
+    let first = &*coarse_delta;
     let spent_now = &*spent;
-    let (pairs2, rays2) = delta
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(64)
-        .map_init(Scratch::default, |scratch: &mut Scratch, (l, delta)| {
+    let (pairs2, rays2) = par_runs(
+        mesh,
+        &mut delta[vertices.clone()],
+        start,
+        |scratch, l, delta| {
             let j = mesh.vertex_polygon[l];
             let Some(cell) = cells.cell(l, j) else {
                 return (0, 0);
@@ -2130,16 +2491,25 @@ where
             let (d, pairs, rays) = exact(l, j, scratch);
             *delta = d;
             (pairs, rays)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        },
+    );
     if cancel.load(Ordering::Relaxed) {
         return None;
     }
-    spent
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(256)
-        .for_each(|(l, s)| {
+    gathered.add(Gathered {
+        pairs: pairs2,
+        rays: rays2,
+    });
+    // The check charges, once the second pass read them all.
+    let charge = match stage {
+        Stage::All => Some(vertices),
+        Stage::Interpolated { charge } => charge,
+        Stage::Exact { .. } => None,
+    };
+    if let Some(r) = charge {
+        let first_l = r.start;
+        let charge_one = |(k, s): (usize, &mut Rgb)| {
+            let l = first_l + k;
             let j = mesh.vertex_polygon[l];
             if let Some(cell) = cells.checked_cell(l, j) {
                 let corners = cell.corners.map(|c| first[c as usize]);
@@ -2149,11 +2519,78 @@ where
                     *s += cost;
                 }
             }
-        });
-    Some(Gathered {
-        pairs: pairs + pairs2,
-        rays: rays + rays2,
-    })
+        };
+        // A chunk's few thousand vertices cost less than waking the
+        // workers.
+        if r.len() < PARALLEL_CHARGES {
+            spent[r].iter_mut().enumerate().for_each(charge_one);
+        } else {
+            spent[r]
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(256)
+                .for_each(charge_one);
+        }
+    }
+    Some(gathered)
+}
+
+/// Orders one receiver's shaft candidates `c` by culling group (of
+/// `groups`) and records their runs with the group's bounds, for
+/// [`Visibility::refine_candidates_in_runs`].
+fn group_candidates(
+    groups: &Clusters,
+    c: &mut [u32],
+    runs: &mut Vec<crate::visibility::CandidateRun>,
+) {
+    runs.clear();
+    c.sort_unstable_by_key(|&p| (groups.of(PolygonId(p)), p));
+    let mut start = 0;
+    while start < c.len() {
+        let g = groups.of(PolygonId(c[start]));
+        let mut end = start + 1;
+        while end < c.len() && groups.of(PolygonId(c[end])) == g {
+            end += 1;
+        }
+        let (lo, hi) = groups.bounds(g);
+        runs.push((start as u32..end as u32, (lo.as_dvec3(), hi.as_dvec3())));
+        start = end;
+    }
+}
+
+/// Runs `f` (scratch, vertex, its `Δrad`; returns pairs and rays) on
+/// every vertex of `delta`, which holds the vertices from `start`, in
+/// parallel, in runs of at most [`PAR_RUN`] vertices of one polygon: a
+/// small facet's vertices stay with one worker, which shares their rays
+/// ([`facets`]), and the threads finish a chunk of a few hundred vertices
+/// ([`parts`]) within a few vertices' time of each other. Returns the
+/// summed pairs and rays.
+fn par_runs<F>(mesh: &Mesh, delta: &mut [Rgb], start: usize, f: F) -> (u64, u64)
+where
+    F: Fn(&mut Scratch, usize, &mut Rgb) -> (u64, u64) + Sync,
+{
+    let mut runs = Vec::with_capacity(delta.len() / PAR_RUN + 1);
+    let (mut rest, mut l) = (delta, start);
+    while !rest.is_empty() {
+        let polygon_end = mesh.polygons[mesh.vertex_polygon[l].index()].vertices.end as usize;
+        let n = (polygon_end - l).min(PAR_RUN).min(rest.len());
+        let (run, tail) = std::mem::take(&mut rest).split_at_mut(n);
+        runs.push((l, run));
+        rest = tail;
+        l += n;
+    }
+    runs.into_par_iter()
+        // One scratch per worker, reused from run to run.
+        .map_init(Scratch::default, |scratch: &mut Scratch, (first, run)| {
+            let mut sum = (0, 0);
+            for (k, d) in run.iter_mut().enumerate() {
+                let (pairs, rays) = f(scratch, first + k, d);
+                sum.0 += pairs;
+                sum.1 += rays;
+            }
+            sum
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
 /// Whether the segment from `from` to `x` is blocked, and the rays cast
@@ -2282,6 +2719,8 @@ fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
 mod far_shooter_tests;
 #[cfg(test)]
 mod overshoot_tests;
+#[cfg(test)]
+mod parts_tests;
 #[cfg(test)]
 mod sky_tests;
 #[cfg(test)]

@@ -6,8 +6,12 @@
 //! radiosities after each step; the window thread renders the latest copy
 //! with the same [`Rasterizer`] and tone mapping the batch command uses, so
 //! what `w` writes is exactly what is on screen. The window never waits
-//! for a step: a long step only delays the next new picture, and quitting
-//! cancels it ([`Progressive::step_cancellable`](crate::solver::Progressive::step_cancellable)).
+//! for a step, and a long step comes in parts of about
+//! [`WINDOW_PART_BUDGET`](crate::solver::parts::WINDOW_PART_BUDGET) of
+//! solving, each published with the receivers it finished
+//! ([`crate::solver::parts`]), so the picture moves while a large scene's
+//! step runs; quitting cancels the part under way
+//! ([`Progressive::step_cancellable`](crate::solver::Progressive::step_cancellable)).
 //!
 //! With adaptive subdivision the worker refines the mesh once a solve
 //! converges and solves again on the refined mesh; meanwhile the window
@@ -59,6 +63,12 @@ use std::time::{Duration, Instant};
 pub const REDRAW_INTERVAL: Duration = Duration::from_millis(50);
 /// How often the window polls input when nothing changes (about 60 Hz).
 pub const FRAME_INTERVAL: Duration = Duration::from_millis(16);
+
+/// A part of a step publishes its picture once the solving since the last
+/// picture is this many times what publishing one costs; the window draws
+/// a new solution once this many times its last drawing's time has
+/// passed.
+const PUBLISH_SHARE: u32 = 4;
 /// Radians of orbit per pixel of mouse drag.
 pub const ORBIT_PER_PIXEL: f32 = 0.008;
 
@@ -293,7 +303,11 @@ fn solve_in_background<'p>(
     progress: &Mutex<Progress<'p>>,
     control: &Control,
 ) {
-    let mut session = Session::from_prepared(prepared, SessionOptions::for_run(config, true));
+    // Long steps come in parts, so the picture moves at least every
+    // tenth of a second or so of solving.
+    let mut options = SessionOptions::for_run(config, true);
+    options.solver.part_budget = Some(crate::solver::parts::WINDOW_PART_BUDGET);
+    let mut session = Session::from_prepared(prepared, options);
     let levels = session.max_refinements();
     if let Ok(mut p) = progress.lock() {
         session.shown(&mut p.radiosity);
@@ -304,6 +318,12 @@ fn solve_in_background<'p>(
     }
     let mut solving = Duration::ZERO;
     let mut stopped = None;
+    // What publishing a picture costs (the ambient term and a copy of
+    // every vertex), and when the last was: a part of a step publishes
+    // only when that cost stays a fifth of the solving between pictures,
+    // so a mesh of millions of vertices is not slowed by its pictures.
+    let mut publishing = Duration::ZERO;
+    let mut published = Instant::now();
     loop {
         if control.quit.load(Ordering::Relaxed) {
             return;
@@ -318,10 +338,18 @@ fn solve_in_background<'p>(
         let Ok(mut p) = progress.lock() else {
             return;
         };
+        // Whether the window has something new to draw.
+        let mut changed = true;
         match event {
             Ok(Event::Step(report)) => {
-                if session.pass() == 1 {
+                let due = report.complete
+                    || published.elapsed() >= REDRAW_INTERVAL.max(publishing * PUBLISH_SHARE);
+                changed = due;
+                if session.pass() == 1 && due {
+                    let t = Instant::now();
                     session.shown(&mut p.radiosity);
+                    publishing = t.elapsed();
+                    published = Instant::now();
                 }
                 p.step = report.step;
                 p.unshot_fraction = report.unshot_fraction;
@@ -353,7 +381,9 @@ fn solve_in_background<'p>(
                 break;
             }
         }
-        p.version += 1;
+        if changed {
+            p.version += 1;
+        }
     }
     while !control.quit.load(Ordering::Relaxed) {
         std::thread::sleep(FRAME_INTERVAL);
@@ -436,6 +466,7 @@ impl<'a> Ui<'a> {
     ) -> Result<(), ViewerError> {
         let mut shown_version = u64::MAX;
         let mut last_draw = Instant::now() - REDRAW_INTERVAL;
+        let mut draw_cost = Duration::ZERO;
         let mut dirty = true;
         let mut title = String::new();
         let emits = self.prepared.scene.emits();
@@ -466,9 +497,14 @@ impl<'a> Ui<'a> {
             let Ok((version, step, unshot, rays, solving, stopped, pass)) = snapshot else {
                 break;
             };
-            let fresh = version != shown_version && last_draw.elapsed() >= REDRAW_INTERVAL;
+            // A new solution is drawn at most every REDRAW_INTERVAL, and
+            // no more often than leaves the solver four fifths of the
+            // time on a mesh that is slow to draw; input draws at once.
+            let fresh = version != shown_version
+                && last_draw.elapsed() >= REDRAW_INTERVAL.max(draw_cost * PUBLISH_SHARE);
             let drawn = fresh || dirty;
             if drawn {
+                let t = Instant::now();
                 if let Ok(p) = progress.lock() {
                     self.radiosity.clone_from(&p.radiosity);
                     self.mesh.clone_from(&p.mesh);
@@ -476,6 +512,7 @@ impl<'a> Ui<'a> {
                 shown_version = version;
                 self.draw()?;
                 last_draw = Instant::now();
+                draw_cost = t.elapsed();
                 dirty = false;
             }
             let state = match stopped {

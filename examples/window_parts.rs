@@ -1,0 +1,104 @@
+//! How often the window's picture moves: solves a scene as the window does,
+//! with steps delivered in parts of about
+//! [`WINDOW_PART_BUDGET`](radiosity::solver::parts::WINDOW_PART_BUDGET)
+//! (`docs/performance.md`), and prints the solver time between pictures
+//! (each part) against the time of whole steps:
+//!
+//! ```sh
+//! cargo run --release --example hall -- 150 > hall150.sc
+//! cargo run --release --example window_parts -- hall150.sc
+//! ```
+//!
+//! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
+//! absent for the program's default) and the part budget in milliseconds
+//! (default the window's; `0` ends a part after every chunk, `none` runs
+//! every step in one piece, as a batch run does). Prints the steps, the
+//! parts, the median and longest part and step, how many of each took more
+//! than 100 ms, and the whole solve's seconds.
+
+use radiosity::config::{RunConfig, SceneSource};
+use radiosity::prepare;
+use radiosity::session::{Event, Session, SessionOptions};
+use radiosity::solver::parts::WINDOW_PART_BUDGET;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+/// Median and largest of `v` (seconds), and how many exceed 0.1 s.
+fn summary(v: &mut [f64]) -> (f64, f64, usize) {
+    v.sort_by(f64::total_cmp);
+    let median = v.get(v.len() / 2).copied().unwrap_or(0.0);
+    let max = v.last().copied().unwrap_or(0.0);
+    (median, max, v.iter().filter(|&&t| t > 0.1).count())
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(scene) = args.first() else {
+        eprintln!("usage: window_parts SCENE [LENMAX|-] [BUDGET_MS|none]");
+        std::process::exit(2);
+    };
+    let mut config = RunConfig::new(SceneSource::File(PathBuf::from(scene)));
+    config.lenmax = args.get(1).and_then(|l| l.parse().ok());
+    let budget = match args.get(2).map(String::as_str) {
+        None => Some(WINDOW_PART_BUDGET),
+        Some("none") => None,
+        Some(ms) => match ms.parse::<u64>() {
+            Ok(ms) => Some(Duration::from_millis(ms)),
+            Err(_) => {
+                eprintln!("budget: milliseconds or `none`, not {ms:?}");
+                std::process::exit(2);
+            }
+        },
+    };
+    let prepared = match prepare::prepare(&config) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
+    let mut options = SessionOptions::for_run(&config, true);
+    options.solver.part_budget = budget;
+    let mut session = Session::from_prepared(&prepared, options);
+    let cancel = AtomicBool::new(false);
+    let (mut parts, mut steps) = (Vec::new(), Vec::new());
+    let mut step_so_far = 0.0;
+    let start = Instant::now();
+    loop {
+        let t = Instant::now();
+        let event = session.advance(&cancel).expect("a solve without errors");
+        let took = t.elapsed().as_secs_f64();
+        match event {
+            Event::Step(report) => {
+                parts.push(took);
+                step_so_far += took;
+                if report.complete {
+                    steps.push(step_so_far);
+                    step_so_far = 0.0;
+                }
+            }
+            Event::Finished => break,
+            _ => {}
+        }
+    }
+    let total = start.elapsed().as_secs_f64();
+    let (n_parts, n_steps) = (parts.len(), steps.len());
+    let (pm, px, po) = summary(&mut parts);
+    let (sm, sx, so) = summary(&mut steps);
+    println!(
+        "# {scene}: {} polygons, {} vertices, budget {}",
+        prepared.scene.polygons.len(),
+        prepared.mesh.vertex_count(),
+        budget.map_or("none".into(), |b| format!("{} ms", b.as_millis()))
+    );
+    println!("| | count | median s | longest s | over 100 ms |");
+    println!("|---|---|---|---|---|");
+    println!("| parts (pictures) | {n_parts} | {pm:.3} | {px:.3} | {po} |");
+    println!("| steps | {n_steps} | {sm:.3} | {sx:.3} | {so} |");
+    println!(
+        "solve {total:.2} s, {} rays, unshot {:.3} %",
+        session.totals().rays,
+        session.unshot_fraction() * 100.0
+    );
+}

@@ -1,0 +1,126 @@
+//! Steps delivered in parts ([`SolverOptions::part_budget`]) against the
+//! same steps in one piece: the finished steps must be bit-identical,
+//! whatever the parts, in every kind of step (a lamp alone, clusters and
+//! weak polygons through strata, negative light, large receivers cut into
+//! pieces in both passes of the hierarchical gather).
+
+use super::tests::same_bits;
+use super::*;
+use crate::mesh::{self, MeshOptions};
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+/// The one-table hall at a lenmax that gives its floor more vertices than
+/// one chunk holds, so the floor is cut into pieces.
+fn hall() -> (Scene, Mesh) {
+    let s = crate::scene::parse_str(&crate::scene::hall::hall_sc(1), "hall.sc").unwrap();
+    let m = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.075,
+            inset: mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let largest = m.polygons.iter().map(|p| p.vertex_count()).max().unwrap();
+    let per_chunk = parts::CHUNK_WORK / u64::from(DEFAULT_SHOOTER_SAMPLES);
+    assert!(u64::from(largest) > per_chunk, "{largest} vertices");
+    (s, m)
+}
+
+/// Solves `steps` whole steps; returns the solver's radiosity, unshot
+/// radiosity, rays and the parts it reported.
+fn run(s: &Scene, m: &Mesh, options: SolverOptions, steps: u64) -> (Vec<Rgb>, Vec<Rgb>, u64, u64) {
+    let vis = Visibility::new(s);
+    let mut solver = Progressive::new(s, m, &vis, options);
+    let mut parts = 0;
+    while solver.steps() < steps {
+        let report = solver.step().expect("light left to shoot");
+        parts += 1;
+        assert_eq!(report.complete, !solver.in_step());
+        if !report.complete {
+            assert!(
+                solver.stop_reason().is_none(),
+                "a step under way stops nothing"
+            );
+            assert_eq!(report.step, solver.steps() + 1);
+        }
+    }
+    let unshot = solver.unshot().to_vec();
+    (solver.radiosity().to_vec(), unshot, solver.rays(), parts)
+}
+
+#[test]
+fn a_step_in_parts_is_bit_identical_to_one_in_a_piece() {
+    let (s, m) = hall();
+    for base in [
+        SolverOptions::default(),
+        SolverOptions {
+            clustering: false,
+            unshot: UnshotScheme::Polygon,
+            ..Default::default()
+        },
+    ] {
+        let whole = run(&s, &m, base, 24);
+        // A zero budget ends a part after every chunk.
+        let cut = SolverOptions {
+            part_budget: Some(Duration::ZERO),
+            ..base
+        };
+        let parted = run(&s, &m, cut, 24);
+        assert_eq!(whole.3, 24, "without a budget every report ends a step");
+        assert!(parted.3 > 3 * 24, "{} parts", parted.3);
+        assert!(same_bits(&whole.0, &parted.0), "radiosity");
+        assert!(same_bits(&whole.1, &parted.1), "unshot radiosity");
+        assert_eq!(whole.2, parted.2, "rays");
+    }
+}
+
+/// A cancelled part leaves the parts before it; going on finishes the
+/// step as if nothing had happened.
+#[test]
+fn a_cancelled_part_leaves_the_parts_before_it() {
+    let (s, m) = hall();
+    let vis = Visibility::new(&s);
+    let options = SolverOptions {
+        part_budget: Some(Duration::ZERO),
+        ..Default::default()
+    };
+    let mut solver = Progressive::new(&s, &m, &vis, options);
+    let first = solver.step().unwrap();
+    assert!(!first.complete && first.part == 1);
+    // On until some receivers are applied (the first parts may be pieces
+    // of the floor, which is applied once whole).
+    let mut last = first;
+    while last.receivers == 0 {
+        last = solver.step().unwrap();
+    }
+    assert!(!last.complete && last.part > 1 && last.step == 1);
+    let before = (solver.radiosity().to_vec(), solver.unshot().to_vec());
+    assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
+    assert!(solver.in_step());
+    assert!(same_bits(&before.0, solver.radiosity()));
+    assert!(same_bits(&before.1, solver.unshot()));
+    while solver.steps() < 3 {
+        solver.step().unwrap();
+    }
+    let whole = run(&s, &m, SolverOptions::default(), 3);
+    assert!(same_bits(&whole.0, solver.radiosity()));
+    assert!(same_bits(&whole.1, solver.unshot()));
+}
+
+/// A step cancelled before any of its receivers were applied is forgotten,
+/// as without parts.
+#[test]
+fn a_step_cancelled_before_its_first_part_changes_nothing() {
+    let (s, m) = hall();
+    let vis = Visibility::new(&s);
+    let options = SolverOptions {
+        part_budget: Some(Duration::ZERO),
+        ..Default::default()
+    };
+    let mut solver = Progressive::new(&s, &m, &vis, options);
+    assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
+    assert!(!solver.in_step());
+    assert_eq!((solver.steps(), solver.rays()), (0, 0));
+}
