@@ -41,7 +41,13 @@ pub const CHUNK_WORK: u64 = 1 << 15;
 const GROWTH: f64 = 1.25;
 
 /// How much a piece of a large polygon may grow on the last one's size.
-const PIECE_GROWTH: f64 = 2.0;
+const PIECE_GROWTH: f64 = 1.5;
+
+/// Work in one piece of a large polygon at most: its vertices cost less
+/// than others, most being interpolated, but the ones near the shooter
+/// are evaluated exactly (a hall's floor under the shooting table cost
+/// 0.47 µs a pair, so a piece stays under about 60 ms).
+pub const PIECE_WORK: u64 = 4 * CHUNK_WORK;
 
 /// The solver time a chunk aims at: a part ends within about this of its
 /// budget.
@@ -247,10 +253,10 @@ impl Plan {
     /// `piece` of a large polygon, or whole polygons): at once down to
     /// what fits [`CHUNK_TARGET`], and up towards it halfway
     /// (geometrically), by a quarter at most for whole polygons, within
-    /// [`CHUNK_WORK`] / 64 and [`CHUNK_WORK`]; pieces may double, without
-    /// a cap, as the rest of one polygon costs about what its last piece
-    /// did (a receiving grid's interpolated vertices cost next to
-    /// nothing). A chunk's size changes which receivers share a part,
+    /// [`CHUNK_WORK`] / 64 and [`CHUNK_WORK`]; pieces may grow by half, up
+    /// to [`PIECE_WORK`], as the rest of one polygon costs about what its
+    /// last piece did (a receiving grid's interpolated vertices cost next
+    /// to nothing). A chunk's size changes which receivers share a part,
     /// never a result bit.
     pub(crate) fn observe(&mut self, piece: bool, work: u64, took: Duration) {
         if work == 0 {
@@ -258,7 +264,7 @@ impl Plan {
         }
         let fits = work as f64 * CHUNK_TARGET.as_secs_f64() / took.as_secs_f64().max(1e-6);
         let (limit, growth, cap) = if piece {
-            (&mut self.piece_limit, PIECE_GROWTH, u64::MAX)
+            (&mut self.piece_limit, PIECE_GROWTH, PIECE_WORK)
         } else {
             (&mut self.limit, GROWTH, CHUNK_WORK)
         };
@@ -429,9 +435,13 @@ mod tests {
         assert_eq!(plan.limit, CHUNK_WORK);
         plan.observe(false, CHUNK_WORK, Duration::from_secs(100));
         assert_eq!(plan.limit, CHUNK_WORK / 64);
-        // Pieces grow faster and past the cap.
+        // Pieces grow faster and past the cap, to theirs.
         plan.observe(true, CHUNK_WORK, CHUNK_TARGET / 16);
-        assert_eq!(plan.piece_limit, 2 * CHUNK_WORK);
+        assert_eq!(plan.piece_limit, CHUNK_WORK * 3 / 2);
+        for _ in 0..10 {
+            plan.observe(true, CHUNK_WORK, Duration::from_nanos(1));
+        }
+        assert_eq!(plan.piece_limit, PIECE_WORK);
         plan.observe(true, CHUNK_WORK, CHUNK_TARGET * 2);
         assert_eq!(plan.piece_limit, CHUNK_WORK / 2);
         // Chunks follow the limit.
