@@ -28,6 +28,14 @@ fn hall() -> (Scene, Mesh) {
     (s, m)
 }
 
+/// The default solver with a part after every chunk.
+fn chunk_by_chunk() -> SolverOptions {
+    SolverOptions {
+        part_budget: Some(Duration::ZERO),
+        ..Default::default()
+    }
+}
+
 /// Solves `steps` whole steps; returns the solver's radiosity, unshot
 /// radiosity, rays and the parts it reported.
 fn run(s: &Scene, m: &Mesh, options: SolverOptions, steps: u64) -> (Vec<Rgb>, Vec<Rgb>, u64, u64) {
@@ -82,11 +90,7 @@ fn a_step_in_parts_is_bit_identical_to_one_in_a_piece() {
 fn a_cancelled_part_leaves_the_parts_before_it() {
     let (s, m) = hall();
     let vis = Visibility::new(&s);
-    let options = SolverOptions {
-        part_budget: Some(Duration::ZERO),
-        ..Default::default()
-    };
-    let mut solver = Progressive::new(&s, &m, &vis, options);
+    let mut solver = Progressive::new(&s, &m, &vis, chunk_by_chunk());
     let first = solver.step().unwrap();
     assert!(!first.complete && first.part == 1);
     // On until some receivers are applied (the first parts may be pieces
@@ -115,11 +119,7 @@ fn a_cancelled_part_leaves_the_parts_before_it() {
 fn a_step_cancelled_before_its_first_part_changes_nothing() {
     let (s, m) = hall();
     let vis = Visibility::new(&s);
-    let options = SolverOptions {
-        part_budget: Some(Duration::ZERO),
-        ..Default::default()
-    };
-    let mut solver = Progressive::new(&s, &m, &vis, options);
+    let mut solver = Progressive::new(&s, &m, &vis, chunk_by_chunk());
     assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
     assert!(!solver.in_step());
     assert_eq!((solver.steps(), solver.rays()), (0, 0));
