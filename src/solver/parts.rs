@@ -26,13 +26,13 @@ use crate::mesh::PolygonMesh;
 use std::ops::Range;
 use std::time::Duration;
 
-/// Receiving vertices × shooter points (samples or strata) in one chunk at
-/// most: about 20 ms of gathering on two cores where a pair costs what
-/// it costs on average, 80 ms where it costs most (0.3 to 1.2 µs, on the
-/// 100,000-triangle sphere box). Chunks shrink from the time the
-/// earlier ones took ([`Plan::observe`]), down to [`CHUNK_WORK`] / 64;
-/// they never grow past it, as the next polygons may cost four times
-/// the last.
+/// Receiving vertices × shooter points (samples or strata) in one chunk of
+/// whole polygons at most: about 10 ms of gathering on two cores where a
+/// pair costs what it costs on average, 75 ms where it costs most (0.3 to
+/// 2.3 µs on the 100,000-triangle sphere box). Chunks shrink from the
+/// time the earlier ones took ([`Plan::observe`]), down to
+/// [`CHUNK_WORK`] / 64; they never grow past it, as the next polygons may
+/// cost several times the last.
 pub const CHUNK_WORK: u64 = 1 << 15;
 
 /// How much a chunk may grow on the last one's size: slowly, as the next
