@@ -1218,7 +1218,7 @@ impl<'a> Progressive<'a> {
             u.plan.advance(after);
             u.plan.observe(piece, work, took);
             longest = longest.max(took);
-            if self.next_chunk(&u).is_none() {
+            if u.plan.finished(self.mesh.polygons.len()) {
                 break;
             }
             if let Some(budget) = self.options.part_budget {

@@ -282,6 +282,12 @@ impl Plan {
         self.cursor = cursor;
     }
 
+    /// Whether every one of `polygons` polygons has been taken (when
+    /// [`Plan::next`] has nothing left).
+    pub(crate) fn finished(&self, polygons: usize) -> bool {
+        self.cursor.piece.is_none() && self.cursor.polygon >= polygons
+    }
+
     /// Whether a large polygon's gather has a second, interpolating pass.
     pub(crate) fn two_passes(&self) -> bool {
         self.two_passes
@@ -324,9 +330,11 @@ mod tests {
         let mut plan = plan;
         let mut out = Vec::new();
         while let Some((chunk, after, _)) = plan.next(polygons, receives, |_| false) {
+            assert!(!plan.finished(polygons.len()));
             out.push(chunk);
             plan.advance(after);
         }
+        assert!(plan.finished(polygons.len()));
         out
     }
 
