@@ -16,12 +16,12 @@
 //! and its share of the right-hand side).
 //!
 //! The right-hand side reads the radiosity the picture shows, so a
-//! surface that sees an element straddling a hidden bright patch (a
-//! ceiling above a lamp hung a centimetre below it, whose vertices over
-//! the lamp are lit by the lamp's back) reads high there: on McGuire's
-//! `CornellBox-Original.obj` the short box's top comes out 7.5 % below
-//! its right-hand side in both modes, most of the difference in what its
-//! rays find on the ceiling around the lamp.
+//! surface that sees an element straddling a hidden bright patch reads
+//! high there: on McGuire's `CornellBox-Original.obj`, while its lamp's
+//! back still lit the ceiling a centimetre above it, the short box's top
+//! came out 7.5 % below its right-hand side in both modes, most of the
+//! difference in what its rays found on the ceiling around the lamp
+//! (−1.1 % ± 0.9 % since that side emits nothing).
 //!
 //! Solves the scene twice, without clustering or overshooting (the
 //! original algorithm) and with the defaults. For each solution and

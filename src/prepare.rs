@@ -171,10 +171,28 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     if let Some(sky) = config.sky {
         scene.add_sky(sky).map_err(PrepareError::Sky)?;
     }
+    // An emitting face with two sides, one just under a ceiling, emits
+    // from the other only. Rays find the gap, so such a scene builds its
+    // BVH here, on the finished geometry (silencing a side changes only a
+    // material), and keeps it.
+    let visibility = OnceLock::new();
+    let mut bvh_seconds = 0.0;
+    if scene.emits_from_both_sides() {
+        let t = Instant::now();
+        let built = Visibility::new(&scene);
+        bvh_seconds = t.elapsed().as_secs_f64();
+        let first_hit = |origin, direction| built.first_hit(origin, direction).map(|hit| hit.1);
+        if let Some(warning) = scene.silence_covered_sides(first_hit, &config.scene.display_name())
+        {
+            scene.warnings.push(warning);
+        }
+        // Set once, here, before anyone can read it.
+        let _ = visibility.set((built, bvh_seconds));
+    }
     if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
         scene.warnings.push(warning);
     }
-    seconds.load = t.elapsed().as_secs_f64();
+    seconds.load = t.elapsed().as_secs_f64() - bvh_seconds;
     // Said before the solve, whatever `--quiet` says: a warning explains a
     // picture that is not what the user expected.
     for warning in &scene.warnings {
@@ -194,7 +212,7 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     Ok(Prepared {
         scene,
         mesh,
-        visibility: OnceLock::new(),
+        visibility,
         lenmax: mesh_options.lenmax,
         seconds,
         split,

@@ -23,6 +23,7 @@ mod sky;
 mod solids;
 pub mod sphere_box;
 mod split;
+mod trapped;
 mod units;
 
 pub use coplanar::{
@@ -49,6 +50,7 @@ pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MA
 pub use sides::Sides;
 pub use sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
 pub use split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
+pub use trapped::COVERED_GAP_SHARE;
 pub use units::{Photometric, Units};
 
 /// The camera lives in [`crate::camera`], below the scene; these are
