@@ -2,7 +2,9 @@
 //! what `--emit` names emit ([`Scene::set_emission`]), put the `--sky`
 //! around it ([`Scene::add_sky`]), say on stderr what
 //! the loader changed or ignored and whether nothing emits
-//! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), split polygons
+//! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), silence the
+//! side of a two-sided lamp that faces a ceiling across a narrow gap
+//! ([`Scene::silence_covered_sides`]), split polygons
 //! where others pass through them ([`Scene::split_intersections`]), check
 //! the mesh size against the element limit before allocating anything,
 //! mesh it and build the visibility BVH. What the batch run, the window
@@ -136,7 +138,9 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
 /// [`prepare`] without building the BVH, which [`Prepared::visibility`]
 /// builds on first use (on a scene of 100,000 triangles it takes about a
 /// quarter of a second, a quarter of the time before a window's first
-/// frame).
+/// frame). A scene with a face emitting from both sides builds it here
+/// all the same, to find the sides that face a surface across a narrow
+/// gap ([`Scene::silence_covered_sides`]).
 pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
