@@ -1091,13 +1091,16 @@ impl<'a> Progressive<'a> {
     /// last part (the next call continues it). A window uses it to quit
     /// promptly during a long step.
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+        // A step's first part counts choosing the shooter and reading it
+        // (building its strata) against its budget.
+        let start = std::time::Instant::now();
         if self.underway.is_none() {
             match self.begin_step(cancel)? {
                 Begun::Done(report) => return Some(report),
                 Begun::Underway(u) => self.underway = Some(u),
             }
         }
-        self.continue_step(cancel)
+        self.continue_step(start, cancel)
     }
 
     /// Whether a step delivered in parts ([`SolverOptions::part_budget`])
@@ -1187,18 +1190,22 @@ impl<'a> Progressive<'a> {
     /// Gathers and applies chunks of the step under way until every
     /// receiver is done (the step's report, `complete`) or, with a
     /// [`SolverOptions::part_budget`], until the next chunk would take the
-    /// part past it (a report of the part). `None` once `cancel` is set:
+    /// part past it, counted from `start` (a report of the part). `None`
+    /// once `cancel` is set:
     /// the chunk in hand is dropped, and a step none of whose chunks was
     /// applied is forgotten, leaving the state exactly as before it.
-    fn continue_step(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+    fn continue_step(
+        &mut self,
+        start: std::time::Instant,
+        cancel: &AtomicBool,
+    ) -> Option<StepReport> {
         // On a worker of the thread pool: a part runs many short parallel
         // loops, and each one called from outside the pool would wait for
         // sleeping workers to wake and for the caller to be woken back.
         if rayon::current_thread_index().is_none() {
-            return rayon::scope(|_| self.continue_step(cancel));
+            return rayon::scope(|_| self.continue_step(start, cancel));
         }
         let mut u = self.underway.take()?;
-        let start = std::time::Instant::now();
         let mut longest = std::time::Duration::ZERO;
         u.part += 1;
         loop {
