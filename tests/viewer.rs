@@ -354,14 +354,17 @@ fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
     let Some((_xvfb, display)) = x_server() else {
         return;
     };
-    for name in ["cornell", "rtable", "table_chair"] {
+    // A few thousand vertices each: `cornell` is 550 units wide, the
+    // others a few metres (at 0.5 `cornell` would have 9 million vertices
+    // and take most of a minute for its four steps).
+    for (name, lenmax) in [("cornell", "20"), ("rtable", "0.5"), ("table_chair", "0.5")] {
         let dir = tempfile::tempdir().unwrap();
         // A few steps, then a still picture, so the files can be compared.
         let (mut program, window) = open_scene(
             name,
             dir.path(),
             &display,
-            &["--max-steps", "4", "--lenmax", "0.5"],
+            &["--max-steps", "4", "--lenmax", lenmax],
         );
         wait_for(Duration::from_secs(60), || {
             let title = xdotool(&display, &["getwindowname", &window])?;
