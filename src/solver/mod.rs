@@ -1402,6 +1402,10 @@ impl<'a> Progressive<'a> {
             &self.radiosity,
             &mut self.shot,
         );
+        // The samples read the field at their cells' centres; what they
+        // send together must be what the step takes from the polygon.
+        let sent = self.unshot.sent_power(&self.mesh, i, shot, &self.radiosity);
+        unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent);
     }
 
     /// Shooter samples of polygon `i` are culled in groups of
@@ -1771,6 +1775,8 @@ impl<'a> Progressive<'a> {
                 &self.radiosity,
                 &mut self.shot,
             );
+            let sent = self.unshot.sent_power(mesh, i, shot, &self.radiosity);
+            unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent);
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
                 if power > 0.0 {

@@ -544,6 +544,47 @@ fn energy_balance_in_an_open_box() {
     }
 }
 
+/// A step sends what it takes from its shooter, however unevenly lit the
+/// shooter is between its samples: a closed box lit by a small lamp below
+/// its ceiling's middle, each wall shooting from 2 × 2 cells much larger
+/// than its elements. The floor's light peaks under the lamp, between the
+/// cells' centres, so the centres read it low; the walls', rising towards
+/// the ceiling, read it high or low by the cell. Energy balances within
+/// 0.5 % (0.19 %; the cells' readings alone, unscaled, left it 6.2 % off).
+#[test]
+fn a_step_sends_what_it_spends_from_cells_larger_than_elements() {
+    let mut polygons = closed_box(1.0, [1; 6]);
+    polygons.push(polygon(
+        0,
+        &[
+            [0.45, 0.45, 0.9],
+            [0.45, 0.55, 0.9],
+            [0.55, 0.55, 0.9],
+            [0.55, 0.45, 0.9],
+        ],
+    ));
+    let s = scene(
+        polygons,
+        vec![grey("lamp", 100.0, 0.3), grey("wall", 0.0, 0.6)],
+    );
+    for clustering in [false, true] {
+        let solved = solve(
+            &s,
+            0.05,
+            crate::mesh::DEFAULT_INSET,
+            SolverOptions {
+                threshold: 1e-5,
+                shooter_samples: ShooterSamples::AtMost(4),
+                clustering,
+                ..Default::default()
+            },
+        );
+        let error = energy_error(&s, &solved);
+        eprintln!("clustering {clustering}: energy error {error}");
+        assert!(error < 0.005, "clustering {clustering}: {error}");
+    }
+}
+
 /// `|absorbed + unshot − emitted| / emitted` of a solve of a closed scene
 /// whose every polygon reflects.
 fn energy_error(s: &Scene, solved: &Solved) -> f64 {

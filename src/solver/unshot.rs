@@ -511,6 +511,52 @@ fn polygon_received(pm: &PolygonMesh, mean_weight: &[f64], received: impl Fn(usi
     sum
 }
 
+/// The largest factor by which [`send_what_is_spent`] scales a channel
+/// of a shooter's samples (or its inverse, the smallest). Beyond it the
+/// samples' reading is no estimate of the polygon's power (a field of
+/// both signs summing to nearly nothing, under overshooting), and is
+/// left as it is.
+const MAX_SPEND_SCALE: f64 = 4.0;
+
+/// Scales, per channel, the radiosity `values` that a shooter's `samples`
+/// send (one each, in the samples' order) so that they send `spent`
+/// altogether, `Σ value · area = spent`: the power the step takes from
+/// the polygon's unshot radiosity ([`UnshotField::sent_power`]).
+///
+/// Read at the centres of cells much larger than the elements, the
+/// values do not add up to it: in a hall whose tables stand on a regular
+/// grid, every centre of the floor's 64 cells fell between the tables'
+/// shadows, and a step of the floor sent up to 7 % more light than it
+/// spent, which left the whole converged picture 3.7 % too bright (0.8 %
+/// at 128 samples, whose cells fall elsewhere). A channel whose reading
+/// and whose target differ in sign, or by more than
+/// [`MAX_SPEND_SCALE`], is left as read.
+pub(crate) fn send_what_is_spent(values: &mut [Rgb], samples: &[ShooterSample], spent: Rgb) {
+    let mut read = Rgb::BLACK;
+    for (value, sample) in values.iter().zip(samples) {
+        read += *value * sample.area;
+    }
+    let scale = |spent: f64, read: f64| {
+        let k = spent / read;
+        if k.is_finite() && (1.0 / MAX_SPEND_SCALE..=MAX_SPEND_SCALE).contains(&k) {
+            k
+        } else {
+            1.0
+        }
+    };
+    let k = Rgb::new(
+        scale(spent.r, read.r),
+        scale(spent.g, read.g),
+        scale(spent.b, read.b),
+    );
+    if k == Rgb::splat(1.0) {
+        return;
+    }
+    for value in values {
+        *value = Rgb::new(value.r * k.r, value.g * k.g, value.b * k.b);
+    }
+}
+
 /// Area-weighted mean of a per-vertex `field` (read by vertex index) over
 /// polygon `pm`, with `vertex_area` the area each vertex stands for.
 fn polygon_mean(pm: &PolygonMesh, vertex_area: &[f64], field: impl Fn(usize) -> Rgb) -> Rgb {
