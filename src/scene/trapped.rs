@@ -18,7 +18,7 @@
 //! emit nothing (it still reflects), with one warning for the file.
 
 use super::error::Warning;
-use super::{Material, MaterialId, Polygon, PolygonId, Scene};
+use super::{Material, MaterialId, Polygon, Scene};
 use glam::Vec3;
 use std::collections::HashMap;
 
@@ -132,8 +132,9 @@ impl Scene {
         first_hit: impl Fn(Vec3, Vec3) -> Option<f32>,
         file: &str,
     ) -> Option<Warning> {
-        // (covered side, its gap) for each face whose other side is open.
-        let mut silenced: Vec<(usize, f32)> = Vec::new();
+        // (covered side, its face's front, the gap) for each face whose
+        // other side is open.
+        let mut silenced: Vec<(usize, usize, f32)> = Vec::new();
         for (b, back) in self.polygons.iter().enumerate() {
             let Some(front) = back.surface.back_of else {
                 continue;
@@ -148,8 +149,8 @@ impl Scene {
                 covered_within(back, reach, &first_hit),
             );
             match sides {
-                (Some(gap), None) => silenced.push((front.index(), gap)),
-                (None, Some(gap)) => silenced.push((b, gap)),
+                (Some(gap), None) => silenced.push((front.index(), front.index(), gap)),
+                (None, Some(gap)) => silenced.push((b, front.index(), gap)),
                 _ => {}
             }
         }
@@ -158,7 +159,7 @@ impl Scene {
         }
         // One dark twin per material, in the order first needed.
         let mut dark: HashMap<MaterialId, MaterialId> = HashMap::new();
-        for &(i, _) in &silenced {
+        for &(i, _, _) in &silenced {
             let material = self.polygons[i].material;
             let twin = *dark.entry(material).or_insert_with(|| {
                 let lit = &self.materials[material.index()];
@@ -171,19 +172,11 @@ impl Scene {
             });
             self.polygons[i].material = twin;
         }
-        let (first, gap) = silenced
+        let (first, face, gap) = silenced
             .iter()
             .copied()
-            .min_by_key(|&(i, _)| {
-                let p = &self.polygons[i];
-                let face = p.surface.back_of.map_or(i, PolygonId::index);
-                (self.polygons[face].origin.line, face)
-            })
+            .min_by_key(|&(_, face, _)| (self.polygons[face].origin.line, face))
             .expect("at least one side was silenced");
-        let face = self.polygons[first]
-            .surface
-            .back_of
-            .map_or(first, PolygonId::index);
         let which = if first == face { "front" } else { "back" };
         let message = match silenced.len() {
             1 => format!(
