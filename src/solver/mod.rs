@@ -1899,7 +1899,8 @@ impl<'a> Progressive<'a> {
             // (node, its cut index or NONE above the cut)
             const NONE: u32 = u32::MAX;
             stack.clear();
-            if from_top {
+            // No cells (every reading zero): the step sends nothing.
+            if from_top && !strata.nodes.is_empty() {
                 stack.push((0, strata.root_index.first().copied().unwrap_or(NONE)));
             } else {
                 stack.extend(strata.roots.iter().enumerate().map(|(i, &r)| (r, i as u32)));

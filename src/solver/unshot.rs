@@ -536,6 +536,35 @@ pub(crate) fn send_what_is_spent(values: &mut [Rgb], samples: &[ShooterSample], 
     for (value, sample) in values.iter().zip(samples) {
         read += *value * sample.area;
     }
+    // A channel that no sample reads (the polygon's unshot light lies
+    // between its cells' centres, where every reading is zero) is sent
+    // evenly over the polygon, or the step would spend it and send
+    // nothing: energy lost, and a cluster of such members shoots no cell.
+    let total: f64 = samples.iter().map(|s| s.area).sum();
+    let even = |spent: f64, read: f64| read == 0.0 && spent > 0.0 && total > 0.0;
+    let fill = Rgb::new(
+        if even(spent.r, read.r) {
+            spent.r / total
+        } else {
+            0.0
+        },
+        if even(spent.g, read.g) {
+            spent.g / total
+        } else {
+            0.0
+        },
+        if even(spent.b, read.b) {
+            spent.b / total
+        } else {
+            0.0
+        },
+    );
+    if !fill.is_black() {
+        for value in values.iter_mut() {
+            *value += fill;
+        }
+        read += fill * total;
+    }
     let scale = |spent: f64, read: f64| {
         let k = spent / read;
         if k.is_finite() && (1.0 / MAX_SPEND_SCALE..=MAX_SPEND_SCALE).contains(&k) {
@@ -689,6 +718,38 @@ mod tests {
             Shot::NEGATIVE.at(received).sent(v),
             Rgb::new(0.0, 0.25, 1.0)
         );
+    }
+
+    /// Readings are scaled per channel to send what the step spends; a
+    /// channel every sample reads as zero is sent evenly (none of it
+    /// lost); a sign change or a scale beyond the limit is left as read.
+    #[test]
+    fn samples_send_what_is_spent_even_when_none_reads_it() {
+        use crate::solver::formfactor::ShooterSample;
+        let samples = [
+            ShooterSample::point(glam::Vec3::ZERO, 1.0),
+            ShooterSample::point(glam::Vec3::X, 3.0),
+        ];
+        let sent = |values: &[Rgb]| {
+            values
+                .iter()
+                .zip(&samples)
+                .fold(Rgb::BLACK, |sum, (v, s)| sum + *v * s.area)
+        };
+        // Red read 2 + 3 = 5 for 6 spent: scaled by 1.2. Green read
+        // nothing for 8 spent: 2 on each (8 over an area of 4). Blue read
+        // 4 for 40 spent: beyond the limit, left as read.
+        let mut values = vec![Rgb::new(2.0, 0.0, 1.0), Rgb::new(1.0, 0.0, 1.0)];
+        super::send_what_is_spent(&mut values, &samples, Rgb::new(6.0, 8.0, 40.0));
+        let total = sent(&values);
+        assert!((total.r - 6.0).abs() < 1e-12, "{total:?}");
+        assert!((total.g - 8.0).abs() < 1e-12, "{total:?}");
+        assert_eq!(values[0].g, values[1].g);
+        assert_eq!(total.b, 4.0);
+        // Nothing spent, nothing read: nothing sent.
+        let mut dark = vec![Rgb::BLACK; 2];
+        super::send_what_is_spent(&mut dark, &samples, Rgb::BLACK);
+        assert_eq!(dark, vec![Rgb::BLACK; 2]);
     }
 
     #[test]
