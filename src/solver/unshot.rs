@@ -541,49 +541,38 @@ pub(crate) fn send_what_is_spent(values: &mut [Rgb], samples: &[ShooterSample], 
     // evenly over the polygon, or the step would spend it and send
     // nothing: energy lost, and a cluster of such members shoots no cell.
     let total: f64 = samples.iter().map(|s| s.area).sum();
-    let even = |spent: f64, read: f64| read == 0.0 && spent > 0.0 && total > 0.0;
-    let fill = Rgb::new(
-        if even(spent.r, read.r) {
-            spent.r / total
+    let fill = per_channel(spent, read, |spent, read| {
+        if read == 0.0 && spent > 0.0 && total > 0.0 {
+            spent / total
         } else {
             0.0
-        },
-        if even(spent.g, read.g) {
-            spent.g / total
-        } else {
-            0.0
-        },
-        if even(spent.b, read.b) {
-            spent.b / total
-        } else {
-            0.0
-        },
-    );
+        }
+    });
     if !fill.is_black() {
         for value in values.iter_mut() {
             *value += fill;
         }
         read += fill * total;
     }
-    let scale = |spent: f64, read: f64| {
+    let k = per_channel(spent, read, |spent, read| {
         let k = spent / read;
         if k.is_finite() && (1.0 / MAX_SPEND_SCALE..=MAX_SPEND_SCALE).contains(&k) {
             k
         } else {
             1.0
         }
-    };
-    let k = Rgb::new(
-        scale(spent.r, read.r),
-        scale(spent.g, read.g),
-        scale(spent.b, read.b),
-    );
+    });
     if k == Rgb::splat(1.0) {
         return;
     }
     for value in values {
         *value = Rgb::new(value.r * k.r, value.g * k.g, value.b * k.b);
     }
+}
+
+/// `f` of each channel of `a` and `b`.
+fn per_channel(a: Rgb, b: Rgb, f: impl Fn(f64, f64) -> f64) -> Rgb {
+    Rgb::new(f(a.r, b.r), f(a.g, b.g), f(a.b, b.b))
 }
 
 /// Area-weighted mean of a per-vertex `field` (read by vertex index) over
