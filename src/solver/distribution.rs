@@ -20,6 +20,7 @@
 //! Visibility is the same one ray per sample as for any shooter.
 
 use super::formfactor::{weighted_point_to_samples, ShooterSample};
+use super::subcells::Split;
 use crate::color::Rgb;
 use crate::scene::{Photometry, Scene};
 use glam::{DVec3, Vec3};
@@ -168,8 +169,9 @@ impl Directional {
 }
 
 /// The form factor of a shot from a polygon: [`Directional::weighted`]
-/// when it has a distribution, else [`weighted_point_to_samples`] (the
-/// arguments as there). The one place the solver's emitters differ.
+/// when it has a distribution (its cells taken whole, each with its
+/// parts' mean), else [`weighted_point_to_samples`] (the arguments as
+/// there). The one place the solver's emitters differ.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn shot_point_to_samples<W>(
@@ -179,14 +181,15 @@ pub fn shot_point_to_samples<W>(
     ns: Vec3,
     samples: &[ShooterSample],
     weight: impl Fn(usize) -> W,
+    split: Option<&Split<W>>,
     near_field: bool,
     occluded: impl FnMut(usize, Vec3) -> bool,
 ) -> (W, u64)
 where
-    W: Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
+    W: Copy + Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
 {
     match directional {
         Some(d) => d.weighted(x, nx, samples, weight, occluded),
-        None => weighted_point_to_samples(x, nx, ns, samples, weight, near_field, occluded),
+        None => weighted_point_to_samples(x, nx, ns, samples, weight, split, near_field, occluded),
     }
 }

@@ -41,6 +41,7 @@
 //! and keep the disc term; so does every sample with the near field
 //! switched off.
 
+use super::subcells::{Split, FAR_SCALE};
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
 use glam::{DVec3, Vec3, Vec4};
@@ -99,7 +100,7 @@ pub struct Quadrature {
 }
 
 impl Quadrature {
-    fn new(points: [(Vec3, f32); 4]) -> Self {
+    pub(crate) fn new(points: [(Vec3, f32); 4]) -> Self {
         let lane = |f: fn(&(Vec3, f32)) -> f32| Vec4::from_array(points.each_ref().map(f));
         Quadrature {
             x: lane(|p| p.0.x),
@@ -159,7 +160,7 @@ impl ShooterSample {
 /// element there (exact for a planar bilinear cell); for a triangle (last
 /// corner repeated) the three points at barycentric `(2/3, 1/6, 1/6)` and
 /// its permutations, a third of the area each. Areas sum to `area`.
-fn quadrature(cell: &[Vec3; 4], area: f64) -> [(Vec3, f32); 4] {
+pub(crate) fn quadrature(cell: &[Vec3; 4], area: f64) -> [(Vec3, f32); 4] {
     let [a, b, c, d] = *cell;
     if c == d {
         let third = (area / 3.0) as f32;
@@ -447,13 +448,15 @@ pub fn point_to_samples(
     near_field: bool,
     occluded: impl FnMut(usize, Vec3) -> bool,
 ) -> (f64, u64) {
-    let (sum, rays) = weighted_point_to_samples(x, nx, ns, samples, |_| 1.0, near_field, occluded);
-    (sum, rays)
+    weighted_point_to_samples(x, nx, ns, samples, |_| 1.0, None, near_field, occluded)
 }
 
 /// [`point_to_samples`] with each sample's term multiplied by
 /// `weight(k)` (an unshot radiosity, say) before summing: returns
 /// `Σ_k weight(k) · F_k` and the number of visibility questions asked.
+/// A sample that `split` takes by its parts ([`Split`]) gives
+/// `Σ value · F` over them instead, under its one ray.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn weighted_point_to_samples<W>(
     x: Vec3,
@@ -461,11 +464,12 @@ pub fn weighted_point_to_samples<W>(
     ns: Vec3,
     samples: &[ShooterSample],
     weight: impl Fn(usize) -> W,
+    split: Option<&Split<W>>,
     near_field: bool,
     mut occluded: impl FnMut(usize, Vec3) -> bool,
 ) -> (W, u64)
 where
-    W: Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
+    W: Copy + Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
 {
     let mut sum = W::default();
     let mut rays = 0u64;
@@ -476,6 +480,26 @@ where
         let cos_x = -nx.dot(d);
         if cos_s < 0.0 || r2 <= 0.0 {
             continue;
+        }
+        if let (Some(split), Some(cell), true) = (split, s.cell, near_field) {
+            if let Some(first) = split.of(k) {
+                let far = r2 >= s.exact_r2 * FAR_SCALE * FAR_SCALE;
+                let (value, seen) = split.sum(first, x, nx, ns, far);
+                if seen <= 0.0 {
+                    continue;
+                }
+                // The cell's ray, as when it is taken whole.
+                let from = if cos_x <= 0.0 {
+                    front_point(x, nx, &cell).unwrap_or(s.position)
+                } else {
+                    s.position
+                };
+                rays += 1;
+                if !occluded(k, from) {
+                    sum += value;
+                }
+                continue;
+            }
         }
         let term = match s.cell {
             // A receiver in the shooter's plane at its edge still sees it
@@ -551,6 +575,13 @@ pub fn front_point(x: Vec3, n: Vec3, cell: &[Vec3; 4]) -> Option<Vec3> {
 /// left out; the four at once, one per SIMD lane.
 #[inline]
 fn quadrature_sum(x: Vec3, nx: Vec3, ns: Vec3, q: &Quadrature) -> f64 {
+    f64::from(lane_terms(x, nx, ns, q).element_sum())
+}
+
+/// The point terms of [`quadrature_sum`], one per lane (0 where a point
+/// is behind either surface).
+#[inline]
+pub(crate) fn lane_terms(x: Vec3, nx: Vec3, ns: Vec3, q: &Quadrature) -> Vec4 {
     let dx = Vec4::splat(x.x) - q.x;
     let dy = Vec4::splat(x.y) - q.y;
     let dz = Vec4::splat(x.z) - q.z;
@@ -561,8 +592,7 @@ fn quadrature_sum(x: Vec3, nx: Vec3, ns: Vec3, q: &Quadrature) -> f64 {
     let seen = cs.cmpgt(zero) & cx.cmpgt(zero) & r2.cmpgt(zero);
     // Lanes left out divide by 1, not by a zero distance.
     let denominator = Vec4::select(seen, r2 * r2 * std::f32::consts::PI, Vec4::ONE);
-    let terms = Vec4::select(seen, cs * cx * q.area / denominator, zero);
-    f64::from(terms.element_sum())
+    Vec4::select(seen, cs * cx * q.area / denominator, zero)
 }
 
 /// Exact unoccluded form factor from a differential area at `x` with unit

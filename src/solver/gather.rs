@@ -194,6 +194,7 @@ impl<'a> FinalGather<'a> {
                         source.normal,
                         &source.samples,
                         |k| source.radiosity[k],
+                        None,
                         self.near_field,
                         |_, s| occluded(s),
                     )

@@ -77,6 +77,7 @@ pub mod hemicube;
 pub mod parts;
 pub mod probes;
 pub mod receivers;
+pub mod subcells;
 mod unshot;
 
 use crate::color::Rgb;
@@ -92,6 +93,7 @@ use rayon::prelude::*;
 use receivers::CoarseGrid;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
+use subcells::SubCells;
 use unshot::{Shot, UnshotField};
 
 /// Receiver vertices are grouped in runs of this many consecutive vertices
@@ -548,6 +550,9 @@ pub struct Progressive<'a> {
     power_weight: Vec<f64>,
     /// Per polygon: shooter samples.
     samples: Vec<Vec<ShooterSample>>,
+    /// Per polygon: the parts of its shooter cells much larger than its
+    /// elements ([`subcells`]).
+    parts: Vec<SubCells>,
     /// Per polygon: its light distribution when it is a luminaire (its
     /// shot then weights directions by it, [`distribution`]).
     directional: Vec<Option<distribution::Directional>>,
@@ -558,6 +563,10 @@ pub struct Progressive<'a> {
     unshot: UnshotField,
     /// Scratch: the unshot radiosity each sample of the shooter carries.
     shot: Vec<Rgb>,
+    /// Scratch: what each part of the shooter's split cells sends
+    /// ([`subcells`]), in the order of its [`SubCells::cells`]; empty in
+    /// the per-polygon scheme, whose parts would all send the same.
+    part_readings: Vec<Rgb>,
     /// Per vertex: scratch for the step's `Δrad`.
     delta: Vec<Rgb>,
     /// Per polygon: scratch, whether it receives in this step.
@@ -605,6 +614,11 @@ pub struct Progressive<'a> {
     /// strata.
     cells: Vec<Cell>,
     cell_samples: Vec<ShooterSample>,
+    /// Scratch for a cluster step, per cell: where its parts' values start
+    /// in `cell_part_values` when it is split, else [`subcells::NONE`].
+    cell_parts: Vec<u32>,
+    /// Scratch: what each part of a cluster step's split cells sends.
+    cell_part_values: Vec<Rgb>,
     strata: Strata,
     /// Per polygon: its regular grid, whose vertices between coarse rows
     /// and columns a cluster step may interpolate ([`receivers`]).
@@ -681,7 +695,16 @@ impl<'a> Progressive<'a> {
             .map(|p| emission[p.index()])
             .collect();
         let covered = crate::mesh::covered::covered_vertices(scene, mesh);
-        let unshot = UnshotField::new(options.unshot, mesh, &emission, &samples, &sets, covered);
+        let parts = SubCells::build_all(scene, mesh, &samples, options.near_field);
+        let unshot = UnshotField::new(
+            options.unshot,
+            mesh,
+            &emission,
+            &samples,
+            &sets,
+            &parts,
+            covered,
+        );
         let power_weight = sky_power_weights(mesh);
         let culling_groups = Clusters::build(scene, mesh, &emission);
         let clustered = matches!(
@@ -743,10 +766,12 @@ impl<'a> Progressive<'a> {
             reflectance,
             power_weight,
             samples,
+            parts,
             directional: distribution::Directional::for_scene(scene),
             radiosity,
             unshot,
             shot: Vec::new(),
+            part_readings: Vec::new(),
             delta: vec![Rgb::BLACK; mesh.vertex_count()],
             receives: vec![false; mesh.polygons.len()],
             candidates: vec![Vec::new(); mesh.polygons.len()],
@@ -763,6 +788,8 @@ impl<'a> Progressive<'a> {
             clustered,
             cells: Vec::new(),
             cell_samples: Vec::new(),
+            cell_parts: Vec::new(),
+            cell_part_values: Vec::new(),
             strata: Strata::default(),
             coarse: mesh
                 .polygons
@@ -1391,6 +1418,9 @@ impl<'a> Progressive<'a> {
     /// Phase 2, read the shooter's samples: fills `self.shot` with the
     /// radiosity each sample of `shooter` sends in a step that sends
     /// `shot` ([`UnshotField::read_shooter`]).
+    /// Its cells much larger than the elements carry their parts' mean,
+    /// and their parts' own light is read into `self.part_readings`
+    /// ([`subcells`]).
     fn read_shooter(&mut self, shooter: PolygonId, shot: Shot) {
         let i = shooter.index();
         let samples = self.samples[i].len();
@@ -1401,11 +1431,14 @@ impl<'a> Progressive<'a> {
             shot,
             &self.radiosity,
             &mut self.shot,
+            &mut self.part_readings,
         );
+        subcells::carry_means(&self.parts[i], &self.part_readings, &mut self.shot);
         // The samples read the field at their cells' centres; what they
         // send together must be what the step takes from the polygon.
         let sent = self.unshot.sent_power(&self.mesh, i, shot, &self.radiosity);
-        unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent);
+        unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent)
+            .apply(&mut self.part_readings);
     }
 
     /// Shooter samples of polygon `i` are culled in groups of
@@ -1562,6 +1595,7 @@ impl<'a> Progressive<'a> {
         let near_field = self.options.near_field;
         let shot = &self.shot;
         let directional = self.directional[i].as_ref();
+        let split = subcells::Split::of_polygon(&self.parts[i], &self.part_readings);
         // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
         // pairs and rays it took.
         let facets = &self.facets;
@@ -1626,6 +1660,7 @@ impl<'a> Progressive<'a> {
                 shooter_normal,
                 samples,
                 |k| shot[k],
+                split.as_ref(),
                 near_field,
                 |k, s| match verdict {
                     Some(blocked) => blocked,
@@ -1764,6 +1799,8 @@ impl<'a> Progressive<'a> {
         let mesh: &Mesh = &self.mesh;
         self.cells.clear();
         self.cell_samples.clear();
+        self.cell_parts.clear();
+        self.cell_part_values.clear();
         for &m in self.clusters.members(cluster) {
             let i = m as usize;
             let shot = self.polygon_shot(i, negative, expected);
@@ -1774,9 +1811,14 @@ impl<'a> Progressive<'a> {
                 shot,
                 &self.radiosity,
                 &mut self.shot,
+                &mut self.part_readings,
             );
+            let parts = &self.parts[i];
+            subcells::carry_means(parts, &self.part_readings, &mut self.shot);
             let sent = self.unshot.sent_power(mesh, i, shot, &self.radiosity);
-            unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent);
+            unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent)
+                .apply(&mut self.part_readings);
+            let split = self.part_readings.len() == parts.cells.len();
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
                 if power > 0.0 {
@@ -1789,6 +1831,17 @@ impl<'a> Progressive<'a> {
                         power,
                     });
                     self.cell_samples.push(*sample);
+                    let at = match parts.first.get(k) {
+                        Some(&f) if split && f != subcells::NONE => {
+                            let at = self.cell_part_values.len() as u32;
+                            let f = f as usize;
+                            self.cell_part_values
+                                .extend_from_slice(&self.part_readings[f..f + subcells::PER_CELL]);
+                            at
+                        }
+                        _ => subcells::NONE,
+                    };
+                    self.cell_parts.push(at);
                 }
             }
         }
@@ -1871,6 +1924,9 @@ impl<'a> Progressive<'a> {
         let small = &self.small;
         let cells = &self.cells;
         let cell_samples = &self.cell_samples;
+        let cell_parts = &self.cell_parts;
+        let cell_part_values = &self.cell_part_values;
+        let parts = &self.parts;
         let strata = &self.strata;
         let held = &self.radiosity;
         let lump_share = if self.options.receiver_interpolation {
@@ -1977,12 +2033,26 @@ impl<'a> Progressive<'a> {
                         if rep.polygon == j || visibility.coplanar(rep.polygon, j) {
                             continue;
                         }
+                        // A split cell by its parts, as when its
+                        // polygon shoots alone.
+                        let at = cell_parts[node.representative as usize];
+                        let split = (at != subcells::NONE)
+                            .then(|| {
+                                let at = at as usize;
+                                subcells::Split::of_cell(
+                                    &parts[rep.polygon.index()],
+                                    rep.sample as usize,
+                                    &cell_part_values[at..at + subcells::PER_CELL],
+                                )
+                            })
+                            .flatten();
                         let (f, asked) = weighted_point_to_samples(
                             x,
                             nx,
                             mesh.polygons[rep.polygon.index()].normal,
                             std::slice::from_ref(rep_sample),
                             |_| rep.unshot,
+                            split.as_ref(),
                             near_field,
                             |_, from| {
                                 let exact_r2 = rep_sample.exact_r2;
@@ -2207,7 +2277,18 @@ impl<'a> Progressive<'a> {
         if previous.len() != refined.vertex_count() || unshot.len() != refined.vertex_count() {
             return None;
         }
-        let shot = self.unshot.shot_at_samples(&self.mesh, &self.radiosity)?;
+        // Each polygon's cells as a step of it reads them: a split cell by
+        // its parts.
+        let shot: Vec<(Vec<Rgb>, Vec<Rgb>)> = self
+            .unshot
+            .shot_at_samples(&self.mesh, &self.radiosity)?
+            .into_iter()
+            .zip(&self.parts)
+            .map(|((mut values, readings), parts)| {
+                subcells::carry_means(parts, &readings, &mut values);
+                (values, readings)
+            })
+            .collect();
         let visibility = self.visibility;
         let near_field = self.options.near_field;
         let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
@@ -2227,7 +2308,9 @@ impl<'a> Progressive<'a> {
                 let normal = refined.polygons[j.index()].normal;
                 let mut sum = Rgb::BLACK;
                 let mut rays = 0;
-                for (i, (samples, values)) in self.samples.iter().zip(&shot).enumerate() {
+                for (i, ((samples, (values, readings)), parts)) in
+                    self.samples.iter().zip(&shot).zip(&self.parts).enumerate()
+                {
                     // Coplanar polygons exchange no light (see
                     // `Visibility::coplanar`).
                     if i == j.index() || visibility.coplanar(PolygonId(i as u32), j) {
@@ -2241,6 +2324,7 @@ impl<'a> Progressive<'a> {
                         self.mesh.polygons[i].normal,
                         samples,
                         |k| values[k],
+                        subcells::Split::of_polygon(parts, readings).as_ref(),
                         near_field,
                         |_, s| visibility.occluded(s, x, (shooter, j)),
                     );

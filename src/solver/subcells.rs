@@ -1,0 +1,605 @@
+//! Sub-cells: a shooter cell much larger than its polygon's elements,
+//! shot as [`PER_CELL`] parts, each with the light it holds.
+//!
+//! A large polygon shoots from at most 64 cells ([`super::formfactor`]),
+//! one shadow ray each. Light pooled in a spot narrower than a cell (where
+//! a sphere rests on the floor, the floor's light gathers around the
+//! contact) is then sent as if spread over the whole cell, and the facets
+//! just above the pool, which see it under a large angle, receive far
+//! less than its light would give them: both solver modes left the
+//! contact 30 to 40 % dark, and by different amounts, as they shoot in
+//! different orders.
+//!
+//! Such a cell is cut into 4 × 4 parts (a triangle into 16 congruent
+//! triangles), each reading the unshot field at its own centre, and
+//! *every* receiver takes the cell as its parts: each part's own value and
+//! form factor (Lambert's exact one for receivers near the cell, the point
+//! term farther), under the cell's one shadow ray, so the parts cost
+//! arithmetic, not rays. Two shortcuts were tried and fail closed-form
+//! tests:
+//!
+//! - parts for near receivers only (those farther take the cell's mean):
+//!   a part near a receiver sends more of its light there than the mean
+//!   does, while the receivers farther still get the mean, and a closed
+//!   box lit by a small lamp lost 1.3 % of its light;
+//! - parts only in steps whose light is uneven over the cell (by 10 %):
+//!   light that one step sends from its parts and another spreads over
+//!   the cell no longer adds up to what the cell has shot, and the
+//!   uniform enclosure's corners came out 1.1 % bright (0.05 % either
+//!   way when every step takes the same choice).
+//!
+//! The cell itself carries the area-weighted mean of its parts
+//! ([`carry_means`]), so whatever takes it whole (a cluster's stratum seen
+//! from afar, a hemicube, a luminaire's distribution) sends the same
+//! power.
+
+use super::formfactor::{
+    lane_terms, point_to_polygon, quadrature, Quadrature, ShooterSample, EXACT_RATIO,
+    NEAR_FIELD_RATIO,
+};
+use crate::color::Rgb;
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+use glam::Vec3;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Parts per side of a split quadrilateral cell (a triangle is cut into
+/// `SIDE²` triangles).
+pub const SIDE: usize = 4;
+
+/// Parts per split cell.
+pub const PER_CELL: usize = SIDE * SIDE;
+
+/// A cell is split when it stands for more than this many of its
+/// polygon's elements (by area): finer than that, its centre's reading is
+/// already what its elements hold.
+pub const ELEMENTS_PER_CELL: f64 = 4.0;
+
+/// A receiver farther than this factor of the cell's exact radius
+/// ([`ShooterSample::exact_r2`], itself 1.5 cell diameters), 2 cell
+/// diameters, is more than 6 of a part's diameters from every part, and
+/// takes their point terms, four at a time; nearer, each part is taken by
+/// the rules of a cell (Lambert's exact form factor within 1.5 of its
+/// diameters, its quadrature within 6, its point term beyond).
+pub const FAR_SCALE: f32 = 2.0 / 1.5;
+
+/// "Not split" in [`SubCells::first`] and in a step's [`Split::first`].
+pub const NONE: u32 = u32::MAX;
+
+/// One part of a split cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubCell {
+    /// Its centre, in scene units.
+    pub position: Vec3,
+    /// The area it stands for, in square scene units; a cell's parts sum
+    /// to the cell's area.
+    pub area: f64,
+    /// Its corners, counter-clockwise from the front (a triangle repeats
+    /// its last).
+    pub corners: [Vec3; 4],
+    /// Its quadrature points ([`quadrature`]).
+    pub quadrature: Quadrature,
+    /// Squared diameter, in square scene units.
+    pub diameter2: f32,
+}
+
+/// The parts of one polygon's split cells.
+///
+/// Invariant: `first` has one entry per shooter sample of the polygon,
+/// [`NONE`] or the index in `cells` of the first of the sample's
+/// [`PER_CELL`] parts.
+#[derive(Clone, Debug, Default)]
+pub struct SubCells {
+    /// Per shooter sample: where its parts start, or [`NONE`].
+    pub first: Vec<u32>,
+    /// The parts, [`PER_CELL`] per split cell.
+    pub cells: Vec<SubCell>,
+    /// The parts' centres and areas, four parts to a [`Quadrature`] (one
+    /// per SIMD lane), in the order of `cells`.
+    pub centres: Vec<Quadrature>,
+}
+
+impl SubCells {
+    /// Every polygon's parts: those of its cells that stand for more than
+    /// [`ELEMENTS_PER_CELL`] of its elements and have something over them
+    /// ([`Over`]). None without the near field (`near_field` false), nor
+    /// for samples without a cell, whose form factors have no cell to cut.
+    pub fn build_all(
+        scene: &Scene,
+        mesh: &Mesh,
+        samples: &[Vec<ShooterSample>],
+        near_field: bool,
+    ) -> Vec<SubCells> {
+        let over = Over::new(mesh);
+        (0..mesh.polygons.len())
+            .into_par_iter()
+            .map(|i| {
+                let pm = &mesh.polygons[i];
+                let element_area = pm.area / pm.elements.len().max(1) as f64;
+                let large = |s: &ShooterSample| {
+                    near_field
+                        && s.cell.is_some()
+                        && s.near_r2 > 0.0
+                        && s.area > ELEMENTS_PER_CELL * element_area
+                };
+                if !samples[i].iter().any(large) {
+                    return SubCells::build(&samples[i], |_| false);
+                }
+                SubCells::build(&samples[i], |s| {
+                    large(s) && over.anything_over(scene, mesh, i, s)
+                })
+            })
+            .collect()
+    }
+
+    /// The parts of the `samples` that `split` chooses (samples without a
+    /// cell are never split).
+    pub fn build(samples: &[ShooterSample], split: impl Fn(&ShooterSample) -> bool) -> SubCells {
+        let mut out = SubCells {
+            first: vec![NONE; samples.len()],
+            cells: Vec::new(),
+            centres: Vec::new(),
+        };
+        for (k, s) in samples.iter().enumerate() {
+            let Some(cell) = s.cell else { continue };
+            if !split(s) {
+                continue;
+            }
+            out.first[k] = out.cells.len() as u32;
+            let start = out.cells.len();
+            cut(&cell, &mut out.cells);
+            // The parts share the cell's area exactly, whatever the f32
+            // corners round to.
+            let sum: f64 = out.cells[start..].iter().map(|c| c.area).sum();
+            if sum > 0.0 {
+                for c in &mut out.cells[start..] {
+                    c.area *= s.area / sum;
+                    c.quadrature = Quadrature::new(quadrature(&c.corners, c.area));
+                }
+            }
+            for four in out.cells[start..].chunks(4) {
+                out.centres.push(Quadrature::new(std::array::from_fn(|l| {
+                    (four[l].position, four[l].area as f32)
+                })));
+            }
+        }
+        out
+    }
+
+    /// True when no cell is split.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// The parts' centres, in the order of [`SubCells::cells`].
+    pub fn positions(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.cells.iter().map(|c| c.position)
+    }
+}
+
+/// Where something stands over a shooter's cell: a mesh vertex of another
+/// polygon in front of the shooter's plane, within the cell's exact radius
+/// ([`ShooterSample::exact_r2`]) of its centre, and over the shooter's
+/// inside, farther than [`EDGE_MARGIN`] cell diameters from its edges.
+///
+/// That is where light pools narrower than a cell: under a sphere resting
+/// on the floor, around a block standing on it, behind a cupboard against
+/// a wall. The walls around a floor meet it along its edges, so all their
+/// points stand over its edges and do not count: a cell in a room's
+/// corner is taken whole, which the uniform enclosure checks.
+struct Over {
+    /// Per polygon: bounds of its mesh vertices, in scene units.
+    bounds: Vec<(Vec3, Vec3)>,
+}
+
+/// How far inside a shooter's edges, in cell diameters, a point must
+/// stand over it to count as over its inside ([`Over`]).
+pub const EDGE_MARGIN: f32 = 0.01;
+
+impl Over {
+    fn new(mesh: &Mesh) -> Over {
+        let bounds = mesh
+            .polygons
+            .iter()
+            .map(|pm| {
+                let range = pm.vertices.start as usize..pm.vertices.end as usize;
+                mesh.positions[range].iter().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), &p| (lo.min(p), hi.max(p)),
+                )
+            })
+            .collect();
+        Over { bounds }
+    }
+
+    /// Whether anything stands over cell `s` of polygon `i`.
+    fn anything_over(&self, scene: &Scene, mesh: &Mesh, i: usize, s: &ShooterSample) -> bool {
+        let polygon = &scene.polygons[i];
+        let (n, rim) = (polygon.normal, &polygon.vertices);
+        let r2 = s.exact_r2;
+        let diameter = (s.exact_r2.sqrt() / super::formfactor::EXACT_RATIO).max(f32::MIN_POSITIVE);
+        let (margin, ahead) = (EDGE_MARGIN * diameter, 1e-4 * diameter);
+        let c = s.position;
+        // Inward normals of the rim's edges (counter-clockwise from the
+        // front, so `n × edge` points inside).
+        let inward: Vec<(Vec3, Vec3)> = (0..rim.len())
+            .filter_map(|k| {
+                let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
+                let w = n.cross(b - a).normalize_or_zero();
+                (w != Vec3::ZERO).then_some((a, w))
+            })
+            .collect();
+        let over = |p: Vec3| {
+            let height = n.dot(p - c);
+            height > ahead
+                && p.distance_squared(c) < r2
+                && inward.iter().all(|&(a, w)| w.dot(p - a) > margin)
+        };
+        self.bounds.iter().enumerate().any(|(j, &(lo, hi))| {
+            if j == i || lo.x > hi.x {
+                return false;
+            }
+            // The nearest point of j's bounds to the centre.
+            if c.clamp(lo, hi).distance_squared(c) >= r2 {
+                return false;
+            }
+            let pm = &mesh.polygons[j];
+            mesh.positions[pm.vertices.start as usize..pm.vertices.end as usize]
+                .iter()
+                .any(|&p| over(p))
+        })
+    }
+}
+
+/// Appends the [`PER_CELL`] parts of `cell` (3 or 4 corners, a triangle
+/// repeating its last) to `out`.
+fn cut(cell: &[Vec3; 4], out: &mut Vec<SubCell>) {
+    let [a, b, c, d] = *cell;
+    let n = SIDE as f32;
+    if c == d {
+        // The regular subdivision: SIDE² congruent triangles.
+        let (e1, e2) = (b - a, c - a);
+        let at = |i: f32, j: f32| a + (i / n) * e1 + (j / n) * e2;
+        for j in 0..SIDE {
+            for i in 0..(SIDE - j) {
+                let (fi, fj) = (i as f32, j as f32);
+                let (p, q, r) = (at(fi, fj), at(fi + 1.0, fj), at(fi, fj + 1.0));
+                out.push(part([p, q, r, r]));
+                if i + j + 1 < SIDE {
+                    let s = at(fi + 1.0, fj + 1.0);
+                    out.push(part([q, s, r, r]));
+                }
+            }
+        }
+    } else {
+        let at = |u: f32, w: f32| {
+            (1.0 - u) * (1.0 - w) * a + u * (1.0 - w) * b + u * w * c + (1.0 - u) * w * d
+        };
+        for j in 0..SIDE {
+            for i in 0..SIDE {
+                let (u0, u1) = (i as f32 / n, (i + 1) as f32 / n);
+                let (w0, w1) = (j as f32 / n, (j + 1) as f32 / n);
+                out.push(part([at(u0, w0), at(u1, w0), at(u1, w1), at(u0, w1)]));
+            }
+        }
+    }
+}
+
+/// A part with the given corners: its centre is the corners' mean (the
+/// centroid for a triangle, the bilinear centre for a quadrilateral).
+fn part(corners: [Vec3; 4]) -> SubCell {
+    let triangle = corners[2] == corners[3];
+    let position = if triangle {
+        (corners[0] + corners[1] + corners[2]) / 3.0
+    } else {
+        (corners[0] + corners[1] + corners[2] + corners[3]) / 4.0
+    };
+    let area = |p: Vec3, q: Vec3, r: Vec3| {
+        (q.as_dvec3() - p.as_dvec3())
+            .cross(r.as_dvec3() - p.as_dvec3())
+            .length()
+            * 0.5
+    };
+    let area = if triangle {
+        area(corners[0], corners[1], corners[2])
+    } else {
+        area(corners[0], corners[1], corners[2]) + area(corners[0], corners[2], corners[3])
+    };
+    let diameter2 = corners[0]
+        .distance_squared(corners[2])
+        .max(corners[1].distance_squared(corners[3]))
+        .max(corners[0].distance_squared(corners[1]))
+        .max(corners[1].distance_squared(corners[2]));
+    SubCell {
+        position,
+        area,
+        corners,
+        quadrature: Quadrature::new(quadrature(&corners, area)),
+        diameter2,
+    }
+}
+
+/// A step's split cells and what their parts send.
+///
+/// Invariant: `first` has one entry per sample of the shooter it is
+/// passed with, [`NONE`] or the index of the sample's first part in
+/// `cells` and `values` (a multiple of 4, its first [`Quadrature`] in
+/// `centres` being a quarter of it).
+#[derive(Clone, Copy, Debug)]
+pub struct Split<'a, W> {
+    /// Per sample: where its parts start, or [`NONE`] (taken whole).
+    pub first: &'a [u32],
+    /// The parts' geometry.
+    pub cells: &'a [SubCell],
+    /// The parts' centres, four to a [`Quadrature`] ([`SubCells::centres`]).
+    pub centres: &'a [Quadrature],
+    /// What each part sends (an unshot radiosity, say).
+    pub values: &'a [W],
+}
+
+impl<'a, W> Split<'a, W>
+where
+    W: Copy + Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
+{
+    /// The split of polygon `subs` with `values` one per part, when there
+    /// are as many (none in the per-polygon scheme).
+    pub fn of_polygon(subs: &'a SubCells, values: &'a [W]) -> Option<Self> {
+        (!subs.is_empty() && values.len() == subs.cells.len()).then_some(Split {
+            first: &subs.first,
+            cells: &subs.cells,
+            centres: &subs.centres,
+            values,
+        })
+    }
+
+    /// The split of the single sample `k` of `subs` with its parts'
+    /// `values` ([`PER_CELL`] of them), for a shot of that one cell.
+    pub fn of_cell(subs: &'a SubCells, k: usize, values: &'a [W]) -> Option<Self> {
+        let f = *subs.first.get(k)? as usize;
+        if f == NONE as usize || values.len() != PER_CELL {
+            return None;
+        }
+        Some(Split {
+            first: &[0],
+            cells: &subs.cells[f..f + PER_CELL],
+            centres: &subs.centres[f / 4..f / 4 + PER_CELL / 4],
+            values,
+        })
+    }
+
+    /// Where sample `k`'s parts start, when it is split.
+    #[inline]
+    pub fn of(&self, k: usize) -> Option<usize> {
+        match self.first.get(k) {
+            Some(&f) if f != NONE => Some(f as usize),
+            _ => None,
+        }
+    }
+
+    /// `Σ value · F` over the parts from `first` seen from `x` (unit normal
+    /// `nx`), the shooter's unit normal being `ns`, and `Σ F` alone (whether
+    /// anything is seen). `far` says the receiver is more than
+    /// [`FAR_SCALE`] of the cell's exact radius away.
+    #[inline]
+    pub fn sum(&self, first: usize, x: Vec3, nx: Vec3, ns: Vec3, far: bool) -> (W, f64) {
+        let mut sum = W::default();
+        let mut total = 0.0;
+        let values = &self.values[first..first + PER_CELL];
+        if far {
+            for (q, four) in self.centres[first / 4..first / 4 + PER_CELL / 4]
+                .iter()
+                .zip(values.chunks_exact(4))
+            {
+                let terms = lane_terms(x, nx, ns, q).to_array();
+                for (&t, &value) in terms.iter().zip(four) {
+                    if t > 0.0 {
+                        let t = f64::from(t);
+                        sum += value * t;
+                        total += t;
+                    }
+                }
+            }
+            return (sum, total);
+        }
+        for (c, &value) in self.cells[first..first + PER_CELL].iter().zip(values) {
+            let d = x - c.position;
+            let r2 = d.length_squared();
+            let term = if r2 < EXACT_RATIO * EXACT_RATIO * c.diameter2 {
+                if c.corners.iter().all(|p| nx.dot(*p - x) <= 0.0) {
+                    continue;
+                }
+                point_to_polygon(x, nx, &c.corners)
+            } else if r2 < NEAR_FIELD_RATIO * NEAR_FIELD_RATIO * c.diameter2 {
+                // A part reaching past the receiver's plane from behind
+                // it lights it by its part in front, as a cell does.
+                if nx.dot(d) >= 0.0 {
+                    if c.corners.iter().all(|p| nx.dot(*p - x) <= 0.0) {
+                        continue;
+                    }
+                    point_to_polygon(x, nx, &c.corners)
+                } else {
+                    f64::from(lane_terms(x, nx, ns, &c.quadrature).element_sum())
+                }
+            } else {
+                let (cos_s, cos_x) = (ns.dot(d), -nx.dot(d));
+                if cos_s <= 0.0 || cos_x <= 0.0 {
+                    continue;
+                }
+                let r2 = f64::from(r2);
+                f64::from(cos_s) * f64::from(cos_x) * c.area / (PI * r2 * r2)
+            };
+            if term > 0.0 {
+                sum += value * term;
+                total += term;
+            }
+        }
+        (sum, total)
+    }
+}
+
+/// Sets each split cell's value in `cells` (one per shooter sample, as
+/// read at the cells' centres) to the area-weighted mean of its parts'
+/// `readings` (aligned with [`SubCells::cells`]): what the cell sends
+/// when a step takes it whole. Does nothing unless there is one reading
+/// per part.
+pub fn carry_means(subs: &SubCells, readings: &[Rgb], cells: &mut [Rgb]) {
+    if readings.len() != subs.cells.len() {
+        return;
+    }
+    for (k, &f) in subs.first.iter().enumerate() {
+        if f == NONE {
+            continue;
+        }
+        let range = f as usize..f as usize + PER_CELL;
+        let (mut sum, mut area) = (Rgb::BLACK, 0.0);
+        for (c, &v) in subs.cells[range.clone()].iter().zip(&readings[range]) {
+            sum += v * c.area;
+            area += c.area;
+        }
+        if let (Some(cell), true) = (cells.get_mut(k), area > 0.0) {
+            *cell = sum / area;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::formfactor::ShooterSample;
+
+    fn square_cell(side: f32) -> ShooterSample {
+        let c = [
+            Vec3::ZERO,
+            Vec3::new(side, 0.0, 0.0),
+            Vec3::new(side, side, 0.0),
+            Vec3::new(0.0, side, 0.0),
+        ];
+        ShooterSample::cell(
+            Vec3::new(side / 2.0, side / 2.0, 0.0),
+            f64::from(side * side),
+            c,
+        )
+    }
+
+    /// The parts of a quadrilateral and of a triangle cover the cell: their
+    /// areas sum to its area and their centres lie inside it.
+    #[test]
+    fn parts_cover_their_cell() {
+        for cell in [
+            [
+                Vec3::ZERO,
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(2.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+            [
+                Vec3::ZERO,
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(0.0, 3.0, 0.0),
+                Vec3::new(0.0, 3.0, 0.0),
+            ],
+        ] {
+            let mut parts = Vec::new();
+            cut(&cell, &mut parts);
+            assert_eq!(parts.len(), PER_CELL);
+            let area: f64 = parts.iter().map(|p| p.area).sum();
+            let expected = if cell[2] == cell[3] { 3.0 } else { 2.0 };
+            assert!((area - expected).abs() < 1e-6, "{area} against {expected}");
+            for p in &parts {
+                assert!(p.position.x > 0.0 && p.position.y > 0.0, "{p:?}");
+                assert!((p.area - expected / PER_CELL as f64).abs() < 1e-6);
+            }
+        }
+    }
+
+    /// The parts' form factors add up to the cell's exact one, near it
+    /// (Lambert's and quadratures), a little farther (quadratures and
+    /// point terms) and far away (point terms four at a time), within the
+    /// errors the cell's own rules allow there.
+    #[test]
+    fn parts_add_up_to_their_cell() {
+        let s = square_cell(1.0);
+        let subs = SubCells::build(std::slice::from_ref(&s), |_| true);
+        assert_eq!(subs.cells.len(), PER_CELL);
+        assert_eq!(subs.centres.len(), PER_CELL / 4);
+        let ones = [1.0f64; PER_CELL];
+        let split = Split::of_polygon(&subs, &ones).unwrap();
+        let nx = -Vec3::Z;
+        for (x, far, tolerance) in [
+            (Vec3::new(0.3, 0.6, 0.05), false, 0.002),
+            (Vec3::new(0.3, 0.6, 0.4), false, 0.002),
+            (Vec3::new(1.5, 0.2, 1.2), false, 0.005),
+            (Vec3::new(0.5, 0.5, 20.0), true, 0.001),
+        ] {
+            let (f, total) = split.sum(0, x, nx, Vec3::Z, far);
+            let whole = point_to_polygon(x, nx, s.cell.as_ref().unwrap());
+            assert!(
+                (f - whole).abs() < tolerance * whole,
+                "at {x}: {f} against {whole}"
+            );
+            assert_eq!(f, total);
+        }
+    }
+
+    /// A split cell carries its parts' mean; a cell without parts keeps
+    /// its own reading.
+    #[test]
+    fn a_split_cell_carries_its_parts_mean() {
+        let s = square_cell(1.0);
+        let mut subs = SubCells::build(&[s, s], |_| true);
+        subs.first[0] = NONE;
+        let mut readings = vec![Rgb::splat(1.0); 2 * PER_CELL];
+        readings[PER_CELL] = Rgb::splat(17.0);
+        let mut cells = vec![Rgb::splat(3.0), Rgb::splat(5.0)];
+        carry_means(&subs, &readings, &mut cells);
+        assert_eq!(cells[0], Rgb::splat(3.0));
+        assert!((cells[1].g - 2.0).abs() < 1e-9, "{:?}", cells[1]);
+    }
+
+    /// Cells are split where something stands over them (a cube on the
+    /// floor, and the walls beside it), not in the room's far corner,
+    /// where only the walls meet the floor, nor on the ceiling far above.
+    #[test]
+    fn cells_are_split_where_something_stands_over_them() {
+        use crate::solver::formfactor::{shooter_samples, SampleSet};
+        use crate::testutil::{closed_box, cuboid, grey, regular_mesh, scene};
+        let mut polygons = closed_box(1.0, [0; 6]);
+        polygons.extend(cuboid([0.1, 0.0, 0.1], [0.2, 0.1, 0.2], false));
+        let s = scene(polygons, vec![grey("wall", 0.0, 0.5)]);
+        let mesh = regular_mesh(&s, 0.02);
+        let samples: Vec<Vec<ShooterSample>> = s
+            .polygons
+            .iter()
+            .zip(&mesh.polygons)
+            .map(|(p, pm)| shooter_samples(p, pm, &mesh, SampleSet::AtMost(64)))
+            .collect();
+        let parts = SubCells::build_all(&s, &mesh, &samples, true);
+        let split_at = |polygon: usize, at: Vec3| {
+            let k = samples[polygon]
+                .iter()
+                .position(|c| c.position.distance(at) < 1e-3)
+                .expect("a cell centred there");
+            parts[polygon].first[k] != NONE
+        };
+        // The floor (y = 0) is polygon 2, the ceiling 3, the wall x = 0 is 0.
+        assert!(split_at(2, Vec3::new(0.0625, 0.0, 0.0625)));
+        assert!(split_at(2, Vec3::new(0.1875, 0.0, 0.3125)));
+        assert!(!split_at(2, Vec3::new(0.9375, 0.0, 0.9375)));
+        assert!(!split_at(2, Vec3::new(0.0625, 0.0, 0.9375)));
+        assert!(split_at(0, Vec3::new(0.0, 0.0625, 0.1875)));
+        assert!(parts[3].is_empty());
+        // The cube's faces are finer than their cells' split threshold.
+        assert!(parts[6..].iter().all(SubCells::is_empty));
+        // Every split cell's parts tile it.
+        for (p, samples) in parts.iter().zip(&samples) {
+            for (k, &f) in p.first.iter().enumerate() {
+                if f != NONE {
+                    let f = f as usize;
+                    let area: f64 = p.cells[f..f + PER_CELL].iter().map(|c| c.area).sum();
+                    assert!((area - samples[k].area).abs() < 1e-9 * samples[k].area);
+                }
+            }
+        }
+    }
+}
