@@ -139,11 +139,7 @@ impl ShooterSample {
     /// A sample at the centre of a cell (3 or 4 corners counter-clockwise;
     /// a triangle repeats its last corner) of `area` square scene units.
     pub fn cell(position: Vec3, area: f64, cell: [Vec3; 4]) -> Self {
-        let diameter2 = cell[0]
-            .distance_squared(cell[2])
-            .max(cell[1].distance_squared(cell[3]))
-            .max(cell[0].distance_squared(cell[1]))
-            .max(cell[1].distance_squared(cell[2]));
+        let diameter2 = cell_diameter2(&cell);
         ShooterSample {
             position,
             area,
@@ -153,6 +149,16 @@ impl ShooterSample {
             quadrature: Quadrature::new(quadrature(&cell, area)),
         }
     }
+}
+
+/// The squared diameter of a cell (3 or 4 corners, a triangle repeating
+/// its last): its longest diagonal or side, in square scene units.
+pub(crate) fn cell_diameter2(cell: &[Vec3; 4]) -> f32 {
+    cell[0]
+        .distance_squared(cell[2])
+        .max(cell[1].distance_squared(cell[3]))
+        .max(cell[0].distance_squared(cell[1]))
+        .max(cell[1].distance_squared(cell[2]))
 }
 
 /// A second-order quadrature rule over a cell: for a quadrilateral the
@@ -415,7 +421,7 @@ fn triangle_cells(v0: Vec3, v1: Vec3, v2: Vec3, m: u32) -> Vec<ShooterSample> {
     samples
 }
 
-fn triangle_area(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+pub(crate) fn triangle_area(a: Vec3, b: Vec3, c: Vec3) -> f64 {
     (b.as_dvec3() - a.as_dvec3())
         .cross(c.as_dvec3() - a.as_dvec3())
         .length()

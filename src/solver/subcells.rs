@@ -41,8 +41,8 @@
 //! power.
 
 use super::formfactor::{
-    lane_terms, point_to_polygon, quadrature, Quadrature, ShooterSample, EXACT_RATIO,
-    NEAR_FIELD_RATIO,
+    cell_diameter2, lane_terms, point_to_polygon, quadrature, triangle_area, Quadrature,
+    ShooterSample, EXACT_RATIO, NEAR_FIELD_RATIO,
 };
 use crate::color::Rgb;
 use crate::mesh::Mesh;
@@ -312,22 +312,13 @@ fn part(corners: [Vec3; 4]) -> SubCell {
     } else {
         (corners[0] + corners[1] + corners[2] + corners[3]) / 4.0
     };
-    let area = |p: Vec3, q: Vec3, r: Vec3| {
-        (q.as_dvec3() - p.as_dvec3())
-            .cross(r.as_dvec3() - p.as_dvec3())
-            .length()
-            * 0.5
-    };
     let area = if triangle {
-        area(corners[0], corners[1], corners[2])
+        triangle_area(corners[0], corners[1], corners[2])
     } else {
-        area(corners[0], corners[1], corners[2]) + area(corners[0], corners[2], corners[3])
+        triangle_area(corners[0], corners[1], corners[2])
+            + triangle_area(corners[0], corners[2], corners[3])
     };
-    let diameter2 = corners[0]
-        .distance_squared(corners[2])
-        .max(corners[1].distance_squared(corners[3]))
-        .max(corners[0].distance_squared(corners[1]))
-        .max(corners[1].distance_squared(corners[2]));
+    let diameter2 = cell_diameter2(&corners);
     SubCell {
         position,
         area,
