@@ -14,11 +14,10 @@
 //! has something close over it (`Over`: a sphere's bottom, a block's
 //! foot, a lamp under the ceiling) is cut into 4 × 4 parts (a triangle
 //! into 16 congruent triangles), each reading the unshot field at its own
-//! centre, and
-//! *every* receiver takes the cell as its parts: each part's own value and
-//! form factor (Lambert's exact one for receivers near the cell, the point
-//! term farther), under the cell's one shadow ray, so the parts cost
-//! arithmetic, not rays. Two shortcuts were tried and fail closed-form
+//! centre, and *every* receiver takes the cell as its parts: each part's
+//! own value and form factor (Lambert's exact one for receivers near the
+//! cell, the point term farther), under the cell's one shadow ray, so the
+//! parts cost arithmetic, not rays. Two shortcuts were tried and fail closed-form
 //! tests:
 //!
 //! - parts for near receivers only (those farther take the cell's mean):
@@ -46,7 +45,7 @@ use super::formfactor::{
 };
 use crate::color::Rgb;
 use crate::mesh::Mesh;
-use crate::scene::Scene;
+use crate::scene::{Polygon, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -133,8 +132,10 @@ impl SubCells {
                 if !samples[i].iter().any(large) {
                     return SubCells::build(&samples[i], |_| false);
                 }
+                let polygon = &scene.polygons[i];
+                let inward = inward_edges(polygon);
                 SubCells::build(&samples[i], |s| {
-                    large(s) && over.anything_over(scene, mesh, i, s)
+                    large(s) && over.anything_over(mesh, i, polygon.normal, &inward, s)
                 })
             })
             .collect()
@@ -155,16 +156,7 @@ impl SubCells {
             }
             out.first[k] = out.cells.len() as u32;
             let start = out.cells.len();
-            cut(&cell, &mut out.cells);
-            // The parts share the cell's area exactly, whatever the f32
-            // corners round to.
-            let sum: f64 = out.cells[start..].iter().map(|c| c.area).sum();
-            if sum > 0.0 {
-                for c in &mut out.cells[start..] {
-                    c.area *= s.area / sum;
-                    c.quadrature = Quadrature::new(quadrature(&c.corners, c.area));
-                }
-            }
+            cut(&cell, s.area, &mut out.cells);
             for four in out.cells[start..].chunks(4) {
                 out.centres.push(Quadrature::new(std::array::from_fn(|l| {
                     (four[l].position, four[l].area as f32)
@@ -193,9 +185,10 @@ impl SubCells {
 ///
 /// That is where light pools narrower than a cell: under a sphere resting
 /// on the floor, around a block standing on it, behind a cupboard against
-/// a wall, above a lamp hung just under a ceiling. The walls around a floor meet it along its edges, so all their
-/// points stand over its edges and do not count: a cell in a room's
-/// corner is taken whole, which the uniform enclosure checks.
+/// a wall, above a lamp hung just under a ceiling. The walls around a
+/// floor meet it along its edges, so all their points stand over its
+/// edges and do not count: a cell in a room's corner is taken whole,
+/// which the uniform enclosure checks.
 struct Over {
     /// Per polygon: bounds of its mesh vertices, in scene units.
     bounds: Vec<(Vec3, Vec3)>,
@@ -229,23 +222,20 @@ impl Over {
         Over { bounds }
     }
 
-    /// Whether anything stands over cell `s` of polygon `i`.
-    fn anything_over(&self, scene: &Scene, mesh: &Mesh, i: usize, s: &ShooterSample) -> bool {
-        let polygon = &scene.polygons[i];
-        let (n, rim) = (polygon.normal, &polygon.vertices);
+    /// Whether anything stands over cell `s` of polygon `i`, whose unit
+    /// normal is `n` and whose edges are `inward` ([`inward_edges`]).
+    fn anything_over(
+        &self,
+        mesh: &Mesh,
+        i: usize,
+        n: Vec3,
+        inward: &[(Vec3, Vec3)],
+        s: &ShooterSample,
+    ) -> bool {
         let diameter = (s.exact_r2.sqrt() / super::formfactor::EXACT_RATIO).max(f32::MIN_POSITIVE);
         let r2 = (REACH * diameter).powi(2);
         let (margin, ahead) = (EDGE_MARGIN * diameter, 1e-4 * diameter);
         let c = s.position;
-        // Inward normals of the rim's edges (counter-clockwise from the
-        // front, so `n × edge` points inside).
-        let inward: Vec<(Vec3, Vec3)> = (0..rim.len())
-            .filter_map(|k| {
-                let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
-                let w = n.cross(b - a).normalize_or_zero();
-                (w != Vec3::ZERO).then_some((a, w))
-            })
-            .collect();
         let over = |p: Vec3| {
             let height = n.dot(p - c);
             height > ahead
@@ -269,9 +259,25 @@ impl Over {
     }
 }
 
+/// Each edge of `polygon` as a point on it and the unit normal pointing
+/// inside, in its plane (its corners run counter-clockwise from the front,
+/// so `normal × edge` points inside); degenerate edges are left out.
+fn inward_edges(polygon: &Polygon) -> Vec<(Vec3, Vec3)> {
+    let rim = &polygon.vertices;
+    (0..rim.len())
+        .filter_map(|k| {
+            let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
+            let w = polygon.normal.cross(b - a).normalize_or_zero();
+            (w != Vec3::ZERO).then_some((a, w))
+        })
+        .collect()
+}
+
 /// Appends the [`PER_CELL`] parts of `cell` (3 or 4 corners, a triangle
-/// repeating its last) to `out`.
-fn cut(cell: &[Vec3; 4], out: &mut Vec<SubCell>) {
+/// repeating its last) to `out`, their areas scaled to sum to `area`
+/// exactly (the cell's, whatever the `f32` corners round to).
+fn cut(cell: &[Vec3; 4], area: f64, out: &mut Vec<SubCell>) {
+    let start = out.len();
     let [a, b, c, d] = *cell;
     let n = SIDE as f32;
     if c == d {
@@ -301,10 +307,17 @@ fn cut(cell: &[Vec3; 4], out: &mut Vec<SubCell>) {
             }
         }
     }
+    let sum: f64 = out[start..].iter().map(|c| c.area).sum();
+    let scale = if sum > 0.0 { area / sum } else { 1.0 };
+    for c in &mut out[start..] {
+        c.area *= scale;
+        c.quadrature = Quadrature::new(quadrature(&c.corners, c.area));
+    }
 }
 
 /// A part with the given corners: its centre is the corners' mean (the
-/// centroid for a triangle, the bilinear centre for a quadrilateral).
+/// centroid for a triangle, the bilinear centre for a quadrilateral). Its
+/// quadrature is left for [`cut`] to set once the area is scaled.
 fn part(corners: [Vec3; 4]) -> SubCell {
     let triangle = corners[2] == corners[3];
     let position = if triangle {
@@ -323,7 +336,7 @@ fn part(corners: [Vec3; 4]) -> SubCell {
         position,
         area,
         corners,
-        quadrature: Quadrature::new(quadrature(&corners, area)),
+        quadrature: Quadrature::new([(position, 0.0); 4]),
         diameter2,
     }
 }
@@ -509,10 +522,17 @@ mod tests {
             ],
         ] {
             let mut parts = Vec::new();
-            cut(&cell, &mut parts);
-            assert_eq!(parts.len(), PER_CELL);
-            let area: f64 = parts.iter().map(|p| p.area).sum();
             let expected = if cell[2] == cell[3] { 3.0 } else { 2.0 };
+            cut(&cell, expected, &mut parts);
+            assert_eq!(parts.len(), PER_CELL);
+            // The parts' own geometry, not the areas `cut` scaled.
+            let area: f64 = parts
+                .iter()
+                .map(|p| {
+                    let c = p.corners;
+                    triangle_area(c[0], c[1], c[2]) + triangle_area(c[0], c[2], c[3])
+                })
+                .sum();
             assert!((area - expected).abs() < 1e-6, "{area} against {expected}");
             for p in &parts {
                 assert!(p.position.x > 0.0 && p.position.y > 0.0, "{p:?}");
