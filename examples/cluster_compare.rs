@@ -13,7 +13,10 @@
 //! absent for the program's default) and the threshold (default 0.001).
 //! `CC_SHOOTER_SAMPLES=N` makes every mode shoot from at most N cells.
 //! Solves in each mode (`CC_SKIP_BRUTE=1` skips the slow reference, and
-//! the solve with exact receivers is then the reference) and prints for
+//! the solve with exact receivers is then the reference; `CC_MODES=--o,c-o`
+//! runs the modes listed instead, the first the reference: three
+//! letters each, `c` clustering, `i` receiver interpolation, `o`
+//! overshooting, `-` off) and prints for
 //! each the steps, rays and solve seconds, and for all but the reference
 //! their difference from it: the picture's relative L1 error (mean
 //! absolute luminance difference over mean luminance, over the pixels
@@ -71,6 +74,37 @@ fn main() {
                 .is_black()
         })
         .collect();
+    // The first run is the reference. CC_SKIP_BRUTE=1 skips the (slow)
+    // unclustered solve, so the clustered solve with exact receivers is
+    // the reference.
+    let skip_brute = std::env::var_os("CC_SKIP_BRUTE").is_some();
+    // (clustering, receiver interpolation, overshooting, label)
+    let modes = [
+        (false, false, false, "--no-clustering --no-overshoot"),
+        (true, false, true, "--exact-receivers"),
+        (true, true, false, "--no-overshoot"),
+        (true, true, true, "default"),
+    ];
+    // CC_MODES=cio,c-o,--o,...: other modes to run instead, the first the
+    // reference; each three letters, `c` clustering, `i` receiver
+    // interpolation, `o` overshooting, `-` for off.
+    let chosen: Vec<(bool, bool, bool, String)> = match std::env::var("CC_MODES") {
+        Ok(list) => list
+            .split(',')
+            .map(|m| {
+                let on: Vec<bool> = m.chars().map(|c| c != '-').collect();
+                if on.len() != 3 {
+                    eprintln!("CC_MODES: {m:?} is not three letters such as c-o");
+                    std::process::exit(2);
+                }
+                (on[0], on[1], on[2], m.to_string())
+            })
+            .collect(),
+        Err(_) => modes[skip_brute as usize..]
+            .iter()
+            .map(|&(c, i, o, l)| (c, i, o, l.to_string()))
+            .collect(),
+    };
     println!(
         "# {scene}: {} polygons, {} vertices, lenmax {}",
         prepared.scene.polygons.len(),
@@ -80,18 +114,7 @@ fn main() {
     println!("| solver | clusters | steps | rays | solve s | picture relL1 | vertex relL1 | worst polygon mean |");
     println!("|---|---|---|---|---|---|---|---|");
     let mut reference: Option<(Frame, Vec<Rgb>, Vec<Rgb>)> = None;
-    // (clustering, receiver interpolation, label); the first run is the
-    // reference. CC_SKIP_BRUTE=1 skips the (slow) unclustered solve, so the
-    // clustered solve with exact receivers is the reference.
-    let skip_brute = std::env::var_os("CC_SKIP_BRUTE").is_some();
-    // (clustering, receiver interpolation, overshooting, label)
-    let modes = [
-        (false, false, false, "--no-clustering --no-overshoot"),
-        (true, false, true, "--exact-receivers"),
-        (true, true, false, "--no-overshoot"),
-        (true, true, true, "default"),
-    ];
-    for &(clustering, interpolation, overshoot, label) in &modes[skip_brute as usize..] {
+    for (clustering, interpolation, overshoot, label) in chosen {
         let mut c = config.clone();
         c.solver.clustering = clustering;
         c.solver.receiver_interpolation = interpolation;

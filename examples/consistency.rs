@@ -11,9 +11,10 @@
 //! polygons to check (indices, comma-separated, as `cluster_compare`'s
 //! `CC_LIST=1` prints them) and optionally the points per polygon
 //! (default 20,000). `SHOOTER_SAMPLES=N` sets `--shooter-samples` for
-//! both solves; `BINS=1` prints each polygon's two means in ten bands of
-//! height, and `HITS=1` where its rays went (per polygon hit: the count
-//! and its share of the right-hand side).
+//! both solves, `THRESHOLD=T` their threshold (default 0.001); `BINS=1`
+//! prints each polygon's two means in ten bands of height, and `HITS=1`
+//! where its rays went (per polygon hit: the count and its share of the
+//! right-hand side).
 //!
 //! The right-hand side reads the radiosity the picture shows, so a
 //! surface that sees an element straddling a hidden bright patch reads
@@ -132,6 +133,9 @@ fn main() {
         .and_then(|n| n.parse().ok())
     {
         config.solver.shooter_samples = radiosity::solver::ShooterSamples::AtMost(n);
+    }
+    if let Some(t) = std::env::var("THRESHOLD").ok().and_then(|t| t.parse().ok()) {
+        config.solver.threshold = t;
     }
     let polygons: Vec<usize> = args[2]
         .split(',')
