@@ -1796,28 +1796,18 @@ impl<'a> Progressive<'a> {
         negative: bool,
         expected: Expectation,
     ) {
-        let mesh: &Mesh = &self.mesh;
         self.cells.clear();
         self.cell_samples.clear();
         self.cell_parts.clear();
         self.cell_part_values.clear();
-        for &m in self.clusters.members(cluster) {
+        for member in 0..self.clusters.members(cluster).len() {
+            let m = self.clusters.members(cluster)[member];
             let i = m as usize;
             let shot = self.polygon_shot(i, negative, expected);
-            self.unshot.read_shooter(
-                mesh,
-                i,
-                self.samples[i].len(),
-                shot,
-                &self.radiosity,
-                &mut self.shot,
-                &mut self.part_readings,
-            );
+            // Each member's cells read as when it shoots alone.
+            self.read_shooter(PolygonId(m), shot);
+            let mesh: &Mesh = &self.mesh;
             let parts = &self.parts[i];
-            subcells::carry_means(parts, &self.part_readings, &mut self.shot);
-            let sent = self.unshot.sent_power(mesh, i, shot, &self.radiosity);
-            unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent)
-                .apply(&mut self.part_readings);
             let split = self.part_readings.len() == parts.cells.len();
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
