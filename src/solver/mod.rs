@@ -66,6 +66,7 @@
 //! per-polygon sums run in a fixed order, so the result is bit-identical
 //! whatever the thread count.
 
+mod cell_integrals;
 pub mod checkpoint;
 pub mod cluster;
 pub mod distribution;
@@ -619,6 +620,10 @@ pub struct Progressive<'a> {
     cell_parts: Vec<u32>,
     /// Scratch: what each part of a cluster step's split cells sends.
     cell_part_values: Vec<Rgb>,
+    /// The leaves' values of the parts in `cell_part_values`,
+    /// [`subcells::LEAVES`] per part, apart from the parts' so that those
+    /// every receiver takes lie together in memory.
+    cell_leaf_values: Vec<Rgb>,
     strata: Strata,
     /// Per polygon: its regular grid, whose vertices between coarse rows
     /// and columns a cluster step may interpolate ([`receivers`]).
@@ -790,6 +795,7 @@ impl<'a> Progressive<'a> {
             cell_samples: Vec::new(),
             cell_parts: Vec::new(),
             cell_part_values: Vec::new(),
+            cell_leaf_values: Vec::new(),
             strata: Strata::default(),
             coarse: mesh
                 .polygons
@@ -1800,6 +1806,7 @@ impl<'a> Progressive<'a> {
         self.cell_samples.clear();
         self.cell_parts.clear();
         self.cell_part_values.clear();
+        self.cell_leaf_values.clear();
         for member in 0..self.clusters.members(cluster).len() {
             let m = self.clusters.members(cluster)[member];
             let i = m as usize;
@@ -1808,7 +1815,7 @@ impl<'a> Progressive<'a> {
             self.read_shooter(PolygonId(m), shot);
             let mesh: &Mesh = &self.mesh;
             let parts = &self.parts[i];
-            let split = self.part_readings.len() == parts.cells.len();
+
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
                 if power > 0.0 {
@@ -1821,15 +1828,14 @@ impl<'a> Progressive<'a> {
                         power,
                     });
                     self.cell_samples.push(*sample);
-                    let at = match parts.first.get(k) {
-                        Some(&f) if split && f != subcells::NONE => {
+                    let at = match parts.cell_values(k, &self.part_readings) {
+                        Some((parts, leaves)) => {
                             let at = self.cell_part_values.len() as u32;
-                            let f = f as usize;
-                            self.cell_part_values
-                                .extend_from_slice(&self.part_readings[f..f + subcells::PER_CELL]);
+                            self.cell_part_values.extend_from_slice(parts);
+                            self.cell_leaf_values.extend_from_slice(leaves);
                             at
                         }
-                        _ => subcells::NONE,
+                        None => subcells::NONE,
                     };
                     self.cell_parts.push(at);
                 }
@@ -1916,6 +1922,7 @@ impl<'a> Progressive<'a> {
         let cell_samples = &self.cell_samples;
         let cell_parts = &self.cell_parts;
         let cell_part_values = &self.cell_part_values;
+        let cell_leaf_values = &self.cell_leaf_values;
         let parts = &self.parts;
         let strata = &self.strata;
         let held = &self.radiosity;
@@ -2032,7 +2039,9 @@ impl<'a> Progressive<'a> {
                                 subcells::Split::of_cell(
                                     &parts[rep.polygon.index()],
                                     rep.sample as usize,
-                                    &cell_part_values[at..at + subcells::PER_CELL],
+                                    &cell_part_values[at..at + subcells::PARTS],
+                                    &cell_leaf_values[at * subcells::LEAVES
+                                        ..(at + subcells::PARTS) * subcells::LEAVES],
                                 )
                             })
                             .flatten();

@@ -8,6 +8,7 @@
 //! what its scheme needs to answer those questions, so the solver asks
 //! without knowing which scheme it runs.
 
+use super::cell_integrals::cell_weights;
 use super::formfactor::{SampleSet, ShooterSample};
 use super::subcells::SubCells;
 use super::UnshotScheme;
@@ -16,6 +17,7 @@ use crate::color::Rgb;
 use crate::mesh::covered::covered_vertices;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, PolygonMesh};
+use rayon::prelude::*;
 
 /// Unshot radiosity `Δb` (in the scene's emission units) and how it is laid
 /// out over a mesh.
@@ -59,6 +61,9 @@ enum Layout {
         /// Per polygon and part of a split cell ([`SubCells::cells`]):
         /// where its unshot radiosity is read from.
         part_sources: Vec<Vec<SampleSource>>,
+        /// Per polygon: the weights of the cells and parts that read
+        /// their integral ([`SampleSource::Region`]), cell after cell.
+        regions: Vec<Vec<(u32, f32)>>,
     },
 }
 
@@ -74,6 +79,10 @@ enum SampleSource {
     /// The area-weighted mean over the polygon's vertices (the one-sample
     /// centre estimate).
     PolygonMean,
+    /// The mean over the sample's cell of the field as the elements
+    /// interpolate it: `Σ w·field / Σ w` over the polygon's region weights
+    /// `[start, end)` ([`super::cell_integrals`]).
+    Region(u32, u32),
 }
 
 /// What a step sends out of a shooter's unshot radiosity: the part of one
@@ -217,35 +226,37 @@ impl UnshotField {
                     layout: Layout::Polygon { mean_weight },
                 }
             }
-            UnshotScheme::Vertex => UnshotField {
-                values: mesh
-                    .vertex_polygon
-                    .iter()
-                    .enumerate()
-                    .map(|(l, p)| {
-                        if is_covered(l) {
-                            Rgb::BLACK
-                        } else {
-                            emission[p.index()]
-                        }
-                    })
-                    .collect(),
-                layout: Layout::Vertex {
-                    vertex_area: mesh.vertex_areas(),
-                    covered,
-                    sources: samples
+            UnshotScheme::Vertex => {
+                let (sources, (part_sources, regions)): (Vec<_>, (Vec<_>, Vec<_>)) = samples
+                    .par_iter()
+                    .zip(&mesh.polygons)
+                    .zip(sets)
+                    .zip(parts)
+                    .map(|(((s, pm), &set), subs)| polygon_sources(mesh, pm, s, set, subs))
+                    .map(|(a, b, c)| (a, (b, c)))
+                    .unzip();
+                UnshotField {
+                    values: mesh
+                        .vertex_polygon
                         .iter()
-                        .zip(&mesh.polygons)
-                        .zip(sets)
-                        .map(|((s, pm), &set)| sample_sources(mesh, pm, s, set))
+                        .enumerate()
+                        .map(|(l, p)| {
+                            if is_covered(l) {
+                                Rgb::BLACK
+                            } else {
+                                emission[p.index()]
+                            }
+                        })
                         .collect(),
-                    part_sources: parts
-                        .iter()
-                        .zip(&mesh.polygons)
-                        .map(|(p, pm)| point_sources(mesh, pm, p.positions()))
-                        .collect(),
-                },
-            },
+                    layout: Layout::Vertex {
+                        vertex_area: mesh.vertex_areas(),
+                        covered,
+                        sources,
+                        part_sources,
+                        regions,
+                    },
+                }
+            }
         }
     }
 
@@ -365,6 +376,7 @@ impl UnshotField {
                 sources,
                 part_sources,
                 covered,
+                regions,
             } => {
                 let sent = |l: usize| {
                     if covered.get(l).copied().unwrap_or(false) {
@@ -374,8 +386,8 @@ impl UnshotField {
                     }
                 };
                 let mean = polygon_mean(pm, vertex_area, sent);
-                read_at_samples(&sources[i], sent, mean, out);
-                read_at_samples(&part_sources[i], sent, mean, parts);
+                read_at_samples(&sources[i], &regions[i], sent, mean, out);
+                read_at_samples(&part_sources[i], &regions[i], sent, mean, parts);
             }
         }
     }
@@ -488,6 +500,7 @@ impl UnshotField {
             sources,
             part_sources,
             covered,
+            regions,
         } = &self.layout
         else {
             return None;
@@ -511,13 +524,13 @@ impl UnshotField {
         Some(
             mesh.polygons
                 .iter()
-                .zip(sources.iter().zip(part_sources))
-                .map(|(pm, (sources, part_sources))| {
+                .zip(sources.iter().zip(part_sources).zip(regions))
+                .map(|(pm, ((sources, part_sources), regions))| {
                     let (mut values, mut parts) = (Vec::new(), Vec::new());
                     let field = |l: usize| shot_field[l];
                     let mean = polygon_mean(pm, vertex_area, field);
-                    read_at_samples(sources, field, mean, &mut values);
-                    read_at_samples(part_sources, field, mean, &mut parts);
+                    read_at_samples(sources, regions, field, mean, &mut values);
+                    read_at_samples(part_sources, regions, field, mean, &mut parts);
                     (values, parts)
                 })
                 .collect(),
@@ -550,11 +563,18 @@ const MAX_SPEND_SCALE: f64 = 4.0;
 /// the polygon's unshot radiosity ([`UnshotField::sent_power`]).
 ///
 /// Read at the centres of cells much larger than the elements, the
-/// values do not add up to it: in a hall whose tables stand on a regular
+/// values did not add up to it: in a hall whose tables stand on a regular
 /// grid, every centre of the floor's 64 cells fell between the tables'
 /// shadows, and a step of the floor sent up to 7 % more light than it
 /// spent, which left the whole converged picture 3.7 % too bright (0.8 %
-/// at 128 samples, whose cells fall elsewhere). A channel whose reading
+/// at 128 samples, whose cells fall elsewhere). Cells and parts now read
+/// their integrals ([`super::cell_integrals`]), which add up to it but
+/// for what the hats' areas and the vertices' areas disagree on and
+/// for the samples that still read a point (a cell the elements do not
+/// reach, a sample without a cell): the factor stays near 1 and is kept
+/// for those. It is the one step that is not linear in the unshot light,
+/// so the nearer to 1, the less the converged answer depends on the order
+/// of the steps. A channel whose reading
 /// and whose target differ in sign, or by more than
 /// [`MAX_SPEND_SCALE`], is left as read. Returns what was done, for the
 /// parts of split cells ([`Rescale::apply`]) to follow their cells.
@@ -645,10 +665,12 @@ fn polygon_mean(pm: &PolygonMesh, vertex_area: &[f64], field: impl Fn(usize) -> 
 
 /// Appends to `out` the per-vertex `field` (read by vertex index) at each
 /// of a polygon's samples, whose `sources` say where (interpolated within
-/// the element triangle holding the sample); `mean` for samples that stand
+/// the element triangle holding the sample, or integrated over its cell
+/// with the polygon's `regions` weights); `mean` for samples that stand
 /// for the whole polygon.
 fn read_at_samples(
     sources: &[SampleSource],
+    regions: &[(u32, f32)],
     field: impl Fn(usize) -> Rgb,
     mean: Rgb,
     out: &mut Vec<Rgb>,
@@ -669,9 +691,67 @@ fn read_at_samples(
                 )
             }
             SampleSource::PolygonMean => mean,
+            SampleSource::Region(start, end) => {
+                let (mut sum, mut area) = (Rgb::BLACK, 0.0);
+                for &(l, w) in &regions[start as usize..end as usize] {
+                    sum += field(l as usize) * f64::from(w);
+                    area += f64::from(w);
+                }
+                sum / area
+            }
         };
         out.push(value);
     }
+}
+
+/// Where polygon `pm`'s shooter `samples` (chosen as `set` says) and the
+/// parts of its split cells (`subs`) read their unshot radiosity, and the
+/// weights of those that read their cell's integral: every cell of a
+/// grid ([`SampleSet::AtMost`]) and every part
+/// ([`super::cell_integrals`]). A sample without a cell, a sky facet's
+/// jittered one, and a cell the elements do not reach read the field at
+/// their point.
+fn polygon_sources(
+    mesh: &Mesh,
+    pm: &PolygonMesh,
+    samples: &[ShooterSample],
+    set: SampleSet,
+    subs: &SubCells,
+) -> (Vec<SampleSource>, Vec<SampleSource>, Vec<(u32, f32)>) {
+    let mut sources = sample_sources(mesh, pm, samples, set);
+    // Parts nearly always read their integral: only those the elements do
+    // not reach are looked up at their centre (a search of every element).
+    let mut part_sources = vec![SampleSource::PolygonMean; subs.len()];
+    let mut regions = Vec::new();
+    let mut integrate = |cells: Vec<(usize, [glam::Vec3; 4])>, sources: &mut [SampleSource]| {
+        let corners: Vec<[glam::Vec3; 4]> = cells.iter().map(|&(_, c)| c).collect();
+        for ((k, _), weights) in cells.iter().zip(cell_weights(mesh, pm, &corners)) {
+            let area: f64 = weights.iter().map(|&(_, w)| f64::from(w)).sum();
+            if area > 0.0 {
+                let start = regions.len() as u32;
+                regions.extend(weights);
+                sources[*k] = SampleSource::Region(start, regions.len() as u32);
+            }
+        }
+    };
+    if matches!(set, SampleSet::AtMost(_)) {
+        let cells = samples
+            .iter()
+            .enumerate()
+            .filter_map(|(k, s)| s.cell.map(|c| (k, c)))
+            .collect();
+        integrate(cells, &mut sources);
+    }
+    integrate(
+        subs.all().map(|c| c.corners).enumerate().collect(),
+        &mut part_sources,
+    );
+    for (source, c) in part_sources.iter_mut().zip(subs.all()) {
+        if *source == SampleSource::PolygonMean {
+            *source = point_sources(mesh, pm, std::iter::once(c.position))[0];
+        }
+    }
+    (sources, part_sources, regions)
 }
 
 /// Where each of a polygon's shooter samples reads its unshot radiosity.
