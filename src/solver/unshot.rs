@@ -718,40 +718,45 @@ fn polygon_sources(
     set: SampleSet,
     subs: &SubCells,
 ) -> (Vec<SampleSource>, Vec<SampleSource>, Vec<(u32, f32)>) {
-    let mut sources = sample_sources(mesh, pm, samples, set);
-    // Parts nearly always read their integral: only those the elements do
-    // not reach are looked up at their centre (a search of every element).
-    let mut part_sources = vec![SampleSource::PolygonMean; subs.len()];
     let mut regions = Vec::new();
-    let mut integrate = |cells: Vec<(usize, [glam::Vec3; 4])>, sources: &mut [SampleSource]| {
-        let corners: Vec<[glam::Vec3; 4]> = cells.iter().map(|&(_, c)| c).collect();
-        for ((k, _), weights) in cells.iter().zip(cell_weights(mesh, pm, &corners)) {
-            let area: f64 = weights.iter().map(|&(_, w)| f64::from(w)).sum();
-            if area > 0.0 {
-                let start = regions.len() as u32;
-                regions.extend(weights);
-                sources[*k] = SampleSource::Region(start, regions.len() as u32);
-            }
-        }
+    let sources = if matches!(set, SampleSet::AtMost(_)) {
+        let cells: Vec<_> = samples.iter().map(|s| (s.position, s.cell)).collect();
+        cell_sources(mesh, pm, &cells, &mut regions)
+    } else {
+        sample_sources(mesh, pm, samples, set)
     };
-    if matches!(set, SampleSet::AtMost(_)) {
-        let cells = samples
-            .iter()
-            .enumerate()
-            .filter_map(|(k, s)| s.cell.map(|c| (k, c)))
-            .collect();
-        integrate(cells, &mut sources);
-    }
-    integrate(
-        subs.all().map(|c| c.corners).enumerate().collect(),
-        &mut part_sources,
-    );
-    for (source, c) in part_sources.iter_mut().zip(subs.all()) {
-        if *source == SampleSource::PolygonMean {
-            *source = point_sources(mesh, pm, std::iter::once(c.position))[0];
+    let parts: Vec<_> = subs.all().map(|c| (c.position, Some(c.corners))).collect();
+    let part_sources = cell_sources(mesh, pm, &parts, &mut regions);
+    (sources, part_sources, regions)
+}
+
+/// Where each of `cells` (a point of polygon `pm` and the cell it stands
+/// for, if any) reads its unshot radiosity: its cell's integral, whose
+/// weights are appended to `regions`, or, without a cell or where the
+/// elements do not reach it, the field at its point (a search of every
+/// element, so done only for those).
+fn cell_sources(
+    mesh: &Mesh,
+    pm: &PolygonMesh,
+    cells: &[(glam::Vec3, Option<[glam::Vec3; 4]>)],
+    regions: &mut Vec<(u32, f32)>,
+) -> Vec<SampleSource> {
+    let with_cell: Vec<usize> = (0..cells.len()).filter(|&k| cells[k].1.is_some()).collect();
+    let corners: Vec<[glam::Vec3; 4]> = with_cell.iter().filter_map(|&k| cells[k].1).collect();
+    let mut sources: Vec<Option<SampleSource>> = vec![None; cells.len()];
+    for (&k, weights) in with_cell.iter().zip(cell_weights(mesh, pm, &corners)) {
+        let area: f64 = weights.iter().map(|&(_, w)| f64::from(w)).sum();
+        if area > 0.0 {
+            let start = regions.len() as u32;
+            regions.extend(weights);
+            sources[k] = Some(SampleSource::Region(start, regions.len() as u32));
         }
     }
-    (sources, part_sources, regions)
+    sources
+        .into_iter()
+        .zip(cells)
+        .map(|(source, &(p, _))| source.unwrap_or_else(|| point_source(mesh, pm, p)))
+        .collect()
 }
 
 /// Where each of a polygon's shooter samples reads its unshot radiosity.
@@ -770,29 +775,31 @@ fn sample_sources(
 }
 
 /// Where the unshot radiosity at each of `points` (on polygon `pm`) is
-/// read from: the element triangle holding it, the one whose smallest
-/// barycentric weight is largest (>= 0 inside).
+/// read from ([`point_source`]).
 fn point_sources(
     mesh: &Mesh,
     pm: &PolygonMesh,
     points: impl Iterator<Item = glam::Vec3>,
 ) -> Vec<SampleSource> {
-    points
-        .map(|p| {
-            let mut best = (f32::NEG_INFINITY, SampleSource::PolygonMean);
-            for e in pm.elements.clone() {
-                for tri in mesh.elements[e as usize].triangles() {
-                    let [a, b, c] = tri.map(|v| mesh.positions[v.index()]);
-                    let w = barycentric(p, a, b, c);
-                    let least = w[0].min(w[1]).min(w[2]);
-                    if least > best.0 {
-                        best = (least, SampleSource::Triangle(tri.map(|v| v.0), w));
-                    }
-                }
+    points.map(|p| point_source(mesh, pm, p)).collect()
+}
+
+/// Where the unshot radiosity at point `p` (on polygon `pm`) is read
+/// from: the element triangle holding it, the one whose smallest
+/// barycentric weight is largest (>= 0 inside).
+fn point_source(mesh: &Mesh, pm: &PolygonMesh, p: glam::Vec3) -> SampleSource {
+    let mut best = (f32::NEG_INFINITY, SampleSource::PolygonMean);
+    for e in pm.elements.clone() {
+        for tri in mesh.elements[e as usize].triangles() {
+            let [a, b, c] = tri.map(|v| mesh.positions[v.index()]);
+            let w = barycentric(p, a, b, c);
+            let least = w[0].min(w[1]).min(w[2]);
+            if least > best.0 {
+                best = (least, SampleSource::Triangle(tri.map(|v| v.0), w));
             }
-            best.1
-        })
-        .collect()
+        }
+    }
+    best.1
 }
 
 /// Barycentric weights of `p` (projected into the triangle's plane) in
