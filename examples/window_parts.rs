@@ -64,6 +64,7 @@ fn main() {
     let cancel = AtomicBool::new(false);
     let (mut parts, mut steps) = (Vec::new(), Vec::new());
     let mut step_so_far = 0.0;
+    let list_long = std::env::var_os("WP_LIST").is_some();
     let start = Instant::now();
     loop {
         let t = Instant::now();
@@ -71,6 +72,18 @@ fn main() {
         let took = t.elapsed().as_secs_f64();
         match event {
             Event::Step(report) => {
+                if list_long && took > 0.1 {
+                    println!(
+                        "long part: step {} part {} ({}) {took:.3} s, shooter {} of {} polygons, rays {}, receivers {}",
+                        report.step,
+                        report.part,
+                        if report.complete { "last" } else { "not last" },
+                        report.shooter.0,
+                        report.polygons,
+                        report.rays,
+                        report.receivers
+                    );
+                }
                 parts.push(took);
                 step_so_far += took;
                 if report.complete {

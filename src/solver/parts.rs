@@ -27,13 +27,14 @@ use std::ops::Range;
 use std::time::Duration;
 
 /// Receiving vertices × shooter points (samples or strata) in one chunk of
-/// whole polygons at most: about 10 ms of gathering on two cores where a
-/// pair costs what it costs on average, 75 ms where it costs most (0.3 to
-/// 2.3 µs on the 100,000-triangle sphere box). Chunks shrink from the
-/// time the earlier ones took ([`Plan::observe`]), down to
-/// [`CHUNK_WORK`] / 64; they never grow past it, as the next polygons may
-/// cost several times the last.
-pub const CHUNK_WORK: u64 = 1 << 15;
+/// whole polygons at most: about 5 ms of gathering on two cores where a
+/// pair costs what it costs on average, 40 ms where it costs most (0.3 to
+/// 2.3 µs on the 100,000-triangle sphere box, more where receivers take
+/// a part's leaves). Chunks shrink from the time the earlier ones took
+/// ([`Plan::observe`]), down to [`CHUNK_WORK`] / 64; they never grow past
+/// it, as the next polygons may cost several times the last. Twice this
+/// let a part that met the dearest polygons late run to 0.12 s.
+pub const CHUNK_WORK: u64 = 1 << 14;
 
 /// How much a chunk may grow on the last one's size: slowly, as the next
 /// polygons may cost several times the last (a tessellated sphere's
@@ -47,7 +48,7 @@ const PIECE_GROWTH: f64 = 1.5;
 /// than others, most being interpolated, but the ones near the shooter
 /// are evaluated exactly (a hall's floor under the shooting table cost
 /// 0.47 µs a pair, so a piece stays under about 60 ms).
-pub const PIECE_WORK: u64 = 4 * CHUNK_WORK;
+pub const PIECE_WORK: u64 = 8 * CHUNK_WORK;
 
 /// The solver time a chunk aims at: a part ends within about this of its
 /// budget.
