@@ -16,7 +16,8 @@
 //! the solve with exact receivers is then the reference; `CC_MODES=--o,c-o`
 //! runs the modes listed instead, the first the reference: three
 //! letters each, `c` clustering, `i` receiver interpolation, `o`
-//! overshooting, `-` off) and prints for
+//! overshooting, `-` off, optionally followed by `@THRESHOLD`, that
+//! mode's own threshold) and prints for
 //! each the steps, rays and solve seconds, and for all but the reference
 //! their difference from it: the picture's relative L1 error (mean
 //! absolute luminance difference over mean luminance, over the pixels
@@ -88,21 +89,33 @@ fn main() {
     // CC_MODES=cio,c-o,--o,...: other modes to run instead, the first the
     // reference; each three letters, `c` clustering, `i` receiver
     // interpolation, `o` overshooting, `-` for off.
-    let chosen: Vec<(bool, bool, bool, String)> = match std::env::var("CC_MODES") {
+    // A mode may end in `@THRESHOLD`, its own threshold (`---@0.00001,cio`
+    // compares the default solve with the converged brute-force one).
+    let chosen: Vec<(bool, bool, bool, Option<f64>, String)> = match std::env::var("CC_MODES") {
         Ok(list) => list
             .split(',')
             .map(|m| {
-                let on: Vec<bool> = m.chars().map(|c| c != '-').collect();
+                let (letters, threshold) = match m.split_once('@') {
+                    Some((l, t)) => match t.parse::<f64>() {
+                        Ok(t) if t > 0.0 && t < 1.0 => (l, Some(t)),
+                        _ => {
+                            eprintln!("CC_MODES: {t:?} in {m:?} is not a threshold in (0, 1)");
+                            std::process::exit(2);
+                        }
+                    },
+                    None => (m, None),
+                };
+                let on: Vec<bool> = letters.chars().map(|c| c != '-').collect();
                 if on.len() != 3 {
                     eprintln!("CC_MODES: {m:?} is not three letters such as c-o");
                     std::process::exit(2);
                 }
-                (on[0], on[1], on[2], m.to_string())
+                (on[0], on[1], on[2], threshold, m.to_string())
             })
             .collect(),
         Err(_) => modes[skip_brute as usize..]
             .iter()
-            .map(|&(c, i, o, l)| (c, i, o, l.to_string()))
+            .map(|&(c, i, o, l)| (c, i, o, None, l.to_string()))
             .collect(),
     };
     println!(
@@ -114,8 +127,11 @@ fn main() {
     println!("| solver | clusters | steps | rays | solve s | picture relL1 | vertex relL1 | worst polygon mean |");
     println!("|---|---|---|---|---|---|---|---|");
     let mut reference: Option<(Frame, Vec<Rgb>, Vec<Rgb>)> = None;
-    for (clustering, interpolation, overshoot, label) in chosen {
+    for (clustering, interpolation, overshoot, threshold, label) in chosen {
         let mut c = config.clone();
+        if let Some(t) = threshold {
+            c.solver.threshold = t;
+        }
         c.solver.clustering = clustering;
         c.solver.receiver_interpolation = interpolation;
         c.solver.overshoot = overshoot;
