@@ -15,6 +15,8 @@
 //! every step in one piece, as a batch run does). Prints the steps, the
 //! parts, the median and longest part and step, how many of each took more
 //! than 100 ms, and the whole solve's seconds.
+//! `WP_LIST=1` also lists each part over 100 ms: its step, which part of
+//! the step it was, the shooter and how many polygons shot with it.
 
 use radiosity::config::{RunConfig, SceneSource};
 use radiosity::prepare;
