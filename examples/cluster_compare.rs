@@ -11,7 +11,9 @@
 //!
 //! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
 //! absent for the program's default) and the threshold (default 0.001).
-//! `CC_SHOOTER_SAMPLES=N` makes every mode shoot from at most N cells.
+//! `CC_SHOOTER_SAMPLES=N` makes every mode shoot from at most N cells;
+//! `CC_CAMERA=FILE.sc` takes the pictures with that file's camera, as
+//! `--camera` does (for an OBJ or glTF model without one).
 //! Solves in each mode (`CC_SKIP_BRUTE=1` skips the slow reference, and
 //! the solve with exact receivers is then the reference; `CC_MODES=--o,c-o`
 //! runs the modes listed instead, the first the reference: three
@@ -47,6 +49,9 @@ fn main() {
     };
     let mut config = RunConfig::new(SceneSource::File(PathBuf::from(scene)));
     config.lenmax = args.get(1).and_then(|l| l.parse().ok());
+    // CC_CAMERA=FILE.sc: that file's camera for the pictures (`--camera`),
+    // for models that bring none.
+    config.camera = std::env::var_os("CC_CAMERA").map(PathBuf::from);
     if let Some(t) = args.get(2).and_then(|t| t.parse().ok()) {
         config.solver.threshold = t;
     }
