@@ -47,8 +47,11 @@ const PIECE_GROWTH: f64 = 1.5;
 /// Work in one piece of a large polygon at most: its vertices cost less
 /// than others, most being interpolated, but the ones near the shooter
 /// are evaluated exactly (a hall's floor under the shooting table cost
-/// 0.47 µs a pair, so a piece stays under about 60 ms).
-pub const PIECE_WORK: u64 = 8 * CHUNK_WORK;
+/// 0.47 µs a pair, so a piece stays under about 30 ms). Pieces grow
+/// while the floor's far rows are cheap; twice this let the first part
+/// of a step that then reached the rows under the shooting tables run to
+/// 0.13 s on the 150-table hall's finest mesh.
+pub const PIECE_WORK: u64 = 4 * CHUNK_WORK;
 
 /// The solver time a chunk aims at: a part ends within about this of its
 /// budget.
