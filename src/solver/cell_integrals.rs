@@ -109,10 +109,8 @@ struct Frame {
 
 impl Frame {
     fn new(normal: Vec3) -> Frame {
-        let n = normal.normalize_or_zero();
-        let other = if n.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
-        let u = n.cross(other).normalize_or_zero();
-        Frame { u, v: n.cross(u) }
+        let (u, v) = normal.normalize().any_orthonormal_pair();
+        Frame { u, v }
     }
 
     fn project(&self, p: Vec3) -> DVec2 {
