@@ -14,6 +14,10 @@
 //! `CC_SHOOTER_SAMPLES=N` makes every mode shoot from at most N cells;
 //! `CC_CAMERA=FILE.sc` takes the pictures with that file's camera, as
 //! `--camera` does (for an OBJ or glTF model without one).
+//! `CC_REFERENCE=FILE` keeps the reference's vertex radiosity in FILE:
+//! read from it when it exists and fits the mesh (the reference mode is
+//! then not solved again), written to it otherwise, so a slow converged
+//! reference is solved once for many comparisons.
 //! Solves in each mode (`CC_SKIP_BRUTE=1` skips the slow reference, and
 //! the solve with exact receivers is then the reference; `CC_MODES=--o,c-o`
 //! runs the modes listed instead, the first the reference: three
@@ -132,6 +136,7 @@ fn main() {
     println!("| solver | clusters | steps | rays | solve s | picture relL1 | vertex relL1 | worst polygon mean |");
     println!("|---|---|---|---|---|---|---|---|");
     let mut reference: Option<(Frame, Vec<Rgb>, Vec<Rgb>)> = None;
+    let cache = std::env::var_os("CC_REFERENCE").map(PathBuf::from);
     for (clustering, interpolation, overshoot, threshold, label) in chosen {
         let mut c = config.clone();
         if let Some(t) = threshold {
@@ -140,6 +145,19 @@ fn main() {
         c.solver.clustering = clustering;
         c.solver.receiver_interpolation = interpolation;
         c.solver.overshoot = overshoot;
+        let mesh = &prepared.mesh;
+        if reference.is_none() {
+            if let Some(radiosity) = cache
+                .as_deref()
+                .and_then(|f| read_cache(f, mesh.vertex_count()))
+            {
+                let frame = radiosity::render::render(mesh, &radiosity, &view).expect("renders");
+                let means = polygon_means(mesh, &radiosity);
+                println!("| {label} | | | | | (reference, from CC_REFERENCE) | | |");
+                reference = Some((frame, radiosity, means));
+                continue;
+            }
+        }
         let t = Instant::now();
         let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
         session
@@ -148,23 +166,14 @@ fn main() {
         let seconds = t.elapsed().as_secs_f64();
         let mesh = session.mesh();
         let radiosity = session.radiosity().to_vec();
+        if reference.is_none() {
+            if let Some(f) = &cache {
+                write_cache(f, &radiosity);
+            }
+        }
         let frame = radiosity::render::render(mesh, &radiosity, &view).expect("renders");
         let areas = mesh.vertex_areas();
-        let means: Vec<Rgb> = mesh
-            .polygons
-            .iter()
-            .map(|pm| {
-                let mut sum = Rgb::BLACK;
-                for l in pm.vertices.clone() {
-                    sum += radiosity[l as usize] * areas[l as usize];
-                }
-                if pm.area > 0.0 {
-                    sum / pm.area
-                } else {
-                    Rgb::BLACK
-                }
-            })
-            .collect();
+        let means = polygon_means(mesh, &radiosity);
         let solver = session.solver();
         let clusters = solver.clusters();
         let head = format!(
@@ -254,5 +263,55 @@ fn main() {
                 );
             }
         }
+    }
+}
+
+/// Every polygon's area-weighted mean radiosity.
+fn polygon_means(mesh: &radiosity::mesh::Mesh, radiosity: &[Rgb]) -> Vec<Rgb> {
+    let areas = mesh.vertex_areas();
+    mesh.polygons
+        .iter()
+        .map(|pm| {
+            let mut sum = Rgb::BLACK;
+            for l in pm.vertices.clone() {
+                sum += radiosity[l as usize] * areas[l as usize];
+            }
+            if pm.area > 0.0 {
+                sum / pm.area
+            } else {
+                Rgb::BLACK
+            }
+        })
+        .collect()
+}
+
+/// The reference radiosity kept in `file` (three little-endian `f64` per
+/// vertex), when it is there and holds `vertices` of them.
+fn read_cache(file: &std::path::Path, vertices: usize) -> Option<Vec<Rgb>> {
+    let bytes = std::fs::read(file).ok()?;
+    if bytes.len() != vertices * 24 {
+        eprintln!(
+            "CC_REFERENCE: {} does not fit this mesh; solving the reference again",
+            file.display()
+        );
+        return None;
+    }
+    let f = |k: usize| f64::from_le_bytes(bytes[k * 8..k * 8 + 8].try_into().expect("8 bytes"));
+    Some(
+        (0..vertices)
+            .map(|l| Rgb::new(f(3 * l), f(3 * l + 1), f(3 * l + 2)))
+            .collect(),
+    )
+}
+
+/// Keeps `radiosity` in `file` for [`read_cache`].
+fn write_cache(file: &std::path::Path, radiosity: &[Rgb]) {
+    let bytes: Vec<u8> = radiosity
+        .iter()
+        .flat_map(|c| [c.r, c.g, c.b])
+        .flat_map(f64::to_le_bytes)
+        .collect();
+    if let Err(e) = std::fs::write(file, bytes) {
+        eprintln!("CC_REFERENCE: cannot write {}: {e}", file.display());
     }
 }
