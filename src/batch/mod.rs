@@ -185,7 +185,8 @@ pub struct RunStats {
     /// The exposure the 8-bit picture and the exported display colours
     /// used (dimensionless): the given one, or the automatic one.
     pub exposure: f32,
-    /// True when the threshold was reached; false at the step limit, and
+    /// True when the threshold was reached and every point settled
+    /// ([`crate::solver::SolverOptions::settle`]); false at the step limit, and
     /// false when nothing emits (`nothing_emits`): then nothing was
     /// solved, and a picture that is black is no converged solution.
     pub converged: bool,

@@ -14,9 +14,12 @@ const TICKS: u64 = 1000;
 /// A progress bar drawn only when asked for and stderr is a terminal.
 /// Its position is the fraction of the way, in log scale, from the initial
 /// unshot power to the threshold; the ETA extrapolates the recent rate at
-/// which the log of the unshot power falls.
+/// which the log of the unshot power falls. Past the threshold the bar is
+/// full and says the solve is settling ([`crate::solver::SolverOptions::
+/// settle`]), which has no rate to extrapolate.
 pub struct Progress {
     bar: ProgressBar,
+    threshold: f64,
     total_log: f64,
     start: Instant,
     rate: RateEstimate,
@@ -38,6 +41,7 @@ impl Progress {
         );
         Progress {
             bar,
+            threshold,
             total_log: (1.0 / threshold.max(f64::MIN_POSITIVE)).ln(),
             start: Instant::now(),
             rate: RateEstimate::default(),
@@ -57,13 +61,20 @@ impl Progress {
         let rays_per_s = rays as f64 / elapsed.as_secs_f64().max(1e-9);
         self.bar
             .set_position(((done_log / self.total_log).clamp(0.0, 1.0) * TICKS as f64) as u64);
+        let left = if report.unshot_fraction <= self.threshold {
+            "settling".to_string()
+        } else {
+            format!(
+                "ETA {}",
+                eta.map(|d| format!("{:.0}s", d.as_secs_f64()))
+                    .unwrap_or_else(|| "?".into())
+            )
+        };
         self.bar.set_message(format!(
-            "step {} · unshot {:.3}% · {:.2} Mrays/s · ETA {}",
+            "step {} · unshot {:.3}% · {:.2} Mrays/s · {left}",
             report.step,
             report.unshot_fraction * 100.0,
             rays_per_s / 1e6,
-            eta.map(|d| format!("{:.0}s", d.as_secs_f64()))
-                .unwrap_or_else(|| "?".into())
         ));
     }
 

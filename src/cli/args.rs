@@ -15,7 +15,9 @@ use crate::mesh::refine;
 use crate::mesh::DEFAULT_INSET;
 use crate::render::antialias;
 use crate::solver::hemicube::HemicubeRes;
-use crate::solver::{FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_THRESHOLD};
+use crate::solver::{
+    FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_SETTLE, DEFAULT_THRESHOLD,
+};
 use std::path::PathBuf;
 
 /// The exit codes, shown after both the short and the long help.
@@ -65,6 +67,16 @@ pub struct Args {
     /// power.
     #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD)]
     pub(crate) threshold: f64,
+
+    /// Past the threshold, go on until every point has settled.
+    ///
+    /// A point has settled when it holds less than this fraction of its
+    /// radiosity still to send. Light trapped in a pocket (a gap under a
+    /// lamp, a sphere's underside over the floor) is a small share of the
+    /// scene's power but most of the pocket's own; the threshold alone
+    /// would leave such places too dark. 0 stops at the threshold alone.
+    #[arg(long, value_name = "F", default_value_t = DEFAULT_SETTLE)]
+    pub(crate) settle: f64,
 
     /// Stop after this many shooting steps at most.
     #[arg(long, value_name = "N")]

@@ -63,6 +63,9 @@ pub enum UsageError {
     /// `--threshold` is outside `[0, 1]`.
     #[error("--threshold must be between 0 and 1, got {0}")]
     Threshold(f64),
+    /// `--settle` is outside `[0, 1)`.
+    #[error("--settle must be at least 0 and below 1, got {0}")]
+    Settle(f64),
     /// `--lenmax` or `--inset` is refused by the mesh; its messages start
     /// with the option's name (`lenmax`, `inset`), spelled as the flag is.
     #[error("--{0}")]
@@ -149,6 +152,9 @@ impl TryFrom<Args> for Invocation {
         if !(0.0..=1.0).contains(&args.threshold) {
             return Err(UsageError::Threshold(args.threshold));
         }
+        if !(0.0..1.0).contains(&args.settle) {
+            return Err(UsageError::Settle(args.settle));
+        }
         let lenmax = args.lenmax.map(mesh::check_lenmax).transpose()?;
         let inset = mesh::check_inset(args.inset)?;
         if args.max_elements == 0 || args.max_elements > mesh::MAX_ADDRESSABLE_ELEMENTS {
@@ -205,6 +211,7 @@ impl TryFrom<Args> for Invocation {
                 form_factor: args.form_factor,
                 shooter_samples: args.shooter_samples,
                 threshold: args.threshold,
+                settle: args.settle,
                 max_steps: args.max_steps,
                 near_field: !args.no_near_field,
                 shaft_culling: !args.no_shaft_culling,
@@ -325,6 +332,8 @@ mod tests {
             "0",
             "--threshold",
             "0.01",
+            "--settle",
+            "0.05",
             "--max-steps",
             "7",
             "--shooter-samples",
@@ -372,6 +381,7 @@ mod tests {
                 form_factor: FormFactorMethod::Wallace,
                 shooter_samples: ShooterSamples::All,
                 threshold: 0.01,
+                settle: 0.05,
                 max_steps: Some(7),
                 near_field: false,
                 shaft_culling: false,
@@ -478,6 +488,11 @@ mod tests {
                 &["--threshold", "2"],
                 UsageError::Threshold(2.0),
                 "--threshold must be between 0 and 1, got 2",
+            ),
+            (
+                &["--settle", "1"],
+                UsageError::Settle(1.0),
+                "--settle must be at least 0 and below 1, got 1",
             ),
             (
                 &["--lenmax", "0"],

@@ -343,6 +343,55 @@ impl UnshotField {
         }
     }
 
+    /// The part of [`UnshotField::sent_power`] from points that have not
+    /// settled: whose sent radiosity (channel mean) exceeds `tolerance`
+    /// times their radiosity `b` (at least `floor`), in radiosity × area
+    /// units.
+    pub(crate) fn unsettled_power(
+        &self,
+        mesh: &Mesh,
+        j: usize,
+        shot: Shot,
+        radiosity: &[Rgb],
+        tolerance: f64,
+        floor: f64,
+    ) -> f64 {
+        let pm = &mesh.polygons[j];
+        match &self.layout {
+            Layout::Polygon { mean_weight } => {
+                let b = polygon_received(pm, mean_weight, |l| radiosity[l]);
+                let part = shot.at(b - shot.emission);
+                let sent = part.sent(self.values[j]).mean();
+                if sent > tolerance * b.mean().max(floor) {
+                    sent * pm.area
+                } else {
+                    0.0
+                }
+            }
+            Layout::Vertex {
+                vertex_area,
+                covered,
+                ..
+            } => {
+                let mut sum = 0.0;
+                for l in pm.vertices.clone() {
+                    let l = l as usize;
+                    if covered.get(l).copied().unwrap_or(false) {
+                        continue;
+                    }
+                    let sent = shot
+                        .at(radiosity[l] - shot.emission)
+                        .sent(self.values[l])
+                        .mean();
+                    if sent > tolerance * radiosity[l].mean().max(floor) {
+                        sum += sent * vertex_area[l];
+                    }
+                }
+                sum
+            }
+        }
+    }
+
     /// Writes into `out` (cleared first) the radiosity each of shooter
     /// `i`'s `samples` samples sends in a step that sends `shot`
     /// ([`Shot`], `>= 0`; `radiosity` as for [`UnshotField::sent_power`]):
