@@ -2,8 +2,11 @@
 //! two slabs in a lit room) is a small share of the scene's power, so
 //! the threshold alone stops before the pocket has traded its light back
 //! and forth, and leaves it dark. Settling must bring it to the converged
-//! solution of the same mesh.
+//! solution of the same mesh, and stay deterministic: a solve saved while
+//! it settles resumes to the same bits, and one thread or two give the
+//! same bits.
 
+use super::tests::{on_threads, same_bits};
 use super::*;
 use crate::testutil::{closed_box, cuboid, grey, mean_radiosity, polygon, regular_mesh, scene};
 
@@ -115,5 +118,53 @@ fn settling_converges_a_pocket() {
             underside0 > 0.03,
             "clustering {clustering}: the threshold alone already gives {underside0}"
         );
+    }
+}
+
+/// A solve saved while it settles ([`Progressive::state`], as a
+/// checkpoint does) and restored into a fresh solver ends on the same
+/// bits, in the same steps, as the solve left alone: settling reads
+/// nothing but the saved state.
+#[test]
+fn a_solve_saved_while_settling_resumes_to_the_same_bits() {
+    let s = pocket_room(0.001);
+    let mesh = regular_mesh(&s, 0.05);
+    let vis = Visibility::new(&s);
+    let options = SolverOptions::default();
+    let run_to_end = |solver: &mut Progressive| {
+        while !solver.is_done() && solver.step().is_some() {}
+    };
+    let mut whole = Progressive::new(&s, &mesh, &vis, options);
+    run_to_end(&mut whole);
+
+    let mut first = Progressive::new(&s, &mesh, &vis, options);
+    while first.unshot_fraction() > options.threshold {
+        first.step().expect("light left to shoot");
+    }
+    // Two steps into settling.
+    for _ in 0..2 {
+        assert!(!first.is_done(), "the pocket settles in fewer steps");
+        first.step().expect("a settling step");
+    }
+    let mut resumed = Progressive::new(&s, &mesh, &vis, options);
+    resumed.restore(first.state()).unwrap();
+    run_to_end(&mut resumed);
+
+    assert_eq!(resumed.steps(), whole.steps());
+    assert!(same_bits(resumed.radiosity(), whole.radiosity()));
+}
+
+/// The settled solve of the pocket on one thread and on two gives the
+/// same bits, in both modes.
+#[test]
+fn settling_gives_the_same_bits_on_one_thread_and_two() {
+    let s = pocket_room(0.001);
+    for clustering in [true, false] {
+        let [one, two] = [1, 2].map(|threads| {
+            on_threads(threads, || {
+                solve(&s, DEFAULT_THRESHOLD, DEFAULT_SETTLE, clustering).1
+            })
+        });
+        assert!(same_bits(&one, &two), "clustering {clustering}");
     }
 }
