@@ -94,7 +94,7 @@ use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
 use crate::scene::{PolygonId, Scene};
-use crate::visibility::Visibility;
+use crate::visibility::{LastBlocker, Visibility};
 use cluster::{Cell, Clusters, Seen, Strata};
 use facets::{Facets, Scratch};
 use far_shooters::FarShooter;
@@ -1748,6 +1748,7 @@ impl<'a> Progressive<'a> {
             let mut rays = 0u64;
             let memo = &mut scratch.memo;
             let nx = mesh.polygons[j.index()].normal;
+            let mut last = LastBlocker::default();
             // Whether sample `k` at `s` is hidden from this vertex.
             let mut ray = |k: usize, s: glam::Vec3| -> bool {
                 // A ray from elsewhere than the sample (the part of a near
@@ -1755,7 +1756,7 @@ impl<'a> Progressive<'a> {
                 // outside the shafts, which were built from the samples.
                 if s != samples[k].position {
                     rays += 1;
-                    return visibility.occluded(s, x, (shooter, j));
+                    return visibility.occluded_remembering(s, x, (shooter, j), &mut last);
                 }
                 // A small facet's vertices share one ray per sample.
                 if let Some((hit, cast)) = facets.shared_ray(
@@ -1774,16 +1775,16 @@ impl<'a> Progressive<'a> {
                     .map_or(&[][..], |c| &c[..]);
                 if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX {
                     rays += 1;
-                    visibility.occluded(s, x, (shooter, j))
+                    visibility.occluded_remembering(s, x, (shooter, j), &mut last)
                 } else if blockers.is_empty() {
                     // Nothing in the shaft: visible, no ray needed.
                     false
                 } else if blockers.len() <= LINEAR_CANDIDATES {
                     rays += 1;
-                    visibility.occluded_among(s, x, blockers)
+                    visibility.occluded_among_remembering(s, x, blockers, &mut last)
                 } else {
                     rays += 1;
-                    visibility.occluded(s, x, (shooter, j))
+                    visibility.occluded_remembering(s, x, (shooter, j), &mut last)
                 }
             };
             // A sky facet's probes, when they agree, stand for all its
@@ -2095,6 +2096,7 @@ impl<'a> Progressive<'a> {
                 stack.reverse();
             }
             let whole = &candidates[j.index()];
+            let mut last = LastBlocker::default();
             while let Some((n, si)) = stack.pop() {
                 // Rays from a node in or below the cut are culled by
                 // its group's thin shaft; from above, by the receiver's
@@ -2117,12 +2119,14 @@ impl<'a> Progressive<'a> {
                 let mut blocked = |from: glam::Vec3, own: PolygonId, exact_r2: f32, slot: u32| {
                     if slot == OWN_RAY_SLOT {
                         rays += 1;
-                        return visibility.occluded(from, x, (own, j));
+                        return visibility.occluded_remembering(from, x, (own, j), &mut last);
                     }
                     let key = n * RAY_SLOTS + slot;
                     let (hit, cast) = facets
                         .shared_ray(memo, visibility, (own, j), key, from, exact_r2)
-                        .unwrap_or_else(|| ray_blocked(visibility, blockers, from, x, (own, j)));
+                        .unwrap_or_else(|| {
+                            ray_blocked(visibility, blockers, from, x, (own, j), &mut last)
+                        });
                     rays += cast;
                     hit
                 };
@@ -2841,13 +2845,15 @@ fn ray_blocked(
     from: glam::Vec3,
     x: glam::Vec3,
     ends: (PolygonId, PolygonId),
+    last: &mut LastBlocker,
 ) -> (bool, u64) {
     match blockers {
         Some([]) => (false, 0),
-        Some(b) if b.len() <= LINEAR_CANDIDATES => {
-            (visibility.occluded_among_ends(from, x, b, ends), 1)
-        }
-        _ => (visibility.occluded(from, x, ends), 1),
+        Some(b) if b.len() <= LINEAR_CANDIDATES => (
+            visibility.occluded_among_ends_remembering(from, x, b, ends, last),
+            1,
+        ),
+        _ => (visibility.occluded_remembering(from, x, ends, last), 1),
     }
 }
 

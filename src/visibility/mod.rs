@@ -61,6 +61,16 @@ pub const PLANE_SIDE_TOLERANCE: f64 = 1e-9;
 /// (see [`Visibility::refine_candidates_in_runs`]).
 pub type CandidateRun = (std::ops::Range<u32>, (DVec3, DVec3));
 
+/// The polygon that last blocked one of a receiver's segments, which the
+/// next query tries before any other (the shadow cache of Haines and
+/// Greenberg's light buffer): the rays from one point to the samples of
+/// a shooter mostly end on the same table top or chair back, and one
+/// polygon test then stands for a traversal of the whole scene. Keep one
+/// per receiving point; it only changes how fast an answer is found,
+/// never the answer.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LastBlocker(Option<u32>);
+
 /// A polygon prepared for ray tests.
 struct Blocker {
     /// First vertex (a point of the plane).
@@ -385,14 +395,36 @@ impl Visibility {
     /// segment from `a` to `b`: [`Visibility::occluded`] restricted to a
     /// list from [`Visibility::shaft_candidates`], testing each in turn.
     pub fn occluded_among(&self, a: Vec3, b: Vec3, candidates: &[u32]) -> bool {
+        self.occluded_among_remembering(a, b, candidates, &mut LastBlocker::default())
+    }
+
+    /// [`Visibility::occluded_among`], trying `last` first and keeping in
+    /// it the blocker found; `last` must only ever name blockers of
+    /// segments between the same two polygons, so that the answer is the
+    /// same.
+    pub fn occluded_among_remembering(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        candidates: &[u32],
+        last: &mut LastBlocker,
+    ) -> bool {
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        candidates.iter().any(|&p| {
+        let hits = |p: u32| {
             self.blockers
                 .get(p as usize)
                 .is_some_and(|blocker| blocker.intersect(&ray).is_finite())
-        })
+        };
+        if last.0.is_some_and(hits) {
+            return true;
+        }
+        let found = candidates.iter().copied().find(|&p| hits(p));
+        if found.is_some() {
+            last.0 = found;
+        }
+        found.is_some()
     }
 
     /// [`Visibility::occluded_among`] leaving out `ends` and the polygons
@@ -406,16 +438,37 @@ impl Visibility {
         candidates: &[u32],
         ends: (PolygonId, PolygonId),
     ) -> bool {
+        self.occluded_among_ends_remembering(a, b, candidates, ends, &mut LastBlocker::default())
+    }
+
+    /// [`Visibility::occluded_among_ends`], trying `last` first and
+    /// keeping in it the blocker found. The answer is the same, as the
+    /// candidates hold every polygon that can block such a segment.
+    pub fn occluded_among_ends_remembering(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        candidates: &[u32],
+        ends: (PolygonId, PolygonId),
+        last: &mut LastBlocker,
+    ) -> bool {
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        candidates.iter().any(|&p| {
+        if self.last_blocks(last, &ray, ends) {
+            return true;
+        }
+        let found = candidates.iter().copied().find(|&p| {
             !self.in_plane_of(p, ends)
                 && self
                     .blockers
                     .get(p as usize)
                     .is_some_and(|blocker| blocker.intersect(&ray).is_finite())
-        })
+        });
+        if found.is_some() {
+            last.0 = found;
+        }
+        found.is_some()
     }
 
     /// True when polygon `p` lies in the plane of one of `ends` (or is
@@ -451,19 +504,56 @@ impl Visibility {
     /// open segment from `a` to `b` (ignoring hits within
     /// [`SEGMENT_END_EPSILON`] of either end).
     pub fn occluded(&self, a: Vec3, b: Vec3, ends: (PolygonId, PolygonId)) -> bool {
+        self.occluded_remembering(a, b, ends, &mut LastBlocker::default())
+    }
+
+    /// [`Visibility::occluded`], trying `last` first and keeping in it the
+    /// blocker found. The answer is the same: a blocker `last` names that
+    /// crosses the segment is one the traversal would find.
+    pub fn occluded_remembering(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        ends: (PolygonId, PolygonId),
+        last: &mut LastBlocker,
+    ) -> bool {
         let Some(bvh) = &self.bvh else {
             return false;
         };
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        !bvh.ray_traverse_miss(ray, |ray, id| {
+        if self.last_blocks(last, &ray, ends) {
+            return true;
+        }
+        let mut found = None;
+        let missed = bvh.ray_traverse_miss(ray, |ray, id| {
             let p = bvh.primitive_indices[id];
             if self.in_plane_of(p, ends) {
-                f32::INFINITY
-            } else {
-                self.blockers[p as usize].intersect(ray)
+                return f32::INFINITY;
             }
+            let t = self.blockers[p as usize].intersect(ray);
+            if t.is_finite() {
+                found = Some(p);
+            }
+            t
+        });
+        if !missed {
+            last.0 = found;
+        }
+        !missed
+    }
+
+    /// Whether the blocker `last` names (if any) crosses `ray` and may
+    /// block a segment joining `ends`.
+    #[inline]
+    fn last_blocks(&self, last: &LastBlocker, ray: &Ray, ends: (PolygonId, PolygonId)) -> bool {
+        last.0.is_some_and(|p| {
+            !self.in_plane_of(p, ends)
+                && self
+                    .blockers
+                    .get(p as usize)
+                    .is_some_and(|blocker| blocker.intersect(ray).is_finite())
         })
     }
 
