@@ -678,6 +678,11 @@ pub struct Progressive<'a> {
     /// Per polygon: its regular grid, whose vertices between coarse rows
     /// and columns a cluster step may interpolate ([`receivers`]).
     coarse: Vec<Option<CoarseGrid>>,
+    /// Per mesh vertex, true where it is the first corner of a receiving
+    /// grid's cell that another polygon crowds, which is never
+    /// interpolated ([`receivers::crowded_cells`]); empty without
+    /// receiver interpolation.
+    crowded: Vec<bool>,
     /// Per vertex: scratch, a cluster step's `Δrad` at the vertices
     /// evaluated exactly, read while the others are interpolated.
     coarse_delta: Vec<Rgb>,
@@ -791,6 +796,18 @@ impl<'a> Progressive<'a> {
         // Shared facet rays and sky probes go with the other receiver
         // approximations.
         let approximate = clustered && options.receiver_interpolation;
+        let coarse: Vec<Option<CoarseGrid>> = mesh
+            .polygons
+            .iter()
+            .map(|pm| CoarseGrid::detect(mesh, pm))
+            .collect();
+        let crowded = if approximate {
+            receivers::crowded_cells(mesh, &coarse, |j, corners, normal, depth| {
+                visibility.crowds(PolygonId(j as u32), &corners, normal, depth)
+            })
+        } else {
+            Vec::new()
+        };
         let sky_probes = mesh
             .polygons
             .iter()
@@ -848,11 +865,8 @@ impl<'a> Progressive<'a> {
             cell_part_values: Vec::new(),
             cell_leaf_values: Vec::new(),
             strata: Strata::default(),
-            coarse: mesh
-                .polygons
-                .iter()
-                .map(|pm| CoarseGrid::detect(mesh, pm))
-                .collect(),
+            coarse,
+            crowded,
             coarse_delta: vec![Rgb::BLACK; mesh.vertex_count()],
             facets: Facets::new(mesh, approximate),
             probes: sky_probes,
@@ -1854,6 +1868,7 @@ impl<'a> Progressive<'a> {
                 && self.options.receiver_interpolation
                 && self.emission[i].is_black(),
             coarse: &self.coarse,
+            crowded: &self.crowded,
             clusters: &self.clusters,
             receives,
             cluster: self.clusters.of(shooter),
@@ -2332,6 +2347,7 @@ impl<'a> Progressive<'a> {
         let cells = Interpolating {
             on: self.options.receiver_interpolation,
             coarse: &self.coarse,
+            crowded: &self.crowded,
             clusters,
             receives,
             cluster,
@@ -2623,6 +2639,9 @@ struct Interpolating<'s> {
     /// False when the step evaluates every vertex exactly.
     on: bool,
     coarse: &'s [Option<CoarseGrid>],
+    /// Per mesh vertex, whether the cell it is the first corner of is
+    /// crowded (empty: none is).
+    crowded: &'s [bool],
     clusters: &'s Clusters,
     receives: &'s [bool],
     /// The shooting cluster.
@@ -2661,6 +2680,9 @@ impl Interpolating<'_> {
 
     /// `cell`, unless it is too near the shooter ([`receivers::far_from`]).
     fn usable(&self, cell: receivers::Interpolation) -> Option<receivers::Interpolation> {
+        if self.crowded.get(cell.corners[0] as usize) == Some(&true) {
+            return None;
+        }
         let corners = cell.corners.map(|c| self.positions[c as usize]);
         receivers::far_from(corners, self.shooter).then_some(cell)
     }
@@ -2994,6 +3016,8 @@ fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
         .collect()
 }
 
+#[cfg(test)]
+mod crowded_tests;
 #[cfg(test)]
 mod emitter_order_tests;
 #[cfg(test)]

@@ -391,6 +391,63 @@ impl Visibility {
         a_lo.min(b_lo) < -eps && a_hi.max(b_hi) > eps
     }
 
+    /// True when some polygon other than `own`, and not in its plane,
+    /// reaches into the box bounding the points `corners` and those
+    /// points moved `depth` scene units along the unit `normal`, and has
+    /// some vertex in front of `own`'s plane there (by the boxes of the
+    /// polygons, so a slanted polygon near the box may count).
+    pub fn crowds(&self, own: PolygonId, corners: &[Vec3], normal: Vec3, depth: f32) -> bool {
+        let Some(regions) = &self.regions else {
+            return false;
+        };
+        let n = normal.as_dvec3();
+        let Some(&first) = corners.first() else {
+            return false;
+        };
+        let (lo, hi) = corners
+            .iter()
+            .flat_map(|c| [c.as_dvec3(), c.as_dvec3() + n * f64::from(depth)])
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        let tol = self.shaft_tolerance;
+        let (lo, hi) = (lo - DVec3::splat(tol), hi + DVec3::splat(tol));
+        let d = n.dot(first.as_dvec3());
+        let overlaps = |a: DVec3, b: DVec3| a.cmple(hi).all() && b.cmpge(lo).all();
+        let mut stack: Vec<u32> = vec![0];
+        while let Some(k) = stack.pop() {
+            let Some(node) = regions.nodes.get(k as usize) else {
+                continue;
+            };
+            if !overlaps(node.aabb.min.as_dvec3(), node.aabb.max.as_dvec3()) {
+                continue;
+            }
+            if node.prim_count == 0 {
+                stack.push(node.first_index);
+                stack.push(node.first_index + 1);
+                continue;
+            }
+            let first = node.first_index as usize;
+            for &p in regions
+                .primitive_indices
+                .get(first..first + node.prim_count as usize)
+                .unwrap_or(&[])
+            {
+                let b = &self.blockers[p as usize];
+                if p == own.0
+                    || self.coplanar(own, PolygonId(p))
+                    || !overlaps(b.exact_bounds.0, b.exact_bounds.1)
+                {
+                    continue;
+                }
+                if b.vertices.iter().any(|v| n.dot(*v) - d > tol) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
     /// True when one of the `candidates` (polygon indices) crosses the open
     /// segment from `a` to `b`: [`Visibility::occluded`] restricted to a
     /// list from [`Visibility::shaft_candidates`], testing each in turn.
@@ -647,6 +704,66 @@ mod tests {
 
     fn scene(polygons: Vec<Polygon>) -> Scene {
         testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
+    }
+
+    /// A polygon of four `corners` with unit `normal`.
+    fn quad(corners: [[f32; 3]; 4], normal: Vec3) -> Polygon {
+        let mut p = square(0.0, 1.0, (0.0, 0.0));
+        p.vertices = corners.iter().map(|&c| Vec3::from(c)).collect();
+        p.normal = normal;
+        p
+    }
+
+    #[test]
+    fn crowds_sees_what_reaches_in_front_of_a_cell() {
+        let s = scene(vec![
+            // 0: the floor, facing +z.
+            square(0.0, 8.0, (0.0, 0.0)),
+            // 1: a lamp 0.05 over it at (1, 1).
+            square(0.05, 0.2, (0.9, 0.9)),
+            // 2: a square 0.1 under it at (3, 3).
+            square(-0.1, 0.5, (2.9, 2.9)),
+            // 3: a square far over it at (5, 5).
+            square(4.0, 0.5, (4.9, 4.9)),
+            // 4: a leg standing on it at x = 7, y 1 to 1.2.
+            quad(
+                [
+                    [7.0, 1.0, 0.0],
+                    [7.0, 1.2, 0.0],
+                    [7.0, 1.2, 0.5],
+                    [7.0, 1.0, 0.5],
+                ],
+                Vec3::X,
+            ),
+            // 5: a square in the floor's plane beyond it.
+            square(0.0, 1.0, (9.0, 9.0)),
+        ]);
+        let v = Visibility::new(&s);
+        let cell = |x: f32, y: f32| {
+            [
+                Vec3::new(x - 0.5, y - 0.5, 0.0),
+                Vec3::new(x + 0.5, y - 0.5, 0.0),
+                Vec3::new(x + 0.5, y + 0.5, 0.0),
+                Vec3::new(x - 0.5, y + 0.5, 0.0),
+            ]
+        };
+        let floor = PolygonId(0);
+        assert!(v.crowds(floor, &cell(1.0, 1.0), Vec3::Z, 0.3), "the lamp");
+        assert!(
+            !v.crowds(floor, &cell(1.0, 1.0), Vec3::Z, 0.01),
+            "too shallow"
+        );
+        assert!(!v.crowds(floor, &cell(3.0, 3.0), Vec3::Z, 0.3), "behind");
+        assert!(!v.crowds(floor, &cell(5.0, 5.0), Vec3::Z, 0.3), "far");
+        assert!(v.crowds(floor, &cell(7.0, 1.0), Vec3::Z, 0.3), "the leg");
+        assert!(!v.crowds(floor, &cell(8.9, 8.9), Vec3::Z, 0.3), "coplanar");
+        // Seen from the lamp's own cell, facing down onto the floor.
+        assert!(v.crowds(
+            PolygonId(1),
+            &cell(1.0, 1.0).map(|c| c + Vec3::Z * 0.05),
+            -Vec3::Z,
+            0.3
+        ));
     }
 
     #[test]
