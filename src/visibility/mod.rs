@@ -23,6 +23,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::Ray;
 use obvhs::{Boundable, BvhBuildParams};
 use shaft::Shaft;
+use std::ops::ControlFlow;
 use std::time::Duration;
 
 /// Hits closer to either end of a segment than this fraction of its length
@@ -266,36 +267,25 @@ impl Visibility {
         out: &mut Vec<u32>,
         keep: impl Fn(u32, &Blocker) -> bool,
     ) {
-        let mut stack: Vec<u32> = vec![0];
-        while let Some(n) = stack.pop() {
-            let Some(node) = regions.nodes.get(n as usize) else {
-                continue;
-            };
-            if !shaft.may_overlap_box(node.aabb.min.as_dvec3(), node.aabb.max.as_dvec3()) {
-                continue;
-            }
-            if node.prim_count == 0 {
-                stack.push(node.first_index);
-                stack.push(node.first_index + 1);
-                continue;
-            }
-            let first = node.first_index as usize;
-            for &p in regions
-                .primitive_indices
-                .get(first..first + node.prim_count as usize)
-                .unwrap_or(&[])
-            {
-                if keep(p, &self.blockers[p as usize]) {
+        let full = self.visit_regions(
+            regions,
+            |lo, hi| shaft.may_overlap_box(lo, hi),
+            |p, blocker| {
+                if keep(p, blocker) {
                     out.push(p);
                     if out.len() > limit {
                         out.sort_unstable();
                         out.dedup();
                         if out.len() > limit {
-                            return;
+                            return ControlFlow::Break(());
                         }
                     }
                 }
-            }
+                ControlFlow::Continue(())
+            },
+        );
+        if full.is_break() {
+            return;
         }
         out.sort_unstable();
         out.dedup();
@@ -414,12 +404,35 @@ impl Visibility {
         let (lo, hi) = (lo - DVec3::splat(tol), hi + DVec3::splat(tol));
         let d = n.dot(first.as_dvec3());
         let overlaps = |a: DVec3, b: DVec3| a.cmple(hi).all() && b.cmpge(lo).all();
+        self.visit_regions(regions, overlaps, |p, b| {
+            let reaches = p != own.0
+                && !self.coplanar(own, PolygonId(p))
+                && overlaps(b.exact_bounds.0, b.exact_bounds.1)
+                && b.vertices.iter().any(|v| n.dot(*v) - d > tol);
+            if reaches {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .is_break()
+    }
+
+    /// Visits the polygons in the leaves of `regions` whose boxes
+    /// `node_overlaps(min, max)` accepts (and their ancestors'), until
+    /// `visit` breaks; returns whether it did.
+    fn visit_regions(
+        &self,
+        regions: &Bvh2,
+        node_overlaps: impl Fn(DVec3, DVec3) -> bool,
+        mut visit: impl FnMut(u32, &Blocker) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
         let mut stack: Vec<u32> = vec![0];
         while let Some(k) = stack.pop() {
             let Some(node) = regions.nodes.get(k as usize) else {
                 continue;
             };
-            if !overlaps(node.aabb.min.as_dvec3(), node.aabb.max.as_dvec3()) {
+            if !node_overlaps(node.aabb.min.as_dvec3(), node.aabb.max.as_dvec3()) {
                 continue;
             }
             if node.prim_count == 0 {
@@ -433,19 +446,10 @@ impl Visibility {
                 .get(first..first + node.prim_count as usize)
                 .unwrap_or(&[])
             {
-                let b = &self.blockers[p as usize];
-                if p == own.0
-                    || self.coplanar(own, PolygonId(p))
-                    || !overlaps(b.exact_bounds.0, b.exact_bounds.1)
-                {
-                    continue;
-                }
-                if b.vertices.iter().any(|v| n.dot(*v) - d > tol) {
-                    return true;
-                }
+                visit(p, &self.blockers[p as usize])?;
             }
         }
-        false
+        ControlFlow::Continue(())
     }
 
     /// True when one of the `candidates` (polygon indices) crosses the open
