@@ -48,10 +48,13 @@ const PIECE_GROWTH: f64 = 1.5;
 /// than others, most being interpolated, but the ones near the shooter
 /// are evaluated exactly (a hall's floor under the shooting table cost
 /// 0.47 µs a pair, so a piece stays under about 30 ms). Pieces grow
-/// while the floor's far rows are cheap; twice this let the first part
-/// of a step that then reached the rows under the shooting tables run to
-/// 0.13 s on the 150-table hall's finest mesh.
-pub const PIECE_WORK: u64 = 4 * CHUNK_WORK;
+/// while the floor's far rows are cheap; four times this let the first
+/// part of a step that then reached the rows under the shooting tables
+/// run to 0.13 s on the 150-table hall's finest mesh, and twice this,
+/// once the floor's cells round chair legs were exact in every step
+/// ([`super::receivers::CROWD_RATIO`]), let a piece of the 150-table
+/// hall's floor that reached them run to 0.12 s.
+pub const PIECE_WORK: u64 = 2 * CHUNK_WORK;
 
 /// The solver time a chunk aims at: a part ends within about this of its
 /// budget.
