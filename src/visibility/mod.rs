@@ -267,7 +267,8 @@ impl Visibility {
         out: &mut Vec<u32>,
         keep: impl Fn(u32, &Blocker) -> bool,
     ) {
-        let full = self.visit_regions(
+        // Stopped past the limit: the list is already sorted and deduped.
+        let stopped = self.visit_regions(
             regions,
             |lo, hi| shaft.may_overlap_box(lo, hi),
             |p, blocker| {
@@ -284,11 +285,10 @@ impl Visibility {
                 ControlFlow::Continue(())
             },
         );
-        if full.is_break() {
-            return;
+        if stopped.is_continue() {
+            out.sort_unstable();
+            out.dedup();
         }
-        out.sort_unstable();
-        out.dedup();
     }
 
     /// True unless all `points` lie in one closed half-space of
