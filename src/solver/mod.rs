@@ -3027,6 +3027,8 @@ mod overshoot_tests;
 #[cfg(test)]
 mod parts_tests;
 #[cfg(test)]
+mod resting_tests;
+#[cfg(test)]
 mod settle_tests;
 #[cfg(test)]
 mod sky_tests;
