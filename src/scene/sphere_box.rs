@@ -89,35 +89,46 @@ pub fn sphere_box_sc(n: usize) -> String {
     // Where the blocks stood: a larger sphere at the back left, a smaller
     // one at the front right, both resting on the floor.
     for (centre, radius) in [([370.0, 120.0, 350.0], 120.0), ([180.0, 90.0, 180.0], 90.0)] {
-        let at = |ring: usize, seg: usize| -> [f64; 3] {
-            let theta = PI * ring as f64 / (n / 2) as f64;
-            let phi = 2.0 * PI * seg as f64 / n as f64;
-            [
-                centre[0] + radius * theta.sin() * phi.cos(),
-                centre[1] + radius * theta.cos(),
-                centre[2] + radius * theta.sin() * phi.sin(),
-            ]
-        };
-        let rings = n / 2;
-        for ring in 0..rings {
-            for seg in 0..n {
-                let (a, b) = (at(ring, seg), at(ring, seg + 1));
-                let (c, d) = (at(ring + 1, seg + 1), at(ring + 1, seg));
-                // The poles' rings are fans of one triangle a segment.
-                let triangles: &[[[f64; 3]; 3]] = if ring == 0 {
-                    &[[a, c, d]]
-                } else if ring == rings - 1 {
-                    &[[a, b, d]]
-                } else {
-                    &[[a, b, d], [b, c, d]]
-                };
-                for &t in triangles {
-                    polygon(&mut s, "ball", &outward(t, centre));
-                }
-            }
+        for t in uv_sphere(centre, radius, n) {
+            polygon(&mut s, "ball", &t);
         }
     }
     s
+}
+
+/// The triangles of a UV sphere about `centre` of `radius` (scene units)
+/// with `n` segments around and `n / 2` rings (`n` even, at least 4),
+/// every facet a triangle as exporters write them: a fan of one triangle
+/// a segment at each pole, two a segment between; each counter-clockwise
+/// seen from outside, so its front normal points out. `n (n − 2)`
+/// triangles, ring by ring from the +y pole.
+pub fn uv_sphere(centre: [f64; 3], radius: f64, n: usize) -> Vec<[[f64; 3]; 3]> {
+    let at = |ring: usize, seg: usize| -> [f64; 3] {
+        let theta = PI * ring as f64 / (n / 2) as f64;
+        let phi = 2.0 * PI * seg as f64 / n as f64;
+        [
+            centre[0] + radius * theta.sin() * phi.cos(),
+            centre[1] + radius * theta.cos(),
+            centre[2] + radius * theta.sin() * phi.sin(),
+        ]
+    };
+    let rings = n / 2;
+    let mut out = Vec::with_capacity(n * n.saturating_sub(2));
+    for ring in 0..rings {
+        for seg in 0..n {
+            let (a, b) = (at(ring, seg), at(ring, seg + 1));
+            let (c, d) = (at(ring + 1, seg + 1), at(ring + 1, seg));
+            let triangles: &[[[f64; 3]; 3]] = if ring == 0 {
+                &[[a, c, d]]
+            } else if ring == rings - 1 {
+                &[[a, b, d]]
+            } else {
+                &[[a, b, d], [b, c, d]]
+            };
+            out.extend(triangles.iter().map(|&t| outward(t, centre)));
+        }
+    }
+    out
 }
 
 /// The triangle `t` ordered counter-clockwise seen from outside a sphere
