@@ -96,7 +96,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 /// The name of the material of primitives that name none, with the
-/// reflectance [`DEFAULT_REFLECTANCE`] of faces without a material in OBJ
+/// reflectance [`super::obj::DEFAULT_REFLECTANCE`] of faces without a material in OBJ
 /// files (Blender's default base colour) rather than glTF's white, which
 /// would reflect everything.
 pub const DEFAULT_MATERIAL_NAME: &str = "(no material)";

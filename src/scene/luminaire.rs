@@ -110,7 +110,7 @@ impl Scene {
 
     /// Gives every luminaire polygon's back side its light: the upper
     /// half of the distribution when the file sends light upwards (above
-    /// [`MIN_UPWARD_FRACTION`]), emitted by a material of its own of
+    /// `MIN_UPWARD_FRACTION`), emitted by a material of its own of
     /// exitance `front exitance × upward / downward flux` (the same area),
     /// with a [`Luminaire`] marked [`Luminaire::upper`]; else a black
     /// material (a luminaire without uplight emits from its front only).

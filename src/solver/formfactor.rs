@@ -223,7 +223,7 @@ pub enum SampleSet {
     /// A sky facet's samples ([`SKY_FACET_SAMPLES`]): a regular grid of
     /// about this many cells whatever its element vertices, each sampled
     /// at a pseudo-random point inside it (the same on every run), always
-    /// with the far-field point term (see [`sky_samples`]).
+    /// with the far-field point term (see `sky_samples`).
     Sky(u32),
 }
 

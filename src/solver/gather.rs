@@ -13,10 +13,10 @@
 //! values over it) and `F` the form factor from a differential area at `x`
 //! to the element, with the visibility of one ray from the element's
 //! centre. The form factor is the solver's own
-//! ([`formfactor::weighted_point_to_samples`]): each element is a cell
-//! sample, so a point within [`formfactor::NEAR_FIELD_RATIO`] cell
+//! ([`super::formfactor::weighted_point_to_samples`]): each element is a cell
+//! sample, so a point within [`super::formfactor::NEAR_FIELD_RATIO`] cell
 //! diameters gets the cell's quadrature and within
-//! [`formfactor::EXACT_RATIO`] the exact point-to-cell form factor, and a
+//! [`super::formfactor::EXACT_RATIO`] the exact point-to-cell form factor, and a
 //! point on a polygon's edge or in a room's corner stays finite. The rays
 //! are the solver's: shaft culling between the point and each polygon
 //! ([`Visibility::box_shaft_candidates`]), the BVH where the shaft holds

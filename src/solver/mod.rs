@@ -17,7 +17,7 @@
 //! **Overshooting** ([`SolverOptions::overshoot`], on by default; Feda and
 //! Purgathofer 1992, the over-relaxation of Gortler, Cohen and Slusallek's
 //! Southwell view of progressive refinement): each point of a shooter
-//! also sends the light it expects to receive later ([`Expectation`]:
+//! also sends the light it expects to receive later (`Expectation`:
 //! what it has received so far times the ratio of light still to come to
 //! light shot, capped by its share of the ambient term), and is left at
 //! `Δb = −` that, filled as the light arrives; a negative part the
@@ -133,7 +133,7 @@ pub const REFINE_MAX: usize = 256;
 
 /// An emitter whose unshot power is at least this share of the power it
 /// emits has not shot its light yet, and shoots before any reflector
-/// ([`Progressive::choose_pending_emitter`]). Once shot, what it holds is
+/// (`Progressive::choose_pending_emitter`). Once shot, what it holds is
 /// the light it reflects, far less in any ordinary scene.
 pub const PENDING_EMISSION: f64 = 0.5;
 
@@ -341,7 +341,7 @@ pub struct SolverOptions {
     pub part_budget: Option<std::time::Duration>,
     /// Overshoot (Feda and Purgathofer 1992): a step also sends out the
     /// light each point of its shooters is expected to receive later
-    /// ([`Expectation`]), leaving their unshot radiosity negative until
+    /// (`Expectation`), leaving their unshot radiosity negative until
     /// that light arrives; what the shrinking expectation no longer covers
     /// is shot as negative light. Fewer steps to the same residual; off,
     /// unshot radiosity never goes below zero (the original algorithm).
@@ -933,7 +933,7 @@ impl<'a> Progressive<'a> {
     /// missing from an unconverged solution and tends to zero as the solve
     /// converges. With overshooting the unshot radiosity is signed, and so
     /// is this: what is left to shoot less what was sent ahead. It is for
-    /// display only, and for the overshoot ([`Expectation`]).
+    /// display only, and for the overshoot (`Expectation`).
     pub fn ambient(&self) -> Rgb {
         ambient_term(&self.mesh, &self.reflectance, &self.power_weight, |j| {
             self.unshot.mean(&self.mesh, j)
@@ -963,7 +963,7 @@ impl<'a> Progressive<'a> {
     /// ([`SolverOptions::overshoot`]) alike. A sky's facets count together
     /// as at most `S · A_scene` (its radiosity times the area of every
     /// other polygon), the most it can bring to the scene, not its own far
-    /// larger power (see [`sky_power_weights`]).
+    /// larger power (see `sky_power_weights`).
     pub fn unshot_power(&self) -> f64 {
         self.unshot_sums().0
     }

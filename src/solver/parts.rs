@@ -15,7 +15,7 @@
 //! pairs ([`CHUNK_WORK`] at first, then what the chunks before took about
 //! [`CHUNK_TARGET`] to gather), or, for one polygon larger than that (a
 //! hall's floor), a piece of its vertices in one of the two passes of a
-//! hierarchical gather ([`Pass`]); the polygon is applied once its last
+//! hierarchical gather (`Pass`); the polygon is applied once its last
 //! piece is done, as a receiving grid's interpolation and its check charges
 //! need all of its first pass. Without a budget a step is one chunk of
 //! every polygon: the solver as it was.
@@ -31,7 +31,7 @@ use std::time::Duration;
 /// pair costs what it costs on average, 40 ms where it costs most (0.3 to
 /// 2.3 µs on the 100,000-triangle sphere box, more where receivers take
 /// a part's leaves). Chunks shrink from the time the earlier ones took
-/// ([`Plan::observe`]), down to [`CHUNK_WORK`] / 64; they never grow past
+/// (`Plan::observe`), down to [`CHUNK_WORK`] / 64; they never grow past
 /// it, as the next polygons may cost several times the last. Twice this
 /// let a part that met the dearest polygons late run to 0.12 s.
 pub const CHUNK_WORK: u64 = 1 << 14;

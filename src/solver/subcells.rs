@@ -16,7 +16,7 @@
 //! foot, a lamp under the ceiling) is cut into 4 × 4 parts (a triangle
 //! into 16 congruent triangles), and each part again into 4 × 4 leaves.
 //! Each part and each leaf reads the light it holds (its integral over
-//! the elements, [`super::cell_integrals`]), and *every* receiver takes
+//! the elements, `cell_integrals`), and *every* receiver takes
 //! the cell as its parts: each part's own value and form factor (the
 //! quadrature of a cell or its point term), under the cell's one shadow
 //! ray, so the parts cost arithmetic, not rays. A receiver within
@@ -106,7 +106,7 @@ pub struct SubCell {
     /// Its corners, counter-clockwise from the front (a triangle repeats
     /// its last).
     pub corners: [Vec3; 4],
-    /// Its quadrature points ([`quadrature`]).
+    /// Its quadrature points (`quadrature`).
     pub quadrature: Quadrature,
     /// Squared diameter, in square scene units.
     pub diameter2: f32,
@@ -135,7 +135,7 @@ pub struct SubCells {
 impl SubCells {
     /// Every polygon's parts: those of its cells that stand for more than
     /// [`ELEMENTS_PER_CELL`] of its elements and have something close over
-    /// them ([`Over`]). None without the near field (`near_field` false), nor
+    /// them (`Over`). None without the near field (`near_field` false), nor
     /// for samples without a cell, whose form factors have no cell to cut.
     pub fn build_all(
         scene: &Scene,
@@ -245,15 +245,15 @@ struct Over {
 }
 
 /// How close over a shooter's plane, in cell diameters, a point must
-/// stand to count ([`Over`]).
+/// stand to count (`Over`).
 pub const CLOSE: f32 = 0.5;
 
 /// How near a cell's centre, in cell diameters, a point must stand to
-/// count ([`Over`]).
+/// count (`Over`).
 pub const REACH: f32 = 1.0;
 
 /// How far inside a shooter's edges, in cell diameters, a point must
-/// stand over it to count as over its inside ([`Over`]).
+/// stand over it to count as over its inside (`Over`).
 pub const EDGE_MARGIN: f32 = 0.01;
 
 impl Over {
