@@ -235,6 +235,7 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     h.word(options.receiver_interpolation as u64);
     h.word(super::WEAK_STRATUM_SHARE.to_bits());
     h.word(u64::from(super::cluster::PLANE_DEPTH_RATIO.to_bits()));
+    h.word(u64::from(super::cluster::TOP_DEPTH_RATIO.to_bits()));
     h.word(u64::from(super::cluster::STRATUM_NEAR_RATIO.to_bits()));
     h.word(u64::from(super::cluster::RESTING_NEAR_FACTOR.to_bits()));
     h.word(u64::from(super::receivers::CROWD_RATIO.to_bits()));

@@ -2184,7 +2184,14 @@ impl<'a> Progressive<'a> {
                 let node = &strata.nodes[n as usize];
                 let rep = &cells[node.representative as usize];
                 let rep_sample = &cell_samples[node.representative as usize];
-                let seen = node.seen_from(x, nx);
+                // Above a weak step's cut, nodes larger than any
+                // stratum must lie deeper in front of the receiver.
+                let depth_ratio = if si == NONE {
+                    cluster::TOP_DEPTH_RATIO
+                } else {
+                    cluster::PLANE_DEPTH_RATIO
+                };
+                let seen = node.seen_from_at(x, nx, depth_ratio);
                 if seen == Seen::Behind {
                     continue;
                 }
