@@ -3,7 +3,10 @@
 //!
 //! The scene's polygons go into a compressed wide BVH from `obvhs`, whose
 //! traversal tests four child boxes at a time with SIMD. A shadow query is
-//! an any-hit traversal that stops at the first blocker. Polygons are
+//! an any-hit traversal that stops at the first blocker; on x86-64 CPUs
+//! with SSE4.2 and POPCNT it runs a build of the search for those
+//! instructions, chosen at run time (the same answers, a tenth faster on
+//! large scenes). Polygons are
 //! intersected whole (plane, then inside every edge), not as triangles: a
 //! ray through the diagonal between two triangles of a split quad can slip
 //! between them, and symmetric scenes put vertices exactly below such
