@@ -14,7 +14,7 @@
 //! with the picture under it: a light cyan on dark and mid-tone surfaces, a
 //! deep blue on light ones, so the mesh is readable on every wall.
 
-use super::camera::View;
+use super::view::View;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
 use image::RgbImage;

@@ -32,7 +32,7 @@
 //! and the same bits as drawing every triangle over the whole picture (a
 //! test holds the two together).
 
-use super::camera::View;
+use super::view::View;
 use crate::color::Rgb;
 use crate::mesh::{Mesh, VertexId};
 use glam::{DVec2, DVec3};
