@@ -406,30 +406,11 @@ pub fn glb_bytes(
     name: &str,
 ) -> Vec<u8> {
     let nodes = export_nodes(scene, name);
-    let mut bin = Vec::with_capacity(mesh.vertex_count() * 48 + mesh.elements.len() * 24);
-    let mut views: Vec<serde_json::Value> = Vec::new();
-    let mut accessors: Vec<serde_json::Value> = Vec::new();
-    // Appends one tightly packed view and its accessor; returns the
-    // accessor's index. Every length is a multiple of 4, so every view
-    // starts aligned.
-    let mut push = |bin: &mut Vec<u8>,
-                    bytes: &dyn Fn(&mut Vec<u8>),
-                    mut accessor: serde_json::Value,
-                    target: u32| {
-        let start = bin.len();
-        bytes(bin);
-        accessor["bufferView"] = json!(views.len());
-        views.push(json!({
-            "buffer": 0,
-            "byteOffset": start,
-            "byteLength": bin.len() - start,
-            "target": target,
-        }));
-        accessors.push(accessor);
-        accessors.len() - 1
+    let mut buffer = GlbBuffer {
+        bin: Vec::with_capacity(mesh.vertex_count() * 48 + mesh.elements.len() * 24),
+        views: Vec::new(),
+        accessors: Vec::new(),
     };
-    // Written as the f64 equal to each f32, so a reader compares exactly.
-    let exact = |v: [f32; 3]| v.map(f64::from);
 
     let mut gltf_material = vec![None; scene.materials.len()];
     let mut materials = Vec::new();
@@ -443,87 +424,8 @@ pub fn glb_bytes(
         for (material, polygons) in &node.primitives {
             let data = collect_primitive(mesh, polygons, next_id, &mut local, &mut stamp);
             next_id += 1;
-            let count = data.vertices.len();
-            let vec3 = json!({"componentType": FLOAT, "count": count, "type": "VEC3"});
-            let (lo, hi) = data.vertices.iter().fold(
-                ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-                |(lo, hi), &v| {
-                    let p = mesh.positions[v as usize].to_array();
-                    (
-                        [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
-                        [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
-                    )
-                },
-            );
-            let mut position = vec3.clone();
-            position["min"] = json!(exact(lo));
-            position["max"] = json!(exact(hi));
-            let position = push(
-                &mut bin,
-                &|b| {
-                    put_f32s(
-                        b,
-                        data.vertices
-                            .iter()
-                            .flat_map(|&v| mesh.positions[v as usize].to_array()),
-                    )
-                },
-                position,
-                ARRAY_BUFFER,
-            );
-            let normal = push(
-                &mut bin,
-                &|b| {
-                    put_f32s(
-                        b,
-                        data.normal_of
-                            .iter()
-                            .flat_map(|p| mesh.polygons[p.index()].normal.to_array()),
-                    )
-                },
-                vec3.clone(),
-                ARRAY_BUFFER,
-            );
-            let color = push(
-                &mut bin,
-                &|b| {
-                    put_f32s(
-                        b,
-                        data.vertices
-                            .iter()
-                            .flat_map(|&v| linear_display(radiosity[v as usize], exposure)),
-                    )
-                },
-                vec3.clone(),
-                ARRAY_BUFFER,
-            );
-            let raw = push(
-                &mut bin,
-                &|b| {
-                    put_f32s(
-                        b,
-                        data.vertices
-                            .iter()
-                            .flat_map(|&v| radiosity[v as usize].to_f32()),
-                    )
-                },
-                vec3,
-                ARRAY_BUFFER,
-            );
-            let indices = push(
-                &mut bin,
-                &|b| {
-                    for i in &data.indices {
-                        b.extend_from_slice(&i.to_le_bytes());
-                    }
-                },
-                json!({
-                    "componentType": UNSIGNED_INT,
-                    "count": data.indices.len(),
-                    "type": "SCALAR",
-                }),
-                ELEMENT_ARRAY_BUFFER,
-            );
+            let (attributes, indices) =
+                push_primitive(&mut buffer, mesh, radiosity, exposure, &data);
             let m = material.index();
             let index = *gltf_material[m].get_or_insert_with(|| {
                 let (json, strong) = material_json(&scene.materials[m], exposure);
@@ -532,12 +434,7 @@ pub fn glb_bytes(
                 materials.len() - 1
             });
             primitives.push(json!({
-                "attributes": {
-                    "POSITION": position,
-                    "NORMAL": normal,
-                    "COLOR_0": color,
-                    RADIOSITY_ATTRIBUTE: raw,
-                },
+                "attributes": attributes,
                 "indices": indices,
                 "material": index,
                 "mode": TRIANGLES,
@@ -546,6 +443,11 @@ pub fn glb_bytes(
         meshes.push(json!({"name": node.name, "primitives": primitives}));
     }
 
+    let GlbBuffer {
+        bin,
+        views,
+        accessors,
+    } = buffer;
     let scene_name = if name.is_empty() { "radiosity" } else { name };
     let mut doc = json!({
         "asset": {
@@ -574,7 +476,146 @@ pub fn glb_bytes(
         doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
     }
     // A `Value` always serialises.
-    let mut json_chunk = serde_json::to_vec(&doc).unwrap_or_default();
+    let json_chunk = serde_json::to_vec(&doc).unwrap_or_default();
+    glb_container(json_chunk, bin)
+}
+
+/// The binary chunk of a `.glb` file as it fills, with the buffer views
+/// and accessors that describe its parts.
+struct GlbBuffer {
+    /// The binary chunk's bytes.
+    bin: Vec<u8>,
+    /// One buffer view a part of `bin`.
+    views: Vec<serde_json::Value>,
+    /// One accessor a view, in the same order.
+    accessors: Vec<serde_json::Value>,
+}
+
+impl GlbBuffer {
+    /// Appends one tightly packed view and its accessor; returns the
+    /// accessor's index. Every length is a multiple of 4, so every view
+    /// starts aligned.
+    fn push(
+        &mut self,
+        bytes: &dyn Fn(&mut Vec<u8>),
+        mut accessor: serde_json::Value,
+        target: u32,
+    ) -> usize {
+        let start = self.bin.len();
+        bytes(&mut self.bin);
+        accessor["bufferView"] = json!(self.views.len());
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": start,
+            "byteLength": self.bin.len() - start,
+            "target": target,
+        }));
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+}
+
+/// Appends one primitive's positions, normals, display colours, radiosity
+/// and triangle indices to `buffer`; returns its `attributes` object and
+/// the accessor of its indices.
+fn push_primitive(
+    buffer: &mut GlbBuffer,
+    mesh: &Mesh,
+    radiosity: &[Rgb],
+    exposure: f32,
+    data: &PrimitiveData,
+) -> (serde_json::Value, usize) {
+    // Written as the f64 equal to each f32, so a reader compares exactly.
+    let exact = |v: [f32; 3]| v.map(f64::from);
+    let count = data.vertices.len();
+    let vec3 = json!({"componentType": FLOAT, "count": count, "type": "VEC3"});
+    let (lo, hi) = data.vertices.iter().fold(
+        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+        |(lo, hi), &v| {
+            let p = mesh.positions[v as usize].to_array();
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
+                [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
+            )
+        },
+    );
+    let mut position = vec3.clone();
+    position["min"] = json!(exact(lo));
+    position["max"] = json!(exact(hi));
+    let position = buffer.push(
+        &|b| {
+            put_f32s(
+                b,
+                data.vertices
+                    .iter()
+                    .flat_map(|&v| mesh.positions[v as usize].to_array()),
+            )
+        },
+        position,
+        ARRAY_BUFFER,
+    );
+    let normal = buffer.push(
+        &|b| {
+            put_f32s(
+                b,
+                data.normal_of
+                    .iter()
+                    .flat_map(|p| mesh.polygons[p.index()].normal.to_array()),
+            )
+        },
+        vec3.clone(),
+        ARRAY_BUFFER,
+    );
+    let color = buffer.push(
+        &|b| {
+            put_f32s(
+                b,
+                data.vertices
+                    .iter()
+                    .flat_map(|&v| linear_display(radiosity[v as usize], exposure)),
+            )
+        },
+        vec3.clone(),
+        ARRAY_BUFFER,
+    );
+    let raw = buffer.push(
+        &|b| {
+            put_f32s(
+                b,
+                data.vertices
+                    .iter()
+                    .flat_map(|&v| radiosity[v as usize].to_f32()),
+            )
+        },
+        vec3,
+        ARRAY_BUFFER,
+    );
+    let indices = buffer.push(
+        &|b| {
+            for i in &data.indices {
+                b.extend_from_slice(&i.to_le_bytes());
+            }
+        },
+        json!({
+            "componentType": UNSIGNED_INT,
+            "count": data.indices.len(),
+            "type": "SCALAR",
+        }),
+        ELEMENT_ARRAY_BUFFER,
+    );
+    let attributes = json!({
+        "POSITION": position,
+        "NORMAL": normal,
+        "COLOR_0": color,
+        RADIOSITY_ATTRIBUTE: raw,
+    });
+    (attributes, indices)
+}
+
+/// The `.glb` container: its header, then the JSON chunk padded with
+/// spaces and the binary chunk `bin` padded with zeros, each to a multiple
+/// of 4 bytes.
+fn glb_container(mut json_chunk: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
     while !json_chunk.len().is_multiple_of(4) {
         json_chunk.push(b' ');
     }
