@@ -158,7 +158,7 @@ pub struct WorkplaneConfig {
     /// Height above the floor of the scene's bounds, scene units, `>= 0`.
     pub height: f32,
     /// Grid spacing in scene units (`> 0`), `None` for the default
-    /// ([`crate::output::photometry::default_spacing_metres`]).
+    /// ([`crate::output::illuminance::default_spacing_metres`]).
     pub spacing: Option<f32>,
     /// The CSV to write (`PREFIX.csv`).
     pub csv: PathBuf,

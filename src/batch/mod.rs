@@ -34,13 +34,13 @@ use crate::mesh::MeshRef;
 use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, OutputError};
 use crate::prepare::{self, PhaseSeconds, PrepareError, Prepared};
-use crate::render::{self, antialias, Exposure, Rasterizer, RenderError, View, ViewError};
+use crate::render::{self, antialias, Exposure, Frame, Rasterizer, RenderError, View, ViewError};
 use crate::session::{Event, PassStats, Session, SessionOptions};
 use crate::solver::checkpoint::fingerprint;
 use crate::solver::SolverError;
 use progress::Progress;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -262,29 +262,17 @@ pub fn run_prepared(
         return Err(interrupted());
     }
     let t = Instant::now();
-    // Rendered at `aa × aa` samples a pixel, averaged to the picture.
-    let aa = antialias::factor_for(view.width(), view.height(), config.aa);
-    let mut rasterizer = Rasterizer::new();
-    if aa > 1 {
-        let fine = View::with_size(
-            &prepared.scene.camera,
-            view.width() * aa,
-            view.height() * aa,
-        )?;
-        rasterizer.render(mesh, &solved.shown, &fine)?;
-    } else {
-        rasterizer.render(mesh, &solved.shown, &view)?;
-    }
-    let picture_frame = (aa > 1).then(|| antialias::downsample(rasterizer.frame(), aa));
-    let frame = picture_frame.as_ref().unwrap_or(rasterizer.frame());
+    let drawn = draw(config, prepared, &view, mesh, &solved.shown)?;
+    let frame = drawn.frame();
     seconds.render = t.elapsed().as_secs_f64();
     // One line on a (nearly) black picture, whatever `--quiet` says, like
     // the load warnings: it explains a picture the user did not expect.
     // Not when nothing emits: the load warning has said why already.
-    let dark = render::PictureCoverage::of(rasterizer.frame(), rasterizer.front_faces())
-        .dark_warning()
-        .filter(|_| prepared.scene.emits())
-        .map(|w| format!("warning: {w}"));
+    let dark =
+        render::PictureCoverage::of(drawn.rasterizer.frame(), drawn.rasterizer.front_faces())
+            .dark_warning()
+            .filter(|_| prepared.scene.emits())
+            .map(|w| format!("warning: {w}"));
     if let Some(line) = &dark {
         eprintln!("{line}");
     }
@@ -295,18 +283,102 @@ pub fn run_prepared(
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree.
     let exposure = config.exposure.resolve(frame);
+    write_results(config, prepared, &output, &solved, &drawn, &view, exposure)?;
+    let mut stats = run_stats(config, prepared, &session, mesh, dark, exposure, seconds);
+    stats.seconds.write = t.elapsed().as_secs_f64();
+    if let Some(path) = &config.stats {
+        // The picture is complete and stays; the stats are skipped if the
+        // interrupt came while it was written.
+        if cancel.load(Ordering::SeqCst) {
+            return Err(interrupted());
+        }
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| {
+            RunError::Write(OutputError::Io {
+                path: path.clone(),
+                error: std::io::Error::other(e),
+            })
+        })?;
+        output::write_atomically(path, |w| writeln!(w, "{json}")).map_err(RunError::Write)?;
+    }
+    Ok(stats)
+}
+
+/// The picture a batch run drew: the rasterizer's frame at `aa × aa`
+/// samples a pixel, and that frame averaged to the view's size when
+/// `aa > 1`.
+struct Drawn {
+    /// The rasterizer after drawing, with its frame, depths and front faces
+    /// at the sampled size.
+    rasterizer: Rasterizer,
+    /// Samples a pixel along each side (1 without antialiasing).
+    aa: u32,
+    /// The sampled frame averaged to the view's size; `None` when `aa` is 1.
+    downsampled: Option<Frame>,
+}
+
+impl Drawn {
+    /// The picture's linear frame, at the view's size.
+    fn frame(&self) -> &Frame {
+        self.downsampled.as_ref().unwrap_or(self.rasterizer.frame())
+    }
+}
+
+/// Draws `shown` (per vertex of `mesh`) through `view`, antialiased as
+/// `config.aa` asks.
+fn draw(
+    config: &RunConfig,
+    prepared: &Prepared,
+    view: &View,
+    mesh: &crate::mesh::Mesh,
+    shown: &[crate::color::Rgb],
+) -> Result<Drawn, RunError> {
+    // Rendered at `aa × aa` samples a pixel, averaged to the picture.
+    let aa = antialias::factor_for(view.width(), view.height(), config.aa);
+    let mut rasterizer = Rasterizer::new();
+    if aa > 1 {
+        let fine = View::with_size(
+            &prepared.scene.camera,
+            view.width() * aa,
+            view.height() * aa,
+        )?;
+        rasterizer.render(mesh, shown, &fine)?;
+    } else {
+        rasterizer.render(mesh, shown, view)?;
+    }
+    let downsampled = (aa > 1).then(|| antialias::downsample(rasterizer.frame(), aa));
+    Ok(Drawn {
+        rasterizer,
+        aa,
+        downsampled,
+    })
+}
+
+/// Writes the picture to `output` and every other result `config` asks
+/// for: the solved mesh, the step log, the convergence plot and the
+/// photometric results, with the picture's `exposure`.
+fn write_results(
+    config: &RunConfig,
+    prepared: &Prepared,
+    output: &Path,
+    solved: &Solved,
+    drawn: &Drawn,
+    view: &View,
+    exposure: f32,
+) -> Result<(), RunError> {
+    let mesh: &crate::mesh::Mesh = &solved.mesh;
+    let frame = drawn.frame();
+    let aa = drawn.aa;
     if config.mesh_lines {
         let mut picture = render::to_srgb8(frame, exposure);
         let depth = if aa > 1 {
-            antialias::nearest_depth(rasterizer.inv_depth(), view.width() * aa, aa)
+            antialias::nearest_depth(drawn.rasterizer.inv_depth(), view.width() * aa, aa)
         } else {
-            rasterizer.inv_depth().to_vec()
+            drawn.rasterizer.inv_depth().to_vec()
         };
-        render::draw_mesh_edges(&mut picture, mesh, &view, &depth, render::MESH_LINES);
-        output::write_rgb8(&output, &picture).map_err(RunError::Write)?;
+        render::draw_mesh_edges(&mut picture, mesh, view, &depth, render::MESH_LINES);
+        output::write_rgb8(output, &picture).map_err(RunError::Write)?;
     } else {
-        output::write_picture(&output, frame, Exposure::Fixed(exposure))
-            .map_err(RunError::Write)?;
+        output::write_picture(output, frame, Exposure::Fixed(exposure)).map_err(RunError::Write)?;
     }
     if let Some(path) = &config.export {
         // The sky lights the model; it is no part of it.
@@ -337,10 +409,26 @@ pub fn run_prepared(
         )
         .map_err(RunError::Write)?;
     }
-    photometry::write(config, prepared, mesh, &solved.radiosity, frame, &view)?;
-    let mut stats = RunStats {
+    photometry::write(config, prepared, mesh, &solved.radiosity, frame, view)?;
+    Ok(())
+}
+
+/// The figures of a finished run: what was solved and written, with the
+/// `dark` picture warning if there was one; `seconds.write` is left for
+/// the caller to fill.
+fn run_stats(
+    config: &RunConfig,
+    prepared: &Prepared,
+    session: &Session,
+    mesh: &crate::mesh::Mesh,
+    dark: Option<String>,
+    exposure: f32,
+    seconds: PhaseSeconds,
+) -> RunStats {
+    let totals = session.totals();
+    RunStats {
         scene: config.scene.display_name(),
-        output: output.display().to_string(),
+        output: config.output_path().display().to_string(),
         also_written: config
             .extra_outputs()
             .map(|p| p.display().to_string())
@@ -381,23 +469,7 @@ pub fn run_prepared(
             Vec::new()
         },
         seconds,
-    };
-    stats.seconds.write = t.elapsed().as_secs_f64();
-    if let Some(path) = &config.stats {
-        // The picture is complete and stays; the stats are skipped if the
-        // interrupt came while it was written.
-        if cancel.load(Ordering::SeqCst) {
-            return Err(interrupted());
-        }
-        let json = serde_json::to_string_pretty(&stats).map_err(|e| {
-            RunError::Write(OutputError::Io {
-                path: path.clone(),
-                error: std::io::Error::other(e),
-            })
-        })?;
-        output::write_atomically(path, |w| writeln!(w, "{json}")).map_err(RunError::Write)?;
     }
-    Ok(stats)
 }
 
 /// Runs `session` to its end: resumes from the checkpoint asked for,

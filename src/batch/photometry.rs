@@ -12,7 +12,7 @@ use super::RunError;
 use crate::color::Rgb;
 use crate::config::RunConfig;
 use crate::mesh::Mesh;
-use crate::output::{self, photometry as out};
+use crate::output::{self, illuminance as out};
 use crate::prepare::Prepared;
 use crate::render::falsecolor::{self, Mapping, Quantity};
 use crate::render::{Frame, View};

@@ -1,6 +1,7 @@
 //! Writing results to files: pictures (png, tiff, exr, pfm), the solved
-//! mesh (glb, ply), the convergence log and plot, and the atomic-write
-//! helper every output shares.
+//! mesh (glb, ply), the convergence log and plot, illuminance at points and
+//! over work planes (CSV, plan), and the atomic-write helper every output
+//! shares.
 //!
 //! Every file is written to a temporary file in its destination directory
 //! and renamed into place once complete ([`write_atomically`]), so a failed
@@ -11,9 +12,9 @@
 //! the operating system or an encoder failed, says why in the same message.
 
 pub mod convergence;
+pub mod illuminance;
 pub mod image;
 pub mod mesh_export;
-pub mod photometry;
 
 pub use self::image::{write_picture, write_rgb8, PictureFormat, SUPPORTED_EXTENSIONS};
 pub use self::mesh_export::{write_mesh, MeshFormat, MESH_EXTENSIONS};

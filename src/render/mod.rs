@@ -29,15 +29,14 @@
 //! batch command writes the very same frames.
 
 pub mod antialias;
-pub mod camera;
 pub mod coverage;
 pub mod falsecolor;
 pub mod overlay;
 pub mod raster;
 pub mod text;
 pub mod tonemap;
+pub mod view;
 
-pub use camera::{View, ViewError};
 pub use coverage::{PictureCoverage, DARK_PICTURE_FRACTION};
 pub use overlay::{draw_mesh_edges, LinePalette, MESH_COLOR, MESH_COLOR_ON_LIGHT, MESH_LINES};
 pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
@@ -45,6 +44,7 @@ pub use tonemap::{
     auto_exposure, back_face_color, srgb8, srgb_encode, to_srgb8, Exposure, BACK_FACE_COLORS,
     BACK_FACE_STRIPE,
 };
+pub use view::{View, ViewError};
 
 /// Renders one frame of a solution (`radiosity` per vertex of `mesh`) with
 /// a rasterizer of its own: for a single picture; a window or an animation

@@ -1,0 +1,282 @@
+//! Meshing each polygon shape: element counts, edge lengths and areas,
+//! shared vertices, the inset of sample points, and the checks on options
+//! and on a mesh's size.
+
+use super::*;
+use crate::testutil;
+
+/// A polygon built without the parser, of the shape the test names.
+fn polygon(vertices: &[[f32; 3]], shape: Shape) -> Polygon {
+    let p = testutil::polygon(0, vertices);
+    assert_eq!(p.shape, shape);
+    p
+}
+
+fn scene(polygons: Vec<Polygon>) -> Scene {
+    testutil::scene(polygons, vec![testutil::grey("m", 0.0, 0.5)])
+}
+
+/// One polygon of every shape the mesher knows, in parallel planes
+/// `z = 0, 1, 2, …` (also used by the refinement tests).
+pub(super) fn all_shapes() -> Vec<Polygon> {
+    vec![
+        polygon(
+            &[[0., 0., 0.], [2., 0., 0.], [2., 1., 0.], [0., 1., 0.]],
+            Shape::Parallelogram,
+        ),
+        polygon(
+            &[[0., 0., 1.], [2., 0., 1.], [1.5, 1., 1.], [0.2, 1.3, 1.]],
+            Shape::Quad,
+        ),
+        polygon(
+            &[[0., 0., 2.], [1., 0., 2.], [0.3, 1.7, 2.]],
+            Shape::Triangle,
+        ),
+        polygon(
+            &[
+                [1., 0., 3.],
+                [0.5, 0.87, 3.],
+                [-0.5, 0.87, 3.],
+                [-1., 0., 3.],
+                [-0.5, -0.87, 3.],
+                [0.5, -0.87, 3.],
+            ],
+            Shape::Convex,
+        ),
+        // A pentagon with a collinear vertex (allowed by the format).
+        polygon(
+            &[
+                [0., 0., 4.],
+                [1., 0., 4.],
+                [2., 0., 4.],
+                [2., 1., 4.],
+                [0., 1., 4.],
+            ],
+            Shape::Convex,
+        ),
+    ]
+}
+
+fn opts(lenmax: f32, inset: f32) -> MeshOptions {
+    MeshOptions { lenmax, inset }
+}
+
+#[test]
+fn parallelogram_grid_counts() {
+    let s = scene(vec![all_shapes().remove(0)]);
+    let m = build(&s, &opts(0.3, 0.0)).unwrap();
+    let pm = &m.polygons[0];
+    assert_eq!((pm.nu, pm.nv), (7, 4)); // ⌊2/0.3⌋+1, ⌊1/0.3⌋+1
+    assert_eq!(m.vertex_count(), 8 * 5);
+    assert_eq!(m.elements.len(), 28);
+    m.validate().unwrap();
+}
+
+#[test]
+fn exact_multiple_of_lenmax_still_gives_shorter_edges() {
+    let s = scene(vec![all_shapes().remove(0)]);
+    let m = build(&s, &opts(0.5, 0.0)).unwrap();
+    assert_eq!((m.polygons[0].nu, m.polygons[0].nv), (5, 3));
+}
+
+#[test]
+fn triangle_subdivision_counts() {
+    let s = scene(vec![all_shapes().remove(2)]);
+    let m = build(&s, &opts(0.25, 0.0)).unwrap();
+    let n = m.polygons[0].nu as usize;
+    assert!(n >= 2);
+    assert_eq!(m.vertex_count(), (n + 1) * (n + 2) / 2);
+    assert_eq!(m.elements.len(), n * n);
+}
+
+#[test]
+fn every_edge_is_shorter_than_lenmax() {
+    for lenmax in [0.07f32, 0.2, 0.33, 1.0, 5.0] {
+        let m = build(&scene(all_shapes()), &opts(lenmax, 0.0)).unwrap();
+        for e in &m.elements {
+            let c = e.corners();
+            for k in 0..c.len() {
+                let (a, b) = (
+                    m.positions[c[k].index()],
+                    m.positions[c[(k + 1) % c.len()].index()],
+                );
+                assert!(
+                    a.distance(b) < lenmax,
+                    "edge {} >= lenmax {lenmax}",
+                    a.distance(b)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn element_areas_sum_to_polygon_area() {
+    let s = scene(all_shapes());
+    let m = build(&s, &opts(0.13, 0.0)).unwrap();
+    for (p, pm) in s.polygons.iter().zip(&m.polygons) {
+        let sum: f64 = pm
+            .elements
+            .clone()
+            .map(|e| m.element_area(&m.elements[e as usize]))
+            .sum();
+        assert!((sum - p.area).abs() < 1e-5 * p.area, "{sum} vs {}", p.area);
+    }
+    let shares = m.vertex_areas();
+    for (p, pm) in s.polygons.iter().zip(&m.polygons) {
+        let sum: f64 = pm.vertices.clone().map(|v| shares[v as usize]).sum();
+        assert!((sum - p.area).abs() < 1e-5 * p.area);
+    }
+}
+
+#[test]
+fn elements_face_the_polygons_front() {
+    let s = scene(all_shapes());
+    let m = build(&s, &opts(0.2, 0.0)).unwrap();
+    for (e, p) in m.elements.iter().zip(&m.element_polygon) {
+        for [a, b, c] in e.triangles() {
+            let (a, b, c) = (
+                m.positions[a.index()],
+                m.positions[b.index()],
+                m.positions[c.index()],
+            );
+            let n = (b - a).cross(c - a);
+            assert!(n.dot(s.polygons[p.index()].normal) > 0.0);
+        }
+    }
+}
+
+#[test]
+fn vertices_are_shared_not_duplicated() {
+    let s = scene(all_shapes());
+    let m = build(&s, &opts(0.2, 0.0)).unwrap();
+    m.validate().unwrap();
+    for pm in &m.polygons {
+        let vs = &m.positions[pm.vertices.start as usize..pm.vertices.end as usize];
+        for (i, a) in vs.iter().enumerate() {
+            for b in &vs[i + 1..] {
+                assert!(a.distance(*b) > 1e-6, "duplicate vertex at {a}");
+            }
+        }
+        // Every vertex is a corner of some element.
+        let mut used = vec![false; vs.len()];
+        for e in pm.elements.clone() {
+            for c in m.elements[e as usize].corners() {
+                used[(c.0 - pm.vertices.start) as usize] = true;
+            }
+        }
+        assert!(used.iter().all(|&u| u));
+    }
+    // Interior vertices of a quad grid are shared by four elements.
+    let pm = &m.polygons[0];
+    let mut uses = vec![0; pm.vertex_count() as usize];
+    for e in pm.elements.clone() {
+        for c in m.elements[e as usize].corners() {
+            uses[c.index()] += 1;
+        }
+    }
+    let corner_uses = uses.iter().filter(|&&u| u == 1).count();
+    let interior_uses = uses.iter().filter(|&&u| u == 4).count();
+    assert_eq!(corner_uses, 4);
+    assert_eq!(interior_uses, ((pm.nu - 1) * (pm.nv - 1)) as usize);
+}
+
+#[test]
+fn inset_moves_boundary_vertices_inward_only() {
+    let s = scene(vec![all_shapes().remove(0)]);
+    let m = build(&s, &opts(0.5, 0.1)).unwrap();
+    let d = 0.1 * m.polygons[0].min_edge;
+    for (p, q) in m.positions.iter().zip(&m.sample_positions) {
+        let on_x_edge = p.x == 0.0 || p.x == 2.0;
+        let on_y_edge = p.y == 0.0 || p.y == 1.0;
+        let expect_dx = if p.x == 0.0 {
+            d
+        } else if p.x == 2.0 {
+            -d
+        } else {
+            0.0
+        };
+        let expect_dy = if p.y == 0.0 {
+            d
+        } else if p.y == 1.0 {
+            -d
+        } else {
+            0.0
+        };
+        assert!((q.x - p.x - expect_dx).abs() < 1e-6, "{p} -> {q}");
+        assert!((q.y - p.y - expect_dy).abs() < 1e-6, "{p} -> {q}");
+        assert_eq!(q.z, p.z);
+        if !on_x_edge && !on_y_edge {
+            assert_eq!(p, q);
+        }
+    }
+    // The corner at the origin moved diagonally.
+    assert!((m.sample_positions[0] - Vec3::new(d, d, 0.0)).length() < 1e-6);
+}
+
+#[test]
+fn zero_inset_leaves_samples_on_the_vertices() {
+    let m = build(&scene(all_shapes()), &opts(0.3, 0.0)).unwrap();
+    assert_eq!(m.positions, m.sample_positions);
+}
+
+#[test]
+fn inset_samples_stay_inside_the_polygon() {
+    let s = scene(all_shapes());
+    let m = build(&s, &opts(0.3, DEFAULT_INSET)).unwrap();
+    for (q, pid) in m.sample_positions.iter().zip(&m.vertex_polygon) {
+        let p = &s.polygons[pid.index()];
+        let v = &p.vertices;
+        for k in 0..v.len() {
+            let edge = v[(k + 1) % v.len()] - v[k];
+            let inward = p.normal.cross(edge);
+            assert!(
+                inward.dot(*q - v[k]) > 0.0,
+                "sample {q} is not strictly inside"
+            );
+        }
+    }
+}
+
+#[test]
+fn lenmax_and_inset_checks_accept_exactly_their_ranges() {
+    for good in [f32::MIN_POSITIVE, 0.01, 1e6] {
+        assert_eq!(check_lenmax(good), Ok(good));
+    }
+    for bad in [0.0, -0.0, -1.0, f32::NAN, f32::INFINITY] {
+        assert!(matches!(check_lenmax(bad), Err(MeshError::BadLenmax(_))));
+    }
+    for good in [0.0, DEFAULT_INSET, 0.499] {
+        assert_eq!(check_inset(good), Ok(good));
+    }
+    for bad in [-0.01, 0.5, 1.0, f32::NAN, f32::INFINITY] {
+        assert!(matches!(check_inset(bad), Err(MeshError::BadInset(_))));
+    }
+}
+
+#[test]
+fn bad_options_and_huge_meshes_are_refused() {
+    let s = scene(all_shapes());
+    assert!(matches!(
+        build(&s, &opts(0.0, 0.0)),
+        Err(MeshError::BadLenmax(_))
+    ));
+    assert!(matches!(
+        build(&s, &opts(f32::NAN, 0.0)),
+        Err(MeshError::BadLenmax(_))
+    ));
+    assert!(matches!(
+        build(&s, &opts(1.0, 0.6)),
+        Err(MeshError::BadInset(_))
+    ));
+    match build(&s, &opts(1e-5, 0.0)) {
+        Err(MeshError::TooManyElements {
+            suggested: Some(suggested),
+            ..
+        }) => {
+            let m = build(&s, &opts(suggested, 0.0)).unwrap();
+            assert!(m.elements.len() as u64 <= MAX_ELEMENTS);
+        }
+        other => panic!("expected TooManyElements, got {other:?}"),
+    }
+}
