@@ -7,10 +7,18 @@
 //! perpendicular unit squares, measured through one shooting step; the
 //! uniform enclosure `B = e / (1 − ρ)`; energy balance in a closed and in
 //! an open box; a shadow; and the same bits on one thread and on two.
-//! The closed forms, scenes and tolerances are those of the solver's unit
-//! tests, one configuration at a time; here a configuration is a row of
-//! [`configurations`], and a check a configuration cannot pass is left out
-//! of its row with the reason.
+//! The closed forms and scenes are those of the solver's unit tests, which
+//! checked one configuration at a time; here a configuration is a row of
+//! [`configurations`] listing its tolerance per check with the reason. A
+//! bound the unit tests stated is kept; where none was stated (the
+//! estimates with known losses), the bound is what the configuration
+//! measures today with a margin, and a check a configuration cannot pass
+//! is left out of its row with the reason.
+//!
+//! Clusters form of small polygons only: in the scenes of whole walls the
+//! clustered and unclustered rows differ by the receivers' interpolation
+//! alone, which goes with clustering; the determinism check's tiled box
+//! has clusters.
 
 mod common;
 
@@ -534,7 +542,7 @@ fn occluder_casts_a_shadow() {
                 })
                 .expect("a floor vertex") as usize
         };
-        let under = solved.radiosity[vertex_at(0.0, 0.5)].r;
+        let under = solved.radiosity[vertex_at(0.0, 0.5)].max_channel();
         let outside = solved.radiosity[vertex_at(2.5, 0.5)].r;
         assert!(outside > 0.0, "{}: the floor outside is lit", c.name);
         (
@@ -550,14 +558,14 @@ fn determinism_scene() -> Scene {
     tiled_shadowed_box(4)
 }
 
-/// One thread or two, the same bits: 20 steps of the tiled, shadowed box
+/// One thread or two, the same bits: 25 steps of the tiled, shadowed box
 /// on elements 0.15 across.
 #[test]
 fn thread_count_does_not_change_the_result() {
     let s = determinism_scene();
     assert_passed(run(ThreadDeterminism, |c| {
         let options = SolverOptions {
-            max_steps: Some(20),
+            max_steps: Some(25),
             ..c.options
         };
         let runs: Vec<Vec<Rgb>> = [1, 2]
