@@ -1,7 +1,10 @@
 //! Helpers shared by the integration tests: a temporary directory, a
-//! runner for the built binary, and a PNG reader.
+//! runner for the built binary, and a PNG reader; small scenes built in
+//! code and the measurements taken of their solutions ([`scenes`]).
 
 #![allow(dead_code)]
+
+pub mod scenes;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
