@@ -29,12 +29,12 @@
 //!   `KHR_materials_emissive_strength` × the average of
 //!   `emissiveTexture`, in the scene's radiosity units; a material that
 //!   both reflects and emits follows [`Material::with_emission`];
-//!   `doubleSided` sets [`Surface::two_sided`](super::Surface);
+//!   `doubleSided` sets [`Surface::two_sided`](crate::scene::Surface);
 //! - the first perspective camera met in the node order: its node's eye,
 //!   looking along its −z with its +y up, `yfov`, and a picture 480 pixels
 //!   high and `aspectRatio` times as wide (the default size without one);
 //!   without a camera the view is framed as for OBJ
-//!   ([`super::frame_camera`]);
+//!   ([`crate::scene::frame_camera`]);
 //! - node and mesh names, as [`Scene::groups`] (objects and meshes), for
 //!   `--emit` and the warning when nothing emits; material names as they
 //!   are (an unnamed material is `materials[N]`).
@@ -74,20 +74,20 @@
 //! type or reaching outside their buffer views, vertex indices out of
 //! range, non-finite or negative colour factors, emission above
 //! [`MAX_EMISSION`], node graphs that are not trees, triangles that no
-//! [`Polygon`] may be (coordinates beyond [`super::MAX_COORDINATE`]), and
+//! [`Polygon`] may be (coordinates beyond [`crate::scene::MAX_COORDINATE`]), and
 //! a file with no triangles.
 //!
 //! glTF polygons have no line in a file: their [`Polygon::origin`] is
 //! `0:0`.
 
-use super::error::{fmt_num, MAX_DIAGNOSTICS};
 use super::obj::{average_image, is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
-use super::{
+use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
+use crate::color::Rgb;
+use crate::scene::error::{fmt_num, MAX_DIAGNOSTICS};
+use crate::scene::{
     CameraSource, Diagnostic, Group, GroupKind, LoadError, Material, MaterialId, Polygon, Scene,
     SmoothId, SourcePos, Warning, MAX_EMISSION,
 };
-use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
-use crate::color::Rgb;
 use ::gltf::json;
 use base64::Engine as _;
 use glam::{DMat4, DQuat, DVec3, Vec3};
@@ -526,7 +526,7 @@ impl<'a> Reader<'a> {
                     });
                 groups[g]
                     .polygons
-                    .extend(ids.clone().map(|i| super::PolygonId(i as u32)));
+                    .extend(ids.clone().map(|i| crate::scene::PolygonId(i as u32)));
             }
         }
         if let Some((path, mode)) = skipped.first {
@@ -610,7 +610,7 @@ impl<'a> Reader<'a> {
             }
         }
         let mut scene = Scene {
-            camera: camera.unwrap_or_else(|| super::frame_camera(&polygons)),
+            camera: camera.unwrap_or_else(|| crate::scene::frame_camera(&polygons)),
             camera_source,
             polygons,
             materials,
@@ -1118,7 +1118,7 @@ fn make_camera(camera: &::gltf::Camera<'_>, world: &DMat4) -> Result<Camera, Str
 /// the model's centre, so that the window orbits the model; the view
 /// itself does not change. Left alone when the centre is behind the eye.
 fn aim_at_the_model(camera: &mut Camera, polygons: &[Polygon]) {
-    let (lo, hi) = super::polygon_bounds(polygons);
+    let (lo, hi) = crate::scene::polygon_bounds(polygons);
     let centre = (0.5 * (lo + hi)).as_dvec3();
     let eye = camera.eye.as_dvec3();
     let forward = (camera.lookat - camera.eye).as_dvec3().normalize_or_zero();

@@ -46,7 +46,7 @@
 //!   A face of four or more vertices keeps the triangles of it that have
 //!   an area, silently.
 //!
-//! Every face is **two-sided** ([`super::Surface::two_sided`]), as Blender
+//! Every face is **two-sided** ([`crate::scene::Surface::two_sided`]), as Blender
 //! shades it: each side receives, reflects and emits on its own once
 //! [`Scene::with_sides`] has added the back copies (`--one-sided` keeps
 //! the fronts only). A face that repeats an earlier one exactly is
@@ -55,7 +55,7 @@
 //! Object (`o`) and group (`g`) names are recorded in [`Scene::groups`],
 //! for `--emit` and the warning when nothing emits.
 //!
-//! **Smooth surfaces** ([`super::Surface::smooth`]): faces in one smoothing
+//! **Smooth surfaces** ([`crate::scene::Surface::smooth`]): faces in one smoothing
 //! group (`s N`, `N` neither `0` nor `off`, counted within one `o` object
 //! so that two objects never join) form one smooth surface, and so do
 //! faces that share a corner with the same position and the same normal
@@ -92,17 +92,17 @@
 //! file order). MTL files are read here (they are a handful of lines) so
 //! that each `Kd` and `Ke` has its position for messages.
 //!
-//! The camera is framed by [`super::frame_camera`] (from inside a room,
+//! The camera is framed by [`crate::scene::frame_camera`] (from inside a room,
 //! from outside an object), or comes from a
 //! sidecar `.sc` file (see [`Scene::with_camera_from`]).
 
-use super::emit::GroupScan;
-use super::error::{cannot_read, fmt_num, negative_channel, FILE_START, MAX_DIAGNOSTICS};
-use super::{
+use crate::color::Rgb;
+use crate::scene::error::{cannot_read, fmt_num, negative_channel, FILE_START, MAX_DIAGNOSTICS};
+use crate::scene::lighting::emit::GroupScan;
+use crate::scene::{
     CameraSource, Diagnostic, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
     SmoothId, SourcePos, Warning,
 };
-use crate::color::Rgb;
 use glam::{DVec2, DVec3, Vec3};
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
@@ -158,7 +158,7 @@ pub const MAX_UNDEFINED_WARNINGS: usize = 10;
 pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 
 /// Reads the OBJ file at `path`, its material libraries, and the camera:
-/// framed around the model ([`super::frame_camera`]), or from the `.sc` file
+/// framed around the model ([`crate::scene::frame_camera`]), or from the `.sc` file
 /// `camera` when given (see [`Scene::with_camera_from`]).
 ///
 /// Errors name the file (the OBJ, an MTL, or the camera file), the line
@@ -493,7 +493,7 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
         p.surface.two_sided = true;
     }
     let mut scene = Scene {
-        camera: super::frame_camera(&polygons),
+        camera: crate::scene::frame_camera(&polygons),
         polygons,
         materials,
         camera_source: CameraSource::AutoFramed,
