@@ -11,7 +11,7 @@ mod framing;
 pub mod import;
 mod lighting;
 mod polygon;
-mod repair;
+pub mod repair;
 
 pub use error::{Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
 pub use framing::{

@@ -11,7 +11,7 @@
 //! Each side then receives, reflects and (for an emitter) emits on its
 //! own, with its own element mesh and its own radiosity, so a thin wall
 //! lit on one side stays dark on the other. The two sides are coplanar,
-//! and coplanar polygons never block each other (see [`crate::scene::coplanar`]).
+//! and coplanar polygons never block each other (see [`super::coplanar`]).
 //!
 //! A face that repeats an earlier one exactly (same vertices in the same
 //! cyclic order, as in McGuire's widely used `CornellBox-Original.obj`)

@@ -1,6 +1,6 @@
 //! Closed solids: two-sided faces whose inside nobody can see.
 //!
-//! OBJ faces are two-sided ([`crate::scene::sides`]): a back copy lets a room
+//! OBJ faces are two-sided ([`super::sides`]): a back copy lets a room
 //! modelled with outward normals be lit from inside. But most closed
 //! meshes of a model are *solids*, a box on a floor, a table leg, a
 //! statue: their inside is sealed off. Back copies there cost elements and

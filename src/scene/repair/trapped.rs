@@ -1,7 +1,7 @@
 //! Emitting sides that face a surface across a narrow gap.
 //!
 //! OBJ faces are read as two-sided, and so are the faces of a glTF
-//! material marked `doubleSided` (see [`crate::scene::sides`]): each side of an
+//! material marked `doubleSided` (see [`super::sides`]): each side of an
 //! emitting face then emits. That is what Blender does with an emitting
 //! plane, and right for a lamp hanging in a room. It is wrong for the lamp
 //! modelled as one face just under a ceiling, as in McGuire's widely used
