@@ -5,6 +5,14 @@
 //! It knows nothing of meshing or light transport. Loading validates
 //! everything the format promises (planar, convex, non-degenerate polygons;
 //! reflectance below one), so later stages may rely on it.
+//!
+//! Here are the types, polygon validation (`polygon.rs`), the diagnostics
+//! of loading ([`Diagnostic`], [`Warning`]) and camera framing
+//! ([`frame_camera`]). Three rooms do the rest: [`import`] turns files
+//! into a scene ([`load`] picks the reader by extension); [`repair`] runs
+//! the passes that make real exports solvable, in their one order
+//! ([`repair::run`]); `lighting` decides what emits (`--emit` names,
+//! `--ies` luminaires, the `--sky`, photometric units).
 
 mod error;
 mod framing;
