@@ -12,6 +12,9 @@ use radiosity::visibility::Visibility;
 use rayon::prelude::*;
 use std::path::Path;
 
+#[path = "../examples/support/hall.rs"]
+mod hall;
+
 /// Segments per measured batch.
 const SEGMENTS: usize = 20_000;
 
@@ -48,7 +51,7 @@ fn segments(scene: &Scene) -> Vec<(Vec3, Vec3, (PolygonId, PolygonId))> {
 fn bench_visibility(c: &mut Criterion) {
     let cornell = scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.sc"))
         .expect("cornell");
-    let hall = scene::parse_str(&scene::hall::hall_sc(15), "hall.sc").expect("hall");
+    let hall = scene::parse_str(&hall::hall_sc(15), "hall.sc").expect("hall");
     let mut group = c.benchmark_group("shadow rays");
     group.throughput(Throughput::Elements(SEGMENTS as u64));
     group.sample_size(10);

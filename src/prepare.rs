@@ -1,23 +1,26 @@
 //! Preparing a scene for solving: load it (with a camera override), make
-//! what `--emit` names emit ([`Scene::set_emission`]), put the `--sky`
-//! around it ([`Scene::add_sky`]), say on stderr what
-//! the loader changed or ignored and whether nothing emits
-//! ([`scene::Warning`], [`Scene::nothing_emits_warning`]), silence the
-//! side of a two-sided lamp that faces a ceiling across a narrow gap
-//! ([`Scene::silence_covered_sides`]), split polygons
-//! where others pass through them ([`Scene::split_intersections`]), check
-//! the mesh size against the element limit before allocating anything,
-//! mesh it and build the visibility BVH. What the batch run, the window
-//! and the examples all start from.
+//! what `--emit` names emit ([`Scene::set_emission`]) and what `--ies`
+//! names luminaires ([`Scene::set_luminaire`]), run the repair passes in
+//! their one order ([`repair::run`]: solids keep their outside, polygons
+//! are split where others pass through them, back copies, the `--sky`
+//! around it, the side of a two-sided lamp that faces a ceiling across a
+//! narrow gap silenced), say on stderr what the loader and the passes
+//! changed or ignored and whether nothing emits ([`scene::Warning`],
+//! [`Scene::nothing_emits_warning`]), check the mesh size against the
+//! element limit before allocating anything, mesh it and build the
+//! visibility BVH. What the batch run, the window and the examples all
+//! start from.
 
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
+use crate::scene::repair::{self, FirstHit, RepairOptions};
 use crate::scene::{
     self, IesError, LoadError, LuminaireError, Photometry, PolygonError, Scene, SplitStats,
     UnknownName,
 };
 use crate::visibility::Visibility;
+use glam::Vec3;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
@@ -159,37 +162,25 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
                 .map_err(|e| PrepareError::Luminaire(name.clone(), Box::new(e)))?;
         }
     }
-    // Solids keep their outside only. Found before the cuts, which leave
-    // T-junctions on a box sunk into a floor; the pieces keep the mark.
-    if let Some(warning) = scene.orient_solids(config.sides, &config.scene.display_name()) {
-        scene.warnings.push(warning);
-    }
-    // Not a quirk of the file, so no warning: geometry passing through
-    // geometry is how models are built. Before the back copies, so that
-    // each piece gets its own.
-    let split = scene.split_intersections();
-    let mut scene = scene.with_sides(config.sides);
-    scene.light_luminaire_backs();
-    // Last, after everything that adds or changes polygons, so that the
-    // enclosure is built around the finished scene.
-    if let Some(sky) = config.sky {
-        scene.add_sky(sky).map_err(PrepareError::Sky)?;
-    }
-    // An emitting face with two sides, one just under a ceiling, emits
-    // from the other only. Rays find the gap, so such a scene builds its
-    // BVH here, on the finished geometry (silencing a side changes only a
-    // material), and keeps it.
-    let visibility = OnceLock::new();
+    // The passes that make the geometry solvable, in their one order; the
+    // BVH they build to find trapped sides is kept for the solve.
     let mut bvh_seconds = 0.0;
-    if scene.emits_from_both_sides() {
+    let name = config.scene.display_name();
+    let options = RepairOptions {
+        sides: config.sides,
+        sky: config.sky,
+        file: &name,
+    };
+    let (mut scene, repaired) = repair::run(scene, &options, |scene| {
         let t = Instant::now();
-        let built = Visibility::new(&scene);
+        let built = Visibility::new(scene);
         bvh_seconds = t.elapsed().as_secs_f64();
-        let first_hit = |origin, direction| built.first_hit(origin, direction).map(|hit| hit.1);
-        if let Some(warning) = scene.silence_covered_sides(first_hit, &config.scene.display_name())
-        {
-            scene.warnings.push(warning);
-        }
+        built
+    })
+    .map_err(PrepareError::Sky)?;
+    let split = repaired.split;
+    let visibility = OnceLock::new();
+    if let Some(built) = repaired.rays {
         // Set once, here, before anyone can read it.
         let _ = visibility.set((built, bvh_seconds));
     }
@@ -221,6 +212,14 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         seconds,
         split,
     })
+}
+
+/// The BVH casts the rays of the trapped-sides pass
+/// ([`Scene::silence_covered_sides`]).
+impl FirstHit for Visibility {
+    fn first_hit_distance(&self, origin: Vec3, direction: Vec3) -> Option<f32> {
+        self.first_hit(origin, direction).map(|hit| hit.1)
+    }
 }
 
 /// Loads the scene from its source, with the camera of the `.sc` file

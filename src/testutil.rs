@@ -6,6 +6,14 @@ use crate::scene::{
 };
 use glam::{DVec3, Vec3};
 
+/// The generated hall of tables and chairs, shared with the examples and
+/// the benches.
+#[path = "../examples/support/hall.rs"]
+pub mod hall;
+/// The generated Cornell box with two UV spheres, shared with the examples.
+#[path = "../examples/support/sphere_box.rs"]
+pub mod sphere_box;
+
 /// Marsaglia's xorshift64: a tiny deterministic pseudo-random stream, so
 /// that randomized tests draw the same cases on every run.
 pub struct Xorshift(pub u64);

@@ -8,7 +8,7 @@ mod support;
 use common::{run_in, stderr};
 use glam::Vec3;
 use radiosity::color::Rgb;
-use radiosity::scene::gltf::parse_gltf;
+use radiosity::scene::parse_gltf;
 use radiosity::scene::{self, CameraSource, GroupKind, LoadError, Scene};
 use serde_json::json;
 use support::{png_data_uri, Doc};

@@ -93,7 +93,7 @@ pub enum RunError {
     /// The `--illuminance-at` points file is bad or unreadable; the
     /// message reads `FILE:LINE:COL: error: ...`.
     #[error("{0}")]
-    Points(#[from] crate::scene::points::PointsError),
+    Points(#[from] crate::scene::PointsError),
 }
 
 impl RunError {

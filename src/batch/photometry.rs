@@ -16,7 +16,7 @@ use crate::output::{self, illuminance as out};
 use crate::prepare::Prepared;
 use crate::render::falsecolor::{self, Mapping, Quantity};
 use crate::render::{Frame, View};
-use crate::scene::points;
+use crate::scene::import::points;
 use crate::scene::Photometric;
 use crate::solver::gather::{vertex_irradiance, FinalGather};
 use std::time::Instant;

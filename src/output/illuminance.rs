@@ -11,7 +11,7 @@
 use super::{write_atomically, write_rgb8, OutputError};
 use crate::color::Rgb;
 use crate::render::falsecolor::{self, Mapping, Scale};
-use crate::scene::points::MeasurementPoint;
+use crate::scene::MeasurementPoint;
 use crate::scene::{Photometric, Scene, Units};
 use glam::Vec3;
 use std::path::Path;

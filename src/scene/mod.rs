@@ -5,53 +5,53 @@
 //! It knows nothing of meshing or light transport. Loading validates
 //! everything the format promises (planar, convex, non-degenerate polygons;
 //! reflectance below one), so later stages may rely on it.
+//!
+//! Here are the types, polygon validation (`polygon.rs`), the diagnostics
+//! of loading ([`Diagnostic`], [`Warning`]) and camera framing
+//! ([`frame_camera`]). Three rooms do the rest: [`import`] turns files
+//! into a scene ([`load`] picks the reader by extension); [`repair`] runs
+//! the passes that make real exports solvable, in their one order
+//! ([`repair::run`]); `lighting` decides what emits (`--emit` names,
+//! `--ies` luminaires, the `--sky`, photometric units).
 
-mod coplanar;
-mod emit;
 mod error;
 mod framing;
-pub mod gltf;
-pub mod hall;
-pub mod ies;
-mod luminaire;
-pub mod obj;
-pub mod points;
+pub mod import;
+mod lighting;
 mod polygon;
-mod sc;
-mod sides;
-mod sky;
-mod solids;
-pub mod sphere_box;
-mod split;
-mod trapped;
-mod units;
+pub mod repair;
 
-pub use coplanar::{
-    covered_by, draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE,
-    PLANE_OFFSET_TOLERANCE,
-};
-pub use emit::{
-    looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
-};
 pub use error::{Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
 pub use framing::{
     frame_camera, EYE_ACROSS_FRACTIONS, EYE_ALONG_FRACTIONS, EYE_CLEARANCE_FRACTION,
     EYE_HEIGHT_FRACTIONS, FRAMING_RAYS, RAY_EDGE_TOLERANCE, RAY_PARALLEL_COSINE, ROOM_FOV_DEG,
     ROOM_MIN_FRONT_FRACTION, ROOM_PROBE_OFFSET,
 };
-pub use ies::{IesError, Photometry};
-pub use luminaire::{Luminaire, LuminaireError};
-pub use obj::load_obj;
+pub use import::gltf::parse_gltf;
+pub use import::ies::{IesError, Photometry};
+pub use import::load;
+pub use import::obj::load_obj;
+pub use import::points::{load_points, MeasurementPoint, PointsError};
+pub use import::sc::{
+    load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION,
+};
+pub use lighting::emit::{
+    looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
+};
+pub use lighting::luminaire::{Luminaire, LuminaireError};
+pub use lighting::sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
+pub use lighting::units::{Photometric, Units};
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, MAX_COORDINATE, MIN_EXTENT,
     PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE, ZERO_AREA_TOLERANCE,
 };
-pub use sc::{load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION};
-pub use sides::Sides;
-pub use sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
-pub use split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
-pub use trapped::COVERED_GAP_SHARE;
-pub use units::{Photometric, Units};
+pub use repair::coplanar::{
+    covered_by, draw_layers, plane_classes, MAX_DRAW_LAYER, PLANE_NORMAL_TOLERANCE,
+    PLANE_OFFSET_TOLERANCE,
+};
+pub use repair::sides::Sides;
+pub use repair::split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
+pub use repair::trapped::COVERED_GAP_SHARE;
 
 /// The camera lives in [`crate::camera`], below the scene; these are
 /// re-exported because every scene has one.
@@ -266,24 +266,6 @@ pub(crate) fn polygon_bounds(polygons: &[Polygon]) -> (Vec3, Vec3) {
     match it.next() {
         None => (Vec3::ZERO, Vec3::ZERO),
         Some(first) => it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))),
-    }
-}
-
-/// Reads and parses a scene file, by its extension in any case:
-/// Wavefront OBJ (with its MTL libraries) for `.obj`, glTF 2.0 for
-/// `.gltf` and `.glb`, else `.sc`. Errors carry the file name and the
-/// line and column (for glTF, the JSON path).
-pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let is = |ext: &str| {
-        path.extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
-    };
-    if is("obj") {
-        obj::load_obj(path, None)
-    } else if is("gltf") || is("glb") {
-        self::gltf::load_gltf(path, None)
-    } else {
-        sc::load_file(path)
     }
 }
 

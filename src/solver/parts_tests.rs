@@ -13,7 +13,7 @@ use std::time::Duration;
 /// The one-table hall at a lenmax that gives its floor more vertices than
 /// one chunk holds, so the floor is cut into pieces.
 fn hall() -> (Scene, Mesh) {
-    let s = crate::scene::parse_str(&crate::scene::hall::hall_sc(1), "hall.sc").unwrap();
+    let s = crate::scene::parse_str(&crate::testutil::hall::hall_sc(1), "hall.sc").unwrap();
     let m = mesh::build(
         &s,
         &MeshOptions {

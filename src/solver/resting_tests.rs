@@ -4,7 +4,7 @@
 //! shot there adds up at every bounce ([`super::cluster::PLANE_DEPTH_RATIO`]).
 
 use super::*;
-use crate::scene::sphere_box::uv_sphere;
+use crate::testutil::sphere_box::uv_sphere;
 use crate::testutil::{closed_box, grey, polygon, regular_mesh, scene};
 use glam::Vec3;
 

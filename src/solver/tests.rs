@@ -1519,7 +1519,7 @@ fn first_look_is_what_a_new_solver_shows() {
 /// within 2 %), with the same bits on 1 and 2 threads.
 #[test]
 fn shared_facet_rays_match_per_vertex_rays() {
-    let s = crate::scene::parse_str(&crate::scene::sphere_box::sphere_box_sc(24), "t.sc")
+    let s = crate::scene::parse_str(&crate::testutil::sphere_box::sphere_box_sc(24), "t.sc")
         .expect("the generated scene parses");
     let mesh = crate::testutil::regular_mesh(&s, 80.0);
     let vis = Visibility::new(&s);

@@ -20,8 +20,8 @@
 //! its emission, it receives nothing), and it shoots from a grid of its own
 //! (see `solver::formfactor::SKY_FACET_SAMPLES`).
 
-use super::{Material, MaterialId, Polygon, PolygonError, Scene, SourcePos, Surface};
 use crate::color::Rgb;
+use crate::scene::{Material, MaterialId, Polygon, PolygonError, Scene, SourcePos, Surface};
 use glam::DVec3;
 
 /// Times the icosahedron's triangles are split in four for the sky: 1
@@ -46,7 +46,7 @@ const EMPTY_SCENE_HALF_DIAGONAL: f32 = 1.0;
 impl Scene {
     /// Adds a uniform diffuse sky of `radiosity` (in the scene's units,
     /// every channel finite, `>= 0` and at most
-    /// [`MAX_EMISSION`](super::MAX_EMISSION)) around the scene: a material
+    /// [`MAX_EMISSION`](crate::scene::MAX_EMISSION)) around the scene: a material
     /// named [`SKY_MATERIAL_NAME`] emitting it with no reflectance, and the
     /// inward-facing facets of the enclosure described in the module docs,
     /// appended after every other polygon with [`Surface::sky`] set. The
@@ -54,7 +54,7 @@ impl Scene {
     /// one gives the same enclosure again.
     ///
     /// Fails only when the enclosure's coordinates would pass
-    /// [`MAX_COORDINATE`](super::MAX_COORDINATE) (a scene within a tenth of
+    /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE) (a scene within a tenth of
     /// that limit).
     pub fn add_sky(&mut self, radiosity: Rgb) -> Result<(), PolygonError> {
         let (lo, hi) = self.bounds();

@@ -50,7 +50,7 @@
 //! piece keeps the original's vertex order (so its front), material,
 //! origin and [`Surface`], and the pieces of a polygon take its place in
 //! [`Scene::polygons`] (so the order stays deterministic) and in every
-//! [`Group`](super::Group) it belongs to. A piece that [`Polygon::new`]
+//! [`Group`](crate::scene::Group) it belongs to. A piece that [`Polygon::new`]
 //! would refuse (a sliver below its tolerances) is not made: its polygon
 //! stays whole across that cut.
 //!
@@ -64,7 +64,7 @@
 //! half of them sunk) take under half a CPU-second, building the scene
 //! included (the test `a_hundred_thousand_polygons_split_as_counted`).
 
-use super::{Polygon, PolygonId, Scene};
+use crate::scene::{Polygon, PolygonId, Scene};
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;

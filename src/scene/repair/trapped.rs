@@ -17,8 +17,8 @@
 //! [`Scene::silence_covered_sides`] finds each such side and makes it
 //! emit nothing (it still reflects), with one warning for the file.
 
-use super::error::Warning;
-use super::{Material, MaterialId, Polygon, Scene};
+use crate::scene::error::Warning;
+use crate::scene::{Material, MaterialId, Polygon, Scene};
 use glam::Vec3;
 use std::collections::HashMap;
 

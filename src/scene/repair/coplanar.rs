@@ -16,7 +16,7 @@
 //! earlier one it overlaps, and an emitter above every non-emitter it
 //! overlaps, so the later in the file, or the emitter, is on top.
 
-use super::{Polygon, Scene};
+use crate::scene::{Polygon, Scene};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
@@ -170,7 +170,7 @@ fn class_members(scene: &Scene, classes: &[u32]) -> Vec<Vec<usize>> {
     }
     let emits = |i: usize| {
         scene
-            .material_of(super::PolygonId(i as u32))
+            .material_of(crate::scene::PolygonId(i as u32))
             .emission()
             .max_channel()
             > 0.0

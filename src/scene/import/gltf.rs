@@ -29,12 +29,12 @@
 //!   `KHR_materials_emissive_strength` × the average of
 //!   `emissiveTexture`, in the scene's radiosity units; a material that
 //!   both reflects and emits follows [`Material::with_emission`];
-//!   `doubleSided` sets [`Surface::two_sided`](super::Surface);
+//!   `doubleSided` sets [`Surface::two_sided`](crate::scene::Surface);
 //! - the first perspective camera met in the node order: its node's eye,
 //!   looking along its −z with its +y up, `yfov`, and a picture 480 pixels
 //!   high and `aspectRatio` times as wide (the default size without one);
 //!   without a camera the view is framed as for OBJ
-//!   ([`super::frame_camera`]);
+//!   ([`crate::scene::frame_camera`]);
 //! - node and mesh names, as [`Scene::groups`] (objects and meshes), for
 //!   `--emit` and the warning when nothing emits; material names as they
 //!   are (an unnamed material is `materials[N]`).
@@ -74,23 +74,26 @@
 //! type or reaching outside their buffer views, vertex indices out of
 //! range, non-finite or negative colour factors, emission above
 //! [`MAX_EMISSION`], node graphs that are not trees, triangles that no
-//! [`Polygon`] may be (coordinates beyond [`super::MAX_COORDINATE`]), and
+//! [`Polygon`] may be (coordinates beyond [`crate::scene::MAX_COORDINATE`]), and
 //! a file with no triangles.
 //!
 //! glTF polygons have no line in a file: their [`Polygon::origin`] is
 //! `0:0`.
 
-use super::error::{fmt_num, MAX_DIAGNOSTICS};
+mod glb;
+
 use super::obj::{average_image, is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
-use super::{
+use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
+use crate::color::Rgb;
+use crate::scene::error::{fmt_num, MAX_DIAGNOSTICS};
+use crate::scene::{
     CameraSource, Diagnostic, Group, GroupKind, LoadError, Material, MaterialId, Polygon, Scene,
     SmoothId, SourcePos, Warning, MAX_EMISSION,
 };
-use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
-use crate::color::Rgb;
 use ::gltf::json;
 use base64::Engine as _;
 use glam::{DMat4, DQuat, DVec3, Vec3};
+use glb::parse_glb;
 use json::validation::{Checked, Validate};
 use std::collections::HashMap;
 use std::path::Path;
@@ -158,81 +161,6 @@ pub fn parse_gltf(bytes: &[u8], file: &str, read_uri: &ReadUri<'_>) -> Result<Sc
     let mut reader = Reader::new(&document, file, blob, read_uri);
     reader.warnings = warnings;
     reader.read()
-}
-
-// ---------------------------------------------------------------- glb --
-
-/// The chunks of a glb file.
-struct Glb<'a> {
-    json: &'a [u8],
-    bin: Option<&'a [u8]>,
-}
-
-/// A little-endian `u32` at `at`, if the bytes reach that far.
-fn u32_at(bytes: &[u8], at: usize) -> Option<u32> {
-    let b = bytes.get(at..at.checked_add(4)?)?;
-    Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-}
-
-/// Splits a glb into its JSON and BIN chunks (unknown chunks are skipped,
-/// as the specification says); errors give the byte offset.
-fn parse_glb(bytes: &[u8]) -> Result<Glb<'_>, String> {
-    let at = |offset: usize, message: String| format!("glb, byte {offset}: {message}");
-    let n = bytes.len();
-    let (Some(version), Some(length)) = (u32_at(bytes, 4), u32_at(bytes, 8)) else {
-        return Err(at(
-            0,
-            format!("the file has {n} bytes, less than a glb header (12)"),
-        ));
-    };
-    if version != 2 {
-        return Err(at(
-            4,
-            format!("glb version {version}; only glTF 2.0 is read"),
-        ));
-    }
-    let length = length as usize;
-    if length > n {
-        return Err(at(
-            8,
-            format!("the header says {length} bytes but the file has {n} (truncated?)"),
-        ));
-    }
-    let data = &bytes[..length];
-    let mut chunks: Vec<(usize, u32, &[u8])> = Vec::new();
-    let mut offset = 12;
-    while offset < data.len() {
-        let (Some(len), Some(kind)) = (u32_at(data, offset), u32_at(data, offset + 4)) else {
-            return Err(at(offset, "a chunk header is cut off".to_string()));
-        };
-        let start = offset + 8;
-        let Some(chunk) = start
-            .checked_add(len as usize)
-            .and_then(|end| data.get(start..end))
-        else {
-            return Err(at(
-                offset,
-                format!(
-                    "a chunk of {len} bytes runs past the end of the file ({} bytes left)",
-                    data.len() - start.min(data.len())
-                ),
-            ));
-        };
-        chunks.push((offset, kind, chunk));
-        // Chunks are 4-byte aligned; a writer that did not pad is read
-        // as written.
-        offset = start + len as usize;
-    }
-    const JSON: u32 = 0x4E4F_534A;
-    const BIN: u32 = 0x004E_4942;
-    match chunks.first() {
-        Some(&(_, JSON, json)) => Ok(Glb {
-            json,
-            bin: chunks.get(1).filter(|c| c.1 == BIN).map(|c| c.2),
-        }),
-        Some(&(offset, _, _)) => Err(at(offset, "the first chunk is not JSON".to_string())),
-        None => Err(at(12, "the file has no JSON chunk".to_string())),
-    }
 }
 
 /// The diagnostic for JSON that does not parse: at its line and column in
@@ -328,6 +256,88 @@ fn validate(root: &json::Root, file: &str, warnings: &mut Vec<Warning>) -> Resul
 
 // ------------------------------------------------------------ reading --
 
+/// What the walk over the scene's nodes gathers, in node order.
+#[derive(Default)]
+struct Gathered {
+    polygons: Vec<Polygon>,
+    /// The named nodes and meshes, in order of first appearance.
+    groups: Vec<Group>,
+    group_index: HashMap<(GroupKind, String), usize>,
+    degenerate: Tally<String>,
+    /// Primitives of points or lines.
+    skipped: Tally<String>,
+    /// The material added for primitives that name none, once needed.
+    default_material: Option<MaterialId>,
+    next_smooth: u32,
+    /// The first camera of a node that could be read.
+    camera: Option<Camera>,
+    /// Why the first camera that could not be read could not.
+    camera_problem: Option<String>,
+    /// `KHR_lights_punctual` lights, which are not read.
+    lights: Tally<String>,
+}
+
+impl Gathered {
+    /// Counts a light on `instance`'s node, and takes its camera when no
+    /// camera has been read yet.
+    fn note_light_and_camera(&mut self, instance: &Instance<'_>) {
+        let node = &instance.node;
+        if let Some(light) = node.light() {
+            self.lights.add(format!("nodes[{}]", node.index()), || {
+                light
+                    .name()
+                    .map_or_else(|| format!("lights[{}]", light.index()), str::to_string)
+            });
+        }
+        if let Some(cam) = node.camera() {
+            if self.camera.is_none() {
+                match make_camera(&cam, &instance.world) {
+                    Ok(c) => self.camera = Some(c),
+                    Err(why) => {
+                        self.camera_problem.get_or_insert(format!(
+                            "nodes[{}]: camera `cameras[{}]` {why}",
+                            node.index(),
+                            cam.index()
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds the polygons from `first_polygon` on (those `instance` drew of
+    /// `mesh`) to the groups of the node's and the mesh's names.
+    fn group(&mut self, instance: &Instance<'_>, mesh: &::gltf::Mesh<'_>, first_polygon: usize) {
+        let ids = first_polygon..self.polygons.len();
+        if ids.is_empty() {
+            return;
+        }
+        let names = [
+            (GroupKind::Object, instance.node.name()),
+            (GroupKind::Mesh, mesh.name()),
+        ];
+        for (kind, name) in names {
+            let Some(name) = name.filter(|n| !n.is_empty()) else {
+                continue;
+            };
+            let g = *self
+                .group_index
+                .entry((kind, name.to_string()))
+                .or_insert_with(|| {
+                    self.groups.push(Group {
+                        name: name.to_string(),
+                        kind,
+                        polygons: Vec::new(),
+                    });
+                    self.groups.len() - 1
+                });
+            self.groups[g]
+                .polygons
+                .extend(ids.clone().map(|i| crate::scene::PolygonId(i as u32)));
+        }
+    }
+}
+
 /// One glTF document being read into a scene.
 struct Reader<'a> {
     doc: &'a ::gltf::Document,
@@ -404,153 +414,129 @@ impl<'a> Reader<'a> {
             }
         };
         let (mut materials, non_diffuse, bright) = self.materials();
-        let mut polygons: Vec<Polygon> = Vec::new();
-        let mut groups: Vec<Group> = Vec::new();
-        let mut group_index: HashMap<(GroupKind, String), usize> = HashMap::new();
-        let mut degenerate: Tally<String> = Tally::default();
-        let mut skipped: Tally<String> = Tally::default();
-        let mut default_material = None;
-        let mut next_smooth = 0u32;
-        let mut camera = None;
-        let mut camera_problem: Option<String> = None;
-        let mut lights: Tally<String> = Tally::default();
+        let mut gathered = Gathered::default();
         for instance in &instances {
-            let node = &instance.node;
-            if let Some(light) = node.light() {
-                lights.add(format!("nodes[{}]", node.index()), || {
-                    light
-                        .name()
-                        .map_or_else(|| format!("lights[{}]", light.index()), str::to_string)
-                });
-            }
-            if let Some(cam) = node.camera() {
-                if camera.is_none() {
-                    match make_camera(&cam, &instance.world) {
-                        Ok(c) => camera = Some(c),
-                        Err(why) => {
-                            camera_problem.get_or_insert(format!(
-                                "nodes[{}]: camera `cameras[{}]` {why}",
-                                node.index(),
-                                cam.index()
-                            ));
-                        }
-                    }
-                }
-            }
-            let Some(mesh) = node.mesh() else {
+            gathered.note_light_and_camera(instance);
+            let Some(mesh) = instance.node.mesh() else {
                 continue;
             };
-            let first_polygon = polygons.len();
-            let mirrored = instance.world.determinant() < 0.0;
-            for primitive in mesh.primitives() {
-                let path = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
-                use ::gltf::mesh::Mode;
-                let mode = primitive.mode();
-                if !matches!(
-                    mode,
-                    Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-                ) {
-                    skipped.add(path.clone(), || format!("{mode:?}"));
-                    continue;
-                }
-                let material = match primitive.material().index() {
-                    Some(i) => MaterialId(i as u32),
-                    None => *default_material.get_or_insert_with(|| {
-                        materials.push(super::obj::default_material(DEFAULT_MATERIAL_NAME));
-                        MaterialId(materials.len() as u32 - 1)
-                    }),
-                };
-                let two_sided = primitive.material().double_sided();
-                let triangles = match self.triangles(&primitive, &path) {
-                    Ok(t) => t,
-                    Err(message) => {
-                        self.error(message);
-                        continue;
-                    }
-                };
-                let smooth = (primitive.indices().is_some()
-                    && primitive.get(&::gltf::Semantic::Normals).is_some())
-                .then(|| {
-                    next_smooth += 1;
-                    SmoothId(next_smooth - 1)
-                });
-                for (k, corners) in triangles.iter().enumerate() {
-                    let mut v: Vec<Vec3> = corners
-                        .iter()
-                        .map(|p| instance.world.transform_point3(p.as_dvec3()).as_vec3())
-                        .collect();
-                    if mirrored {
-                        v.swap(1, 2);
-                    }
-                    match Polygon::new(material, v, SourcePos::default()) {
-                        Ok(mut p) => {
-                            p.surface.two_sided = two_sided;
-                            p.surface.smooth = smooth;
-                            polygons.push(p);
-                        }
-                        Err(e) if is_degenerate(&e) => degenerate.add(
-                            format!("{path} (nodes[{}]), triangle {k}", node.index()),
-                            || e.to_string(),
-                        ),
-                        Err(e) => {
-                            self.error(format!(
-                                "{path} (nodes[{}]), triangle {k}: {e}",
-                                node.index()
-                            ));
-                            break;
-                        }
-                    }
-                }
-            }
-            let ids = first_polygon..polygons.len();
-            if ids.is_empty() {
+            let first_polygon = gathered.polygons.len();
+            self.mesh_polygons(instance, &mesh, &mut materials, &mut gathered);
+            gathered.group(instance, &mesh, first_polygon);
+        }
+        self.finish(gathered, materials, non_diffuse, bright)
+    }
+
+    /// The triangles of every primitive of `mesh` drawn by `instance`, in
+    /// world space, into `gathered`; the default material is added to
+    /// `materials` when a primitive first needs it. Primitives of points
+    /// or lines are skipped (and counted), degenerate triangles dropped
+    /// (and counted); other bad ones are errors.
+    fn mesh_polygons(
+        &mut self,
+        instance: &Instance<'a>,
+        mesh: &::gltf::Mesh<'a>,
+        materials: &mut Vec<Material>,
+        gathered: &mut Gathered,
+    ) {
+        let node = &instance.node;
+        let mirrored = instance.world.determinant() < 0.0;
+        for primitive in mesh.primitives() {
+            let path = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
+            use ::gltf::mesh::Mode;
+            let mode = primitive.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                gathered.skipped.add(path.clone(), || format!("{mode:?}"));
                 continue;
             }
-            let names = [
-                (GroupKind::Object, node.name()),
-                (GroupKind::Mesh, mesh.name()),
-            ];
-            for (kind, name) in names {
-                let Some(name) = name.filter(|n| !n.is_empty()) else {
+            let material = match primitive.material().index() {
+                Some(i) => MaterialId(i as u32),
+                None => *gathered.default_material.get_or_insert_with(|| {
+                    materials.push(super::obj::default_material(DEFAULT_MATERIAL_NAME));
+                    MaterialId(materials.len() as u32 - 1)
+                }),
+            };
+            let two_sided = primitive.material().double_sided();
+            let triangles = match self.triangles(&primitive, &path) {
+                Ok(t) => t,
+                Err(message) => {
+                    self.error(message);
                     continue;
-                };
-                let g = *group_index
-                    .entry((kind, name.to_string()))
-                    .or_insert_with(|| {
-                        groups.push(Group {
-                            name: name.to_string(),
-                            kind,
-                            polygons: Vec::new(),
-                        });
-                        groups.len() - 1
-                    });
-                groups[g]
-                    .polygons
-                    .extend(ids.clone().map(|i| super::PolygonId(i as u32)));
+                }
+            };
+            let smooth = (primitive.indices().is_some()
+                && primitive.get(&::gltf::Semantic::Normals).is_some())
+            .then(|| {
+                gathered.next_smooth += 1;
+                SmoothId(gathered.next_smooth - 1)
+            });
+            for (k, corners) in triangles.iter().enumerate() {
+                let mut v: Vec<Vec3> = corners
+                    .iter()
+                    .map(|p| instance.world.transform_point3(p.as_dvec3()).as_vec3())
+                    .collect();
+                if mirrored {
+                    v.swap(1, 2);
+                }
+                match Polygon::new(material, v, SourcePos::default()) {
+                    Ok(mut p) => {
+                        p.surface.two_sided = two_sided;
+                        p.surface.smooth = smooth;
+                        gathered.polygons.push(p);
+                    }
+                    Err(e) if is_degenerate(&e) => gathered.degenerate.add(
+                        format!("{path} (nodes[{}]), triangle {k}", node.index()),
+                        || e.to_string(),
+                    ),
+                    Err(e) => {
+                        self.error(format!(
+                            "{path} (nodes[{}]), triangle {k}: {e}",
+                            node.index()
+                        ));
+                        break;
+                    }
+                }
             }
         }
-        if let Some((path, mode)) = skipped.first {
+    }
+
+    /// The scene from what the walk over the nodes gathered: the errors,
+    /// else the warnings in their order (skipped primitives, degenerate
+    /// triangles, bright and non-diffuse materials, lights, animations,
+    /// the camera), the camera aimed or framed, repeated faces dropped.
+    fn finish(
+        mut self,
+        gathered: Gathered,
+        materials: Vec<Material>,
+        non_diffuse: Vec<String>,
+        bright: Vec<String>,
+    ) -> Result<Scene, LoadError> {
+        let file = self.file;
+        if let Some((path, mode)) = gathered.skipped.first {
             let message = format!(
                 "{} primitive(s) of points or lines skipped (the first {path}, mode {mode}): \
                  only triangles are surfaces",
-                skipped.count
+                gathered.skipped.count
             );
-            if polygons.is_empty() && self.diags.is_empty() {
+            if gathered.polygons.is_empty() && self.diags.is_empty() {
                 return Err(Diagnostic::whole(file, format!("{path}: {message}")).into());
             }
             self.warnings.push(Warning::file(file, message));
         }
-        if let Some((path, why)) = degenerate.first {
+        if let Some((path, why)) = gathered.degenerate.first {
             self.warnings.push(Warning::file(
                 file,
                 format!(
                     "dropped {} degenerate triangle(s) (no area, or a vertex repeated); the \
                      first {path}: {why}",
-                    degenerate.count
+                    gathered.degenerate.count
                 ),
             ));
         }
-        if self.diags.is_empty() && polygons.is_empty() {
+        if self.diags.is_empty() && gathered.polygons.is_empty() {
             self.error(
                 "glTF file has no triangles in its scene (no node of it draws a mesh)".to_string(),
             );
@@ -575,7 +561,7 @@ impl<'a> Reader<'a> {
                 format!("treated as diffuse: {}", name_list(&non_diffuse)),
             ));
         }
-        if let Some((path, name)) = lights.first {
+        if let Some((path, name)) = gathered.lights.first {
             self.warnings.push(Warning::file(
                 file,
                 format!(
@@ -583,7 +569,7 @@ impl<'a> Reader<'a> {
                      point, spot or sun light is not a polygon and gives no light here; make a \
                      surface emit with --emit NAME=VALUE, or light the model from all around \
                      with --sky VALUE",
-                    lights.count
+                    gathered.lights.count
                 ),
             ));
         }
@@ -593,6 +579,13 @@ impl<'a> Reader<'a> {
                 "animations and skins are ignored: the model is read in its rest pose",
             ));
         }
+        let Gathered {
+            polygons,
+            groups,
+            mut camera,
+            camera_problem,
+            ..
+        } = gathered;
         if let Some(c) = camera.as_mut() {
             aim_at_the_model(c, &polygons);
         }
@@ -610,7 +603,7 @@ impl<'a> Reader<'a> {
             }
         }
         let mut scene = Scene {
-            camera: camera.unwrap_or_else(|| super::frame_camera(&polygons)),
+            camera: camera.unwrap_or_else(|| crate::scene::frame_camera(&polygons)),
             camera_source,
             polygons,
             materials,
@@ -1118,7 +1111,7 @@ fn make_camera(camera: &::gltf::Camera<'_>, world: &DMat4) -> Result<Camera, Str
 /// the model's centre, so that the window orbits the model; the view
 /// itself does not change. Left alone when the centre is behind the eye.
 fn aim_at_the_model(camera: &mut Camera, polygons: &[Polygon]) {
-    let (lo, hi) = super::polygon_bounds(polygons);
+    let (lo, hi) = crate::scene::polygon_bounds(polygons);
     let centre = (0.5 * (lo + hi)).as_dvec3();
     let eye = camera.eye.as_dvec3();
     let forward = (camera.lookat - camera.eye).as_dvec3().normalize_or_zero();

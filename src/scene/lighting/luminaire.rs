@@ -15,9 +15,9 @@
 //! distribution.
 
 use super::emit::UnknownName;
-use super::ies::Photometry;
-use super::{Material, MaterialId, PolygonId, Scene, Units};
 use crate::color::Rgb;
+use crate::scene::import::ies::Photometry;
+use crate::scene::{Material, MaterialId, PolygonId, Scene, Units};
 use glam::Vec3;
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -192,7 +192,7 @@ impl Scene {
     /// and in its front's groups; returns its id.
     fn add_back_copy(&mut self, i: usize) -> PolygonId {
         let id = PolygonId(self.polygons.len() as u32);
-        let back = super::sides::back_copy(&self.polygons[i], PolygonId(i as u32));
+        let back = crate::scene::repair::sides::back_copy(&self.polygons[i], PolygonId(i as u32));
         self.polygons[i].surface.back = Some(id);
         self.polygons.push(back);
         // The new id is above every other, so the groups stay ascending.

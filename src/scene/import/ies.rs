@@ -125,277 +125,21 @@ impl Photometry {
 
     /// Parses the text of an IES file named `file` in messages.
     pub fn parse(text: &str, file: &str) -> Result<Photometry, IesError> {
-        let err = |line: usize, column: usize, message: String| IesError {
-            file: file.to_string(),
-            line,
-            column,
-            message,
-        };
         let lines: Vec<&str> = text.lines().collect();
-        let mut keywords = Vec::new();
-        let mut tilt_line = None;
-        for (k, raw) in lines.iter().enumerate() {
-            let line = raw.trim();
-            if let Some(rest) = line.strip_prefix("TILT=").or(line.strip_prefix("TILT =")) {
-                let rest = rest.trim();
-                if rest != "NONE" {
-                    return Err(err(
-                        k + 1,
-                        raw.find("TILT").unwrap_or(0) + 1,
-                        format!(
-                            "TILT={rest}: only TILT=NONE is supported (a luminaire here \
-                             is never tilted, so a tilt table has no use)"
-                        ),
-                    ));
-                }
-                tilt_line = Some(k);
-                break;
-            }
-            if let Some(rest) = line.strip_prefix('[') {
-                let (key, value) = rest.split_once(']').unwrap_or((rest, ""));
-                keywords.push((key.trim().to_string(), value.trim().to_string()));
-            }
-            // Anything else before TILT (the format line, free text of
-            // the 1986 format) is a header.
-        }
-        let Some(tilt) = tilt_line else {
-            return Err(err(
-                lines.len().max(1),
-                1,
-                "no TILT= line: an IES file lists its keywords, then TILT=NONE, \
-                 then the photometric data"
-                    .into(),
-            ));
+        let (keywords, tilt) = keywords_and_tilt(&lines, file)?;
+        let mut numbers = Numbers {
+            tokens: Tokens::new(&lines, tilt + 1),
+            file,
         };
-        let mut tokens = Tokens::new(&lines, tilt + 1);
-        let mut number = |what: &str| -> Result<(f64, usize, usize), IesError> {
-            match tokens.next() {
-                None => Err(err(
-                    tokens.end_line(),
-                    1,
-                    format!("the file ends where {what} was expected"),
-                )),
-                Some((text, line, column)) => match text.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok((v, line, column)),
-                    _ => Err(err(
-                        line,
-                        column,
-                        format!("expected {what} (a number), got `{text}`"),
-                    )),
-                },
-            }
-        };
-        let count = |v: (f64, usize, usize), what: &str, max: usize| {
-            if v.0.fract() == 0.0 && v.0 >= 1.0 && v.0 <= max as f64 {
-                Ok(v.0 as usize)
-            } else {
-                Err(err(
-                    v.1,
-                    v.2,
-                    format!("{what} must be a whole number from 1 to {max}, got {}", v.0),
-                ))
-            }
-        };
-        let lamps = number("the number of lamps")?;
-        let lumens = number("the lumens per lamp")?;
-        let multiplier = number("the candela multiplier")?;
-        let nv = count(
-            number("the number of vertical angles")?,
-            "the number of vertical angles",
-            MAX_ANGLES,
-        )?;
-        let nh = count(
-            number("the number of horizontal angles")?,
-            "the number of horizontal angles",
-            MAX_ANGLES,
-        )?;
-        if nv * nh > MAX_VALUES {
-            return Err(err(
-                tilt + 2,
-                1,
-                format!(
-                    "{nv} × {nh} candela values are more than the {MAX_VALUES} this reader takes"
-                ),
-            ));
-        }
-        let kind = number("the photometric type")?;
-        match kind.0 as i64 {
-            1 if kind.0.fract() == 0.0 => {}
-            2 | 3 if kind.0.fract() == 0.0 => {
-                return Err(err(
-                    kind.1,
-                    kind.2,
-                    format!(
-                        "photometric type {} ({}) is not supported: only type C (1), \
-                         the type of architectural luminaires",
-                        kind.0,
-                        if kind.0 == 2.0 { "B" } else { "A" }
-                    ),
-                ))
-            }
-            _ => {
-                return Err(err(
-                    kind.1,
-                    kind.2,
-                    format!(
-                        "the photometric type must be 1 (C), 2 (B) or 3 (A), got {}",
-                        kind.0
-                    ),
-                ))
-            }
-        }
-        let units = number("the units type")?;
-        if units.0 != 1.0 && units.0 != 2.0 {
-            return Err(err(
-                units.1,
-                units.2,
-                format!(
-                    "the units type must be 1 (feet) or 2 (metres), got {}",
-                    units.0
-                ),
-            ));
-        }
-        for what in ["the width", "the length", "the height"] {
-            number(what)?;
-        }
-        let ballast = number("the ballast factor")?;
-        number("the ballast-lamp factor (future use)")?;
-        number("the input watts")?;
-        if lamps.0 < 1.0 || lamps.0.fract() != 0.0 {
-            return Err(err(
-                lamps.1,
-                lamps.2,
-                format!(
-                    "the number of lamps must be a whole number >= 1, got {}",
-                    lamps.0
-                ),
-            ));
-        }
-        let lamp_lumens = if lumens.0 == -1.0 {
-            None
-        } else if lumens.0 > 0.0 {
-            Some(lamps.0 * lumens.0)
-        } else {
-            return Err(err(
-                lumens.1,
-                lumens.2,
-                format!(
-                    "the lumens per lamp must be positive, or -1 for absolute photometry, got {}",
-                    lumens.0
-                ),
-            ));
-        };
-        for (v, what) in [
-            (multiplier, "candela multiplier"),
-            (ballast, "ballast factor"),
-        ] {
-            if v.0 <= 0.0 {
-                return Err(err(
-                    v.1,
-                    v.2,
-                    format!("the {what} must be positive, got {}", v.0),
-                ));
-            }
-        }
-        let mut angles = |n: usize, what: &str| -> Result<Vec<(f64, usize, usize)>, IesError> {
-            (0..n).map(|_| number(what)).collect()
-        };
-        let vertical = angles(nv, "a vertical angle")?;
-        let horizontal = angles(nh, "a horizontal angle")?;
-        let increasing = |a: &[(f64, usize, usize)], what: &str| {
-            for w in a.windows(2) {
-                if w[1].0 <= w[0].0 {
-                    return Err(err(
-                        w[1].1,
-                        w[1].2,
-                        format!(
-                            "the {what} angles must increase, but {} follows {}",
-                            w[1].0, w[0].0
-                        ),
-                    ));
-                }
-            }
-            Ok(())
-        };
-        increasing(&vertical, "vertical")?;
-        increasing(&horizontal, "horizontal")?;
-        let near = |a: f64, b: f64| (a - b).abs() <= ANGLE_TOLERANCE_DEG;
-        let (v0, v1) = (vertical[0], vertical[nv - 1]);
-        if !(near(v0.0, 0.0) || near(v0.0, 90.0)) {
-            return Err(err(
-                v0.1,
-                v0.2,
-                format!(
-                    "type C vertical angles start at 0 or 90 degrees, got {}",
-                    v0.0
-                ),
-            ));
-        }
-        if !(near(v1.0, 90.0) || near(v1.0, 180.0)) && nv > 1 {
-            return Err(err(
-                v1.1,
-                v1.2,
-                format!(
-                    "type C vertical angles end at 90 or 180 degrees, got {}",
-                    v1.0
-                ),
-            ));
-        }
-        let (h0, h1) = (horizontal[0], horizontal[nh - 1]);
-        if !near(h0.0, 0.0) {
-            return Err(err(
-                h0.1,
-                h0.2,
-                format!("type C horizontal angles start at 0 degrees, got {}", h0.0),
-            ));
-        }
-        let symmetry = if nh == 1 {
-            Symmetry::Full
-        } else if near(h1.0, 90.0) {
-            Symmetry::Quadrant
-        } else if near(h1.0, 180.0) {
-            Symmetry::Bilateral
-        } else if near(h1.0, 360.0) {
-            Symmetry::None
-        } else {
-            return Err(err(
-                h1.1,
-                h1.2,
-                format!(
-                    "type C horizontal angles end at 0, 90, 180 or 360 degrees, got {}",
-                    h1.0
-                ),
-            ));
-        };
-        let mut candela = Vec::with_capacity(nv * nh);
-        for _ in 0..nv * nh {
-            let c = number("a candela value")?;
-            if c.0 < 0.0 {
-                return Err(err(
-                    c.1,
-                    c.2,
-                    format!("candela values must be >= 0, got {}", c.0),
-                ));
-            }
-            candela.push(c.0 * multiplier.0 * ballast.0);
-        }
-        if let Some((text, line, column)) = tokens.next() {
-            return Err(err(
-                line,
-                column,
-                format!(
-                    "unexpected `{text}` after the {} candela values the header announces",
-                    nv * nh
-                ),
-            ));
-        }
-        if candela.iter().any(|c| !c.is_finite()) {
-            return Err(err(
-                tilt + 2,
-                1,
-                "the candela values times the multiplier overflow".into(),
-            ));
-        }
+        let header = read_header(&mut numbers, tilt)?;
+        let Header {
+            nv,
+            nh,
+            lamp_lumens,
+            ..
+        } = header;
+        let (vertical, horizontal, symmetry) = read_angles(&mut numbers, nv, nh)?;
+        let candela = read_candela(&mut numbers, &header, tilt)?;
         Ok(Photometry {
             vertical: vertical
                 .iter()
@@ -495,6 +239,362 @@ fn bracket(grid: &[f64], x: f64) -> Option<(usize, f64)> {
     let k = grid.partition_point(|&g| g <= x).clamp(1, n - 1) - 1;
     let t = ((x - grid[k]) / (grid[k + 1] - grid[k])).clamp(0.0, 1.0);
     Some((k, t))
+}
+
+/// The keyword lines before `TILT=`, and the index of the `TILT=NONE`
+/// line; an error when there is none or it asks for a tilt table.
+fn keywords_and_tilt(
+    lines: &[&str],
+    file: &str,
+) -> Result<(Vec<(String, String)>, usize), IesError> {
+    let err = |line, column, message| error_at(file, line, column, message);
+    let mut keywords = Vec::new();
+    let mut tilt_line = None;
+    for (k, raw) in lines.iter().enumerate() {
+        let line = raw.trim();
+        if let Some(rest) = line.strip_prefix("TILT=").or(line.strip_prefix("TILT =")) {
+            let rest = rest.trim();
+            if rest != "NONE" {
+                return Err(err(
+                    k + 1,
+                    raw.find("TILT").unwrap_or(0) + 1,
+                    format!(
+                        "TILT={rest}: only TILT=NONE is supported (a luminaire here \
+                         is never tilted, so a tilt table has no use)"
+                    ),
+                ));
+            }
+            tilt_line = Some(k);
+            break;
+        }
+        if let Some(rest) = line.strip_prefix('[') {
+            let (key, value) = rest.split_once(']').unwrap_or((rest, ""));
+            keywords.push((key.trim().to_string(), value.trim().to_string()));
+        }
+        // Anything else before TILT (the format line, free text of
+        // the 1986 format) is a header.
+    }
+    let Some(tilt) = tilt_line else {
+        return Err(err(
+            lines.len().max(1),
+            1,
+            "no TILT= line: an IES file lists its keywords, then TILT=NONE, \
+             then the photometric data"
+                .into(),
+        ));
+    };
+    Ok((keywords, tilt))
+}
+
+/// An error at `line` and `column` (both 1-based) of `file`.
+fn error_at(file: &str, line: usize, column: usize, message: String) -> IesError {
+    IesError {
+        file: file.to_string(),
+        line,
+        column,
+        message,
+    }
+}
+
+/// A number after the TILT line: its value, line and column.
+type Value = (f64, usize, usize);
+
+/// The numbers after the TILT line, read one at a time, with the errors
+/// that place them in `file`.
+struct Numbers<'a> {
+    tokens: Tokens<'a>,
+    file: &'a str,
+}
+
+impl Numbers<'_> {
+    /// The next number, which should be `what`.
+    fn next(&mut self, what: &str) -> Result<Value, IesError> {
+        let file = self.file;
+        let err = |line, column, message| error_at(file, line, column, message);
+        match self.tokens.next() {
+            None => Err(err(
+                self.tokens.end_line(),
+                1,
+                format!("the file ends where {what} was expected"),
+            )),
+            Some((text, line, column)) => match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok((v, line, column)),
+                _ => Err(err(
+                    line,
+                    column,
+                    format!("expected {what} (a number), got `{text}`"),
+                )),
+            },
+        }
+    }
+}
+
+/// The header numbers after the TILT line, as the distribution needs them.
+#[derive(Clone, Copy)]
+struct Header {
+    /// The number of vertical angles.
+    nv: usize,
+    /// The number of horizontal angles.
+    nh: usize,
+    multiplier: Value,
+    ballast: Value,
+    lamp_lumens: Option<f64>,
+}
+
+/// Reads and checks the thirteen numbers of the header (lamps to input
+/// watts), in file order; `tilt` is the index of the TILT line.
+fn read_header(numbers: &mut Numbers<'_>, tilt: usize) -> Result<Header, IesError> {
+    let file = numbers.file;
+    let err = |line, column, message| error_at(file, line, column, message);
+    let count = |v: (f64, usize, usize), what: &str, max: usize| {
+        if v.0.fract() == 0.0 && v.0 >= 1.0 && v.0 <= max as f64 {
+            Ok(v.0 as usize)
+        } else {
+            Err(err(
+                v.1,
+                v.2,
+                format!("{what} must be a whole number from 1 to {max}, got {}", v.0),
+            ))
+        }
+    };
+    let lamps = numbers.next("the number of lamps")?;
+    let lumens = numbers.next("the lumens per lamp")?;
+    let multiplier = numbers.next("the candela multiplier")?;
+    let nv = count(
+        numbers.next("the number of vertical angles")?,
+        "the number of vertical angles",
+        MAX_ANGLES,
+    )?;
+    let nh = count(
+        numbers.next("the number of horizontal angles")?,
+        "the number of horizontal angles",
+        MAX_ANGLES,
+    )?;
+    if nv * nh > MAX_VALUES {
+        return Err(err(
+            tilt + 2,
+            1,
+            format!("{nv} × {nh} candela values are more than the {MAX_VALUES} this reader takes"),
+        ));
+    }
+    let kind = numbers.next("the photometric type")?;
+    match kind.0 as i64 {
+        1 if kind.0.fract() == 0.0 => {}
+        2 | 3 if kind.0.fract() == 0.0 => {
+            return Err(err(
+                kind.1,
+                kind.2,
+                format!(
+                    "photometric type {} ({}) is not supported: only type C (1), \
+                     the type of architectural luminaires",
+                    kind.0,
+                    if kind.0 == 2.0 { "B" } else { "A" }
+                ),
+            ))
+        }
+        _ => {
+            return Err(err(
+                kind.1,
+                kind.2,
+                format!(
+                    "the photometric type must be 1 (C), 2 (B) or 3 (A), got {}",
+                    kind.0
+                ),
+            ))
+        }
+    }
+    let units = numbers.next("the units type")?;
+    if units.0 != 1.0 && units.0 != 2.0 {
+        return Err(err(
+            units.1,
+            units.2,
+            format!(
+                "the units type must be 1 (feet) or 2 (metres), got {}",
+                units.0
+            ),
+        ));
+    }
+    for what in ["the width", "the length", "the height"] {
+        numbers.next(what)?;
+    }
+    let ballast = numbers.next("the ballast factor")?;
+    numbers.next("the ballast-lamp factor (future use)")?;
+    numbers.next("the input watts")?;
+    if lamps.0 < 1.0 || lamps.0.fract() != 0.0 {
+        return Err(err(
+            lamps.1,
+            lamps.2,
+            format!(
+                "the number of lamps must be a whole number >= 1, got {}",
+                lamps.0
+            ),
+        ));
+    }
+    let lamp_lumens = if lumens.0 == -1.0 {
+        None
+    } else if lumens.0 > 0.0 {
+        Some(lamps.0 * lumens.0)
+    } else {
+        return Err(err(
+            lumens.1,
+            lumens.2,
+            format!(
+                "the lumens per lamp must be positive, or -1 for absolute photometry, got {}",
+                lumens.0
+            ),
+        ));
+    };
+    for (v, what) in [
+        (multiplier, "candela multiplier"),
+        (ballast, "ballast factor"),
+    ] {
+        if v.0 <= 0.0 {
+            return Err(err(
+                v.1,
+                v.2,
+                format!("the {what} must be positive, got {}", v.0),
+            ));
+        }
+    }
+    Ok(Header {
+        nv,
+        nh,
+        multiplier,
+        ballast,
+        lamp_lumens,
+    })
+}
+
+/// Reads the `nv` vertical and `nh` horizontal angles, checks that they
+/// increase and start and end where type C angles do, and gives the
+/// horizontal symmetry they imply.
+fn read_angles(
+    numbers: &mut Numbers<'_>,
+    nv: usize,
+    nh: usize,
+) -> Result<(Vec<Value>, Vec<Value>, Symmetry), IesError> {
+    let file = numbers.file;
+    let err = |line, column, message| error_at(file, line, column, message);
+    let mut angles = |n: usize, what: &str| -> Result<Vec<(f64, usize, usize)>, IesError> {
+        (0..n).map(|_| numbers.next(what)).collect()
+    };
+    let vertical = angles(nv, "a vertical angle")?;
+    let horizontal = angles(nh, "a horizontal angle")?;
+    let increasing = |a: &[(f64, usize, usize)], what: &str| {
+        for w in a.windows(2) {
+            if w[1].0 <= w[0].0 {
+                return Err(err(
+                    w[1].1,
+                    w[1].2,
+                    format!(
+                        "the {what} angles must increase, but {} follows {}",
+                        w[1].0, w[0].0
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    };
+    increasing(&vertical, "vertical")?;
+    increasing(&horizontal, "horizontal")?;
+    let near = |a: f64, b: f64| (a - b).abs() <= ANGLE_TOLERANCE_DEG;
+    let (v0, v1) = (vertical[0], vertical[nv - 1]);
+    if !(near(v0.0, 0.0) || near(v0.0, 90.0)) {
+        return Err(err(
+            v0.1,
+            v0.2,
+            format!(
+                "type C vertical angles start at 0 or 90 degrees, got {}",
+                v0.0
+            ),
+        ));
+    }
+    if !(near(v1.0, 90.0) || near(v1.0, 180.0)) && nv > 1 {
+        return Err(err(
+            v1.1,
+            v1.2,
+            format!(
+                "type C vertical angles end at 90 or 180 degrees, got {}",
+                v1.0
+            ),
+        ));
+    }
+    let (h0, h1) = (horizontal[0], horizontal[nh - 1]);
+    if !near(h0.0, 0.0) {
+        return Err(err(
+            h0.1,
+            h0.2,
+            format!("type C horizontal angles start at 0 degrees, got {}", h0.0),
+        ));
+    }
+    let symmetry = if nh == 1 {
+        Symmetry::Full
+    } else if near(h1.0, 90.0) {
+        Symmetry::Quadrant
+    } else if near(h1.0, 180.0) {
+        Symmetry::Bilateral
+    } else if near(h1.0, 360.0) {
+        Symmetry::None
+    } else {
+        return Err(err(
+            h1.1,
+            h1.2,
+            format!(
+                "type C horizontal angles end at 0, 90, 180 or 360 degrees, got {}",
+                h1.0
+            ),
+        ));
+    };
+    Ok((vertical, horizontal, symmetry))
+}
+
+/// Reads the candela values (times the multiplier and the ballast factor)
+/// and checks that nothing follows them; `tilt` is the index of the TILT
+/// line.
+fn read_candela(
+    numbers: &mut Numbers<'_>,
+    header: &Header,
+    tilt: usize,
+) -> Result<Vec<f64>, IesError> {
+    let file = numbers.file;
+    let Header {
+        nv,
+        nh,
+        multiplier,
+        ballast,
+        ..
+    } = *header;
+    let err = |line, column, message| error_at(file, line, column, message);
+    let mut candela = Vec::with_capacity(nv * nh);
+    for _ in 0..nv * nh {
+        let c = numbers.next("a candela value")?;
+        if c.0 < 0.0 {
+            return Err(err(
+                c.1,
+                c.2,
+                format!("candela values must be >= 0, got {}", c.0),
+            ));
+        }
+        candela.push(c.0 * multiplier.0 * ballast.0);
+    }
+    if let Some((text, line, column)) = numbers.tokens.next() {
+        return Err(err(
+            line,
+            column,
+            format!(
+                "unexpected `{text}` after the {} candela values the header announces",
+                nv * nh
+            ),
+        ));
+    }
+    if candela.iter().any(|c| !c.is_finite()) {
+        return Err(err(
+            tilt + 2,
+            1,
+            "the candela values times the multiplier overflow".into(),
+        ));
+    }
+    Ok(candela)
 }
 
 /// The numbers after the TILT line, with their 1-based lines and columns.

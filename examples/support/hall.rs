@@ -3,6 +3,13 @@
 //! cells. Each table-and-chair set is 11 boxes (66 polygons); the hall adds
 //! 6 walls and `⌈K/4⌉` lamps, so `K` = 1, 15 and 150 give about 70, 1,000
 //! and 10,000 polygons. `cargo run --release --example hall -- K` prints it.
+//!
+//! Not part of the library: the examples, the benches and the library's
+//! unit tests (through `testutil`) each include this file with
+//! `#[path]`; its own tests run with the library's.
+
+// Each includer uses part of it.
+#![allow(dead_code)]
 
 use std::fmt::Write;
 
@@ -123,12 +130,10 @@ pub fn hall_sc(k: usize) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
     #[test]
     fn hall_loads_with_the_documented_polygon_counts() {
         for (k, polygons) in [(1, 73), (15, 1000)] {
-            let scene = crate::scene::parse_str(&hall_sc(k), "hall.sc").unwrap();
+            let scene = crate::scene::parse_str(&super::hall_sc(k), "hall.sc").unwrap();
             assert_eq!(scene.polygons.len(), polygons, "K = {k}");
             assert!(scene.materials.iter().any(|m| m.k_emission > 0.0));
         }

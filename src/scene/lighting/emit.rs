@@ -12,9 +12,9 @@
 //! belong to an object and to several groups at once, and the scenes and
 //! importers that have no such names (`.sc`) leave the list empty.
 
-use super::error::Warning;
-use super::{Material, MaterialId, PolygonId, Scene};
 use crate::color::Rgb;
+use crate::scene::error::Warning;
+use crate::scene::{Material, MaterialId, PolygonId, Scene};
 use std::collections::HashMap;
 use std::fmt;
 
@@ -182,7 +182,7 @@ pub fn looks_like_lamp(name: &str) -> bool {
 impl Material {
     /// The material emitting `emission` (radiosity in the scene's units,
     /// every channel finite, `>= 0` and at most
-    /// [`MAX_EMISSION`](super::MAX_EMISSION)) instead of what it emitted.
+    /// [`MAX_EMISSION`](crate::scene::MAX_EMISSION)) instead of what it emitted.
     ///
     /// Its reflectance is kept exactly when it is black, when the emission
     /// is black, or when the two have the same hue. Otherwise (a
@@ -226,7 +226,7 @@ impl Scene {
 
     /// Makes everything named `name` emit `emission` (radiosity in the
     /// scene's units, every channel finite, `>= 0` and at most
-    /// [`MAX_EMISSION`](super::MAX_EMISSION)), keeping its reflectance as
+    /// [`MAX_EMISSION`](crate::scene::MAX_EMISSION)), keeping its reflectance as
     /// [`Material::with_emission`] says; returns how many polygons it
     /// covers.
     ///
@@ -730,7 +730,7 @@ o Room\n\
 g\n\
 f 1 3 4\n";
         let read = |name: &str| Err(format!("no {name}"));
-        let s = crate::scene::obj::parse_obj(obj, "m.obj", &read).unwrap();
+        let s = crate::scene::import::obj::parse_obj(obj, "m.obj", &read).unwrap();
         // The folded quad under `walls` became two triangles.
         assert_eq!(s.polygons.len(), 6);
         let listed: Vec<(GroupKind, &str, Vec<u32>)> = s

@@ -5,6 +5,13 @@
 //! around and `n / 2` rings, `n (n − 2)` triangles, so `n` = 16, 32 and 64
 //! give 454, 1,926 and 7,942 polygons.
 //! `cargo run --release --example sphere_box -- N` prints it.
+//!
+//! Not part of the library: the examples, the benches and the library's
+//! unit tests (through `testutil`) each include this file with
+//! `#[path]`; its own tests run with the library's.
+
+// Each includer uses part of it.
+#![allow(dead_code)]
 
 use std::f64::consts::PI;
 use std::fmt::Write;
@@ -163,8 +170,8 @@ mod tests {
     fn the_sphere_box_loads_with_outward_spheres() {
         for (n, polygons) in [(16, 454), (32, 1926)] {
             let text = super::sphere_box_sc(n);
-            let scene = crate::scene::sc::parse_str(&text, "sphere_box.sc")
-                .expect("generated scene parses");
+            let scene =
+                crate::scene::parse_str(&text, "sphere_box.sc").expect("generated scene parses");
             assert_eq!(scene.polygons.len(), polygons);
             // Every facet of a sphere faces away from its centre.
             for p in scene.polygons.iter().skip(6) {

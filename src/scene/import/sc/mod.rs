@@ -23,9 +23,9 @@ mod parser;
 #[cfg(test)]
 mod tests;
 
-use super::error::{cannot_read, FILE_START};
-use super::{Diagnostic, LoadError, Scene};
 use crate::camera::Camera;
+use crate::scene::error::{cannot_read, FILE_START};
+use crate::scene::{Diagnostic, LoadError, Scene};
 use lexer::{advance, lex};
 use parser::Parser;
 use std::path::Path;

@@ -16,12 +16,12 @@
 //! none of its faces emits (a room whose ceiling glows is seen from
 //! inside) and no other polygon of the scene lies inside it (a room with
 //! a lamp or furniture in it is seen from inside). A solid keeps one side:
-//! the outside. Its faces get no back copies ([`super::Surface::solid`]);
+//! the outside. Its faces get no back copies ([`crate::scene::Surface::solid`]);
 //! when they all face inward (a negative enclosed volume, normals flipped
 //! in the modeller), each is turned to face out, with one warning.
 
-use super::error::Warning;
-use super::{Polygon, Scene, Sides};
+use crate::scene::error::Warning;
+use crate::scene::{Polygon, Scene, Sides};
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -75,7 +75,9 @@ fn inside(polygons: &[Polygon], faces: &[u32], x: DVec3) -> bool {
     let dir = DVec3::new(0.573_462, 0.688_791, 0.443_296).normalize();
     let crossings = faces
         .iter()
-        .filter(|&&f| super::framing::ray_polygon_hit(&polygons[f as usize], x, dir, 0.0).is_some())
+        .filter(|&&f| {
+            crate::scene::framing::ray_polygon_hit(&polygons[f as usize], x, dir, 0.0).is_some()
+        })
         .count();
     crossings % 2 == 1
 }
@@ -83,7 +85,7 @@ fn inside(polygons: &[Polygon], faces: &[u32], x: DVec3) -> bool {
 impl Scene {
     /// Finds the closed solids among the polygons that `sides` makes
     /// two-sided (see the module docs), marks their polygons
-    /// [`super::Surface::solid`] so that [`Scene::with_sides`] gives them
+    /// [`crate::scene::Surface::solid`] so that [`Scene::with_sides`] gives them
     /// no back copies, and turns the faces of solids that face inward to
     /// face out. Returns one warning for `file` when it turned any.
     /// Returns at once with [`Sides::One`].

@@ -20,8 +20,8 @@
 //! one *reversed* is the other's back side, written out: it is kept, and
 //! [`Scene::with_sides`] makes no back copy for either.
 
-use super::error::Warning;
-use super::{Polygon, PolygonId, Scene, SourcePos};
+use crate::scene::error::Warning;
+use crate::scene::{Polygon, PolygonId, Scene, SourcePos};
 use std::collections::HashMap;
 
 /// Which sides of the polygons take part, as the loader read them or as
@@ -62,7 +62,7 @@ fn reversed_key(vertices: &[glam::Vec3]) -> Vec<[u32; 3]> {
 /// The back copy of `front` (polygon `id`): its vertices reversed from
 /// the second on, so the first stays first, its normal negated, marked as
 /// `id`'s back and with no back of its own.
-pub(super) fn back_copy(front: &Polygon, id: PolygonId) -> Polygon {
+pub(in crate::scene) fn back_copy(front: &Polygon, id: PolygonId) -> Polygon {
     let mut vertices = Vec::with_capacity(front.vertices.len());
     vertices.push(front.vertices[0]);
     vertices.extend(front.vertices[1..].iter().rev());
@@ -171,9 +171,9 @@ impl Scene {
     /// [`Surface::two_sided`] is left as set on every polygon, and the
     /// result is deterministic (copies in the order of their fronts).
     ///
-    /// [`Surface::back_of`]: super::Surface::back_of
-    /// [`Surface::back`]: super::Surface::back
-    /// [`Surface::two_sided`]: super::Surface::two_sided
+    /// [`Surface::back_of`]: crate::scene::Surface::back_of
+    /// [`Surface::back`]: crate::scene::Surface::back
+    /// [`Surface::two_sided`]: crate::scene::Surface::two_sided
     pub fn with_sides(mut self, sides: Sides) -> Scene {
         let keys: HashMap<Vec<[u32; 3]>, usize> = self
             .polygons

@@ -1,0 +1,31 @@
+//! Files to a [`Scene`]: the `.sc` format (`sc`), Wavefront OBJ with its
+//! MTL libraries ([`obj`]), glTF 2.0 ([`gltf`]), and the files that go with
+//! a scene: IES photometric data ([`ies`]) and measurement points
+//! ([`points`]). [`load`] picks the reader by the file's extension.
+
+pub mod gltf;
+pub mod ies;
+pub mod obj;
+pub mod points;
+pub(super) mod sc;
+
+use crate::scene::{LoadError, Scene};
+use std::path::Path;
+
+/// Reads and parses a scene file, by its extension in any case:
+/// Wavefront OBJ (with its MTL libraries) for `.obj`, glTF 2.0 for
+/// `.gltf` and `.glb`, else `.sc`. Errors carry the file name and the
+/// line and column (for glTF, the JSON path).
+pub fn load(path: &Path) -> Result<Scene, LoadError> {
+    let is = |ext: &str| {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    };
+    if is("obj") {
+        obj::load_obj(path, None)
+    } else if is("gltf") || is("glb") {
+        gltf::load_gltf(path, None)
+    } else {
+        sc::load_file(path)
+    }
+}

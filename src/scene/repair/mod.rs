@@ -1,0 +1,101 @@
+//! The passes that make real exports solvable, and the one order they run
+//! in ([`run`]): closed solids keep their outside
+//! ([`Scene::orient_solids`], `solids.rs`), polygons are cut where others
+//! pass through them ([`Scene::split_intersections`], `split.rs`),
+//! two-sided faces get their back copies ([`Scene::with_sides`],
+//! `sides.rs`), and an emitting side trapped under a ceiling falls silent
+//! ([`Scene::silence_covered_sides`], `trapped.rs`). Beside them,
+//! `coplanar.rs` is the rule for polygons in one plane that the visibility
+//! tests and the picture follow (they never block each other, overlaps are
+//! drawn in a fixed order: [`plane_classes`](crate::scene::plane_classes),
+//! [`draw_layers`](crate::scene::draw_layers)); it needs no pass.
+
+pub(super) mod coplanar;
+pub(super) mod sides;
+pub(super) mod solids;
+pub(super) mod split;
+pub(super) mod trapped;
+
+use crate::color::Rgb;
+use crate::scene::{PolygonError, Scene, Sides, SplitStats};
+use glam::Vec3;
+
+/// What the repair passes are told: the choices of the command line that
+/// change geometry.
+#[derive(Clone, Copy, Debug)]
+pub struct RepairOptions<'a> {
+    /// Which faces are two-sided (`--sides`).
+    pub sides: Sides,
+    /// The radiosity of the `--sky` enclosure, in the scene's units, when
+    /// one is asked for (see [`Scene::add_sky`]).
+    pub sky: Option<Rgb>,
+    /// The scene's name as the warnings give it.
+    pub file: &'a str,
+}
+
+/// Rays cast into the finished scene, which the trapped-sides pass needs:
+/// the scene stays below the visibility code, so whoever runs the passes
+/// supplies them (the BVH, or brute force in a test).
+pub trait FirstHit {
+    /// The distance in scene units along the ray from `origin` in the unit
+    /// `direction` to the nearest polygon, or `None` when the ray leaves
+    /// the scene.
+    fn first_hit_distance(&self, origin: Vec3, direction: Vec3) -> Option<f32>;
+}
+
+/// What [`run`] did besides changing the scene.
+#[derive(Debug)]
+pub struct RepairReport<R> {
+    /// What splitting along intersections did.
+    pub split: SplitStats,
+    /// The rays built on the finished scene to look for trapped sides,
+    /// when some face emits from both sides (else none were built).
+    pub rays: Option<R>,
+}
+
+/// Runs the repair passes on a loaded scene whose emission (`--emit`,
+/// `--ies`) is set, pushing their warnings onto [`Scene::warnings`] in
+/// the order the passes run, and returns the repaired scene. `build_rays`
+/// is called at most once, on the finished scene, when some face emits
+/// from both sides ([`Scene::emits_from_both_sides`]).
+///
+/// Fails only when the `--sky` enclosure would lie beyond
+/// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE).
+pub fn run<R: FirstHit>(
+    mut scene: Scene,
+    options: &RepairOptions<'_>,
+    build_rays: impl FnOnce(&Scene) -> R,
+) -> Result<(Scene, RepairReport<R>), PolygonError> {
+    // Solids keep their outside only. Found before the cuts, which leave
+    // T-junctions on a box sunk into a floor; the pieces keep the mark.
+    if let Some(warning) = scene.orient_solids(options.sides, options.file) {
+        scene.warnings.push(warning);
+    }
+    // Not a quirk of the file, so no warning: geometry passing through
+    // geometry is how models are built. Before the back copies, so that
+    // each piece gets its own.
+    let split = scene.split_intersections();
+    let mut scene = scene.with_sides(options.sides);
+    // A luminaire's back is a back copy, or made here as one: after the
+    // back copies, so that it finds those of a two-sided scene.
+    scene.light_luminaire_backs();
+    // Last, after everything that adds or changes polygons, so that the
+    // enclosure is built around the finished scene.
+    if let Some(sky) = options.sky {
+        scene.add_sky(sky)?;
+    }
+    // An emitting face with two sides, one just under a ceiling, emits
+    // from the other only. Rays find the gap, so they are cast on the
+    // finished geometry, sky included (silencing a side changes only a
+    // material, so they stay valid and are handed back).
+    let mut rays = None;
+    if scene.emits_from_both_sides() {
+        let built = build_rays(&scene);
+        let first_hit = |origin, direction| built.first_hit_distance(origin, direction);
+        if let Some(warning) = scene.silence_covered_sides(first_hit, options.file) {
+            scene.warnings.push(warning);
+        }
+        rays = Some(built);
+    }
+    Ok((scene, RepairReport { split, rays }))
+}
