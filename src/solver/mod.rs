@@ -75,20 +75,16 @@
 //! per-polygon sums run in a fixed order, so the result is bit-identical
 //! whatever the thread count.
 
-mod cell_integrals;
+pub mod accel;
 pub mod checkpoint;
-pub mod cluster;
-pub mod distribution;
-pub mod facets;
-pub mod far_shooters;
-pub mod formfactor;
-pub mod gather;
+pub mod final_gather;
 pub mod hemicube;
+pub mod kernel;
 pub mod parts;
-pub mod probes;
-pub mod receivers;
-pub mod subcells;
 mod unshot;
+
+use accel::{cluster, facets, far_shooters, probes, receivers, subcells};
+use kernel::{cell_integrals, distribution, formfactor};
 
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;

@@ -41,7 +41,7 @@
 //! and keep the disc term; so does every sample with the near field
 //! switched off.
 
-use super::subcells::{Split, FAR_SCALE};
+use crate::solver::accel::subcells::{Split, FAR_SCALE};
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
 use glam::{DVec3, Vec3, Vec4};

@@ -20,7 +20,7 @@
 //! Visibility is the same one ray per sample as for any shooter.
 
 use super::formfactor::{weighted_point_to_samples, ShooterSample};
-use super::subcells::Split;
+use crate::solver::accel::subcells::Split;
 use crate::color::Rgb;
 use crate::scene::{Photometry, Scene};
 use glam::{DVec3, Vec3};

@@ -2,7 +2,7 @@
 //! shot as [`PARTS`] parts, each with the light it holds, and the parts
 //! near a receiver as their leaves.
 //!
-//! A large polygon shoots from at most 64 cells ([`super::formfactor`]),
+//! A large polygon shoots from at most 64 cells ([`crate::solver::kernel::formfactor`]),
 //! one shadow ray each. Light pooled in a spot narrower than a cell (where
 //! a sphere rests on the floor, the floor's light gathers around the
 //! contact) is then sent as if spread over the whole cell, and the facets
@@ -49,7 +49,7 @@
 //! from afar, a hemicube, a luminaire's distribution) sends the same
 //! power.
 
-use super::formfactor::{
+use crate::solver::kernel::formfactor::{
     cell_diameter2, lane_terms, point_to_polygon, quadrature, triangle_area, Quadrature,
     ShooterSample, EXACT_RATIO, NEAR_FIELD_RATIO,
 };
@@ -282,7 +282,7 @@ impl Over {
         inward: &[(Vec3, Vec3)],
         s: &ShooterSample,
     ) -> bool {
-        let diameter = (s.exact_r2.sqrt() / super::formfactor::EXACT_RATIO).max(f32::MIN_POSITIVE);
+        let diameter = (s.exact_r2.sqrt() / crate::solver::kernel::formfactor::EXACT_RATIO).max(f32::MIN_POSITIVE);
         let r2 = (REACH * diameter).powi(2);
         let (margin, ahead) = (EDGE_MARGIN * diameter, 1e-4 * diameter);
         let c = s.position;

@@ -35,7 +35,7 @@
 //! `--exact-receivers` and `--no-clustering`. A vertex's answer depends
 //! only on its own rays, so the bits do not depend on the thread count.
 
-use super::formfactor::ShooterSample;
+use crate::solver::kernel::formfactor::ShooterSample;
 use super::probes;
 use glam::Vec3;
 
