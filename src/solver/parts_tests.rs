@@ -4,6 +4,7 @@
 //! weak polygons through strata, negative light, large receivers cut into
 //! pieces in both passes of the hierarchical gather).
 
+use super::step::parts;
 use super::tests::same_bits;
 use super::*;
 use crate::mesh::{self, MeshOptions};

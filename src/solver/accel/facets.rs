@@ -46,9 +46,9 @@
 //! ([`crate::solver::SolverOptions::receiver_interpolation`]); `--exact-receivers`
 //! and `--no-clustering` ask every ray per vertex.
 
-use crate::solver::SHAFT_MIN_VERTICES;
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
+use crate::solver::SHAFT_MIN_VERTICES;
 use crate::visibility::Visibility;
 use glam::Vec3;
 

@@ -49,13 +49,13 @@
 //! from afar, a hemicube, a luminaire's distribution) sends the same
 //! power.
 
+use crate::color::Rgb;
+use crate::mesh::Mesh;
+use crate::scene::{Polygon, Scene};
 use crate::solver::kernel::formfactor::{
     cell_diameter2, lane_terms, point_to_polygon, quadrature, triangle_area, Quadrature,
     ShooterSample, EXACT_RATIO, NEAR_FIELD_RATIO,
 };
-use crate::color::Rgb;
-use crate::mesh::Mesh;
-use crate::scene::{Polygon, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -282,7 +282,8 @@ impl Over {
         inward: &[(Vec3, Vec3)],
         s: &ShooterSample,
     ) -> bool {
-        let diameter = (s.exact_r2.sqrt() / crate::solver::kernel::formfactor::EXACT_RATIO).max(f32::MIN_POSITIVE);
+        let diameter = (s.exact_r2.sqrt() / crate::solver::kernel::formfactor::EXACT_RATIO)
+            .max(f32::MIN_POSITIVE);
         let r2 = (REACH * diameter).powi(2);
         let (margin, ahead) = (EDGE_MARGIN * diameter, 1e-4 * diameter);
         let c = s.position;

@@ -20,9 +20,9 @@
 //! Visibility is the same one ray per sample as for any shooter.
 
 use super::formfactor::{weighted_point_to_samples, ShooterSample};
-use crate::solver::accel::subcells::Split;
 use crate::color::Rgb;
 use crate::scene::{Photometry, Scene};
+use crate::solver::accel::subcells::Split;
 use glam::{DVec3, Vec3};
 use std::sync::Arc;
 

@@ -41,9 +41,9 @@
 //! and keep the disc term; so does every sample with the near field
 //! switched off.
 
-use crate::solver::accel::subcells::{Split, FAR_SCALE};
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
+use crate::solver::accel::subcells::{Split, FAR_SCALE};
 use glam::{DVec3, Vec3, Vec4};
 use std::f64::consts::PI;
 
