@@ -1283,20 +1283,4 @@ fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
 }
 
 #[cfg(test)]
-mod crowded_tests;
-#[cfg(test)]
-mod emitter_order_tests;
-#[cfg(test)]
-mod far_shooter_tests;
-#[cfg(test)]
-mod overshoot_tests;
-#[cfg(test)]
-mod parts_tests;
-#[cfg(test)]
-mod resting_tests;
-#[cfg(test)]
-mod settle_tests;
-#[cfg(test)]
-mod sky_tests;
-#[cfg(test)]
 mod tests;
