@@ -9,8 +9,8 @@
 //!   a check vertex shows it holds, never in crowded cells nor near the
 //!   shooter ([`crate::solver::accel::receivers`], `Interpolating`);
 //! - **shadow-ray choice**: no ray in an empty shaft, a short candidate
-//!   list tested one by one, else the BVH
-//!   ([`crate::solver::LINEAR_CANDIDATES`]);
+//!   list tested one by one, else the BVH ([`ShadowQuery`],
+//!   [`crate::solver::LINEAR_CANDIDATES`]);
 //! - **shared facet rays** ([`crate::solver::accel::facets`]);
 //! - **sky probes** and **far shooters**: a few rays first, their answer
 //!   for all when they agree ([`crate::solver::accel::probes`],
@@ -33,7 +33,7 @@ use crate::solver::unshot::Shot;
 use crate::solver::{
     Progressive, LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
 };
-use crate::visibility::{LastBlocker, Visibility};
+use crate::visibility::{LastBlocker, ShadowQuery};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -119,22 +119,18 @@ impl<'a> Progressive<'a> {
                     rays += cast;
                     return hit;
                 }
-                let blockers = tile_candidates
-                    .get(tile + k / SHOOTER_GROUP)
-                    .map_or(&[][..], |c| &c[..]);
-                if !culling || small[j.index()] || candidates[j.index()].len() > REFINE_MAX {
-                    rays += 1;
-                    visibility.occluded_remembering(s, x, (shooter, j), &mut last)
-                } else if blockers.is_empty() {
-                    // Nothing in the shaft: visible, no ray needed.
-                    false
-                } else if blockers.len() <= LINEAR_CANDIDATES {
-                    rays += 1;
-                    visibility.occluded_among_remembering(s, x, blockers, &mut last)
-                } else {
-                    rays += 1;
-                    visibility.occluded_remembering(s, x, (shooter, j), &mut last)
-                }
+                // The thin shaft's polygons, when the receiver has a
+                // complete list of them.
+                let culled =
+                    culling && !small[j.index()] && candidates[j.index()].len() <= REFINE_MAX;
+                let blockers = culled.then(|| {
+                    tile_candidates
+                        .get(tile + k / SHOOTER_GROUP)
+                        .map_or(&[][..], |c| &c[..])
+                });
+                let query = ShadowQuery::choose(blockers, LINEAR_CANDIDATES);
+                rays += query.rays();
+                visibility.shadow_remembering(query, s, x, (shooter, j), &mut last)
             };
             // A sky facet's probes, when they agree, stand for all its
             // directions; so do a far shooter's for all its samples.
@@ -515,27 +511,4 @@ where
             sum
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
-}
-
-/// Whether the segment from `from` to `x` is blocked, and the rays cast
-/// to tell (0 or 1): `blockers` are the polygons in its thin shaft
-/// (`None`: test the whole scene; empty: nothing can block), `ends` the
-/// polygons it joins, which never block.
-#[inline]
-pub(in crate::solver) fn ray_blocked(
-    visibility: &Visibility,
-    blockers: Option<&[u32]>,
-    from: glam::Vec3,
-    x: glam::Vec3,
-    ends: (PolygonId, PolygonId),
-    last: &mut LastBlocker,
-) -> (bool, u64) {
-    match blockers {
-        Some([]) => (false, 0),
-        Some(b) if b.len() <= LINEAR_CANDIDATES => (
-            visibility.occluded_among_ends_remembering(from, x, b, ends, last),
-            1,
-        ),
-        _ => (visibility.occluded_remembering(from, x, ends, last), 1),
-    }
 }

@@ -13,7 +13,7 @@
 //! - **receiver interpolation**, **shadow-ray choice** and **shared facet
 //!   rays** as in a polygon's gather ([`super::gather`]).
 
-use super::gather::{gather_passes, ray_blocked, Gathered, Interpolating, Stage, Sums, Work};
+use super::gather::{gather_passes, Gathered, Interpolating, Stage, Sums, Work};
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
@@ -22,10 +22,10 @@ use crate::solver::accel::facets::Scratch;
 use crate::solver::accel::{cluster, subcells};
 use crate::solver::kernel::formfactor::weighted_point_to_samples;
 use crate::solver::{
-    Progressive, OWN_RAY_SLOT, RAY_SLOTS, REFINE_MAX, REPRESENTATIVE_SLOT, SHOOTER_GROUP,
-    WEAK_STRATUM_SHARE,
+    Progressive, LINEAR_CANDIDATES, OWN_RAY_SLOT, RAY_SLOTS, REFINE_MAX, REPRESENTATIVE_SLOT,
+    SHOOTER_GROUP, WEAK_STRATUM_SHARE,
 };
-use crate::visibility::LastBlocker;
+use crate::visibility::{LastBlocker, ShadowQuery};
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
@@ -129,7 +129,10 @@ impl<'a> Progressive<'a> {
                     let (hit, cast) = facets
                         .shared_ray(memo, visibility, (own, j), key, from, exact_r2)
                         .unwrap_or_else(|| {
-                            ray_blocked(visibility, blockers, from, x, (own, j), &mut last)
+                            let query = ShadowQuery::choose(blockers, LINEAR_CANDIDATES);
+                            let hit =
+                                visibility.shadow_remembering(query, from, x, (own, j), &mut last);
+                            (hit, query.rays())
                         });
                     rays += cast;
                     hit
