@@ -76,14 +76,18 @@
 //! whatever the thread count.
 
 pub mod accel;
+mod ambient;
 pub mod checkpoint;
 pub mod final_gather;
 pub mod hemicube;
 pub mod kernel;
+mod setup;
 pub mod step;
 mod unshot;
 
 use accel::{cluster, facets, far_shooters, probes, receivers, subcells};
+pub use ambient::first_look;
+use ambient::{ambient_term, sky_power_weights};
 use kernel::{cell_integrals, distribution, formfactor};
 use step::Underway;
 
@@ -617,15 +621,7 @@ impl<'a> Progressive<'a> {
     ) -> Self {
         let mesh_ref = mesh.into();
         let mesh: &Mesh = &mesh_ref;
-        let set = match (options.form_factor, options.shooter_samples) {
-            (FormFactorMethod::Center, _) => SampleSet::Centre,
-            (FormFactorMethod::Wallace | FormFactorMethod::Hemicube, ShooterSamples::All) => {
-                SampleSet::Vertices
-            }
-            (FormFactorMethod::Wallace | FormFactorMethod::Hemicube, ShooterSamples::AtMost(n)) => {
-                SampleSet::AtMost(n)
-            }
-        };
+        let set = setup::sample_set(&options);
         let emission: Vec<Rgb> = scene
             .polygons
             .iter()
@@ -679,19 +675,7 @@ impl<'a> Progressive<'a> {
         } else {
             Clusters::singletons(scene)
         };
-        let mut tiles = Vec::new();
-        let mut tile_of = vec![0u32; mesh.vertex_count()];
-        for pm in &mesh.polygons {
-            let mut start = pm.vertices.start;
-            while start < pm.vertices.end {
-                let end = (start + TILE_VERTICES).min(pm.vertices.end);
-                for l in start..end {
-                    tile_of[l as usize] = tiles.len() as u32;
-                }
-                tiles.push(start..end);
-                start = end;
-            }
-        }
+        let (tiles, tile_of) = setup::tiles(mesh);
         // Shared facet rays and sky probes go with the other receiver
         // approximations.
         let approximate = clustered && options.receiver_interpolation;
@@ -700,35 +684,9 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|pm| CoarseGrid::detect(mesh, pm))
             .collect();
-        let crowded = if approximate {
-            receivers::crowded_cells(mesh, &coarse, |j, corners, normal, depth| {
-                visibility.crowds(PolygonId(j as u32), &corners, normal, depth)
-            })
-        } else {
-            Vec::new()
-        };
-        let sky_probes = mesh
-            .polygons
-            .iter()
-            .zip(&samples)
-            .map(|(pm, own)| {
-                if pm.sky && approximate {
-                    probes::spread(own, probes::SKY_PROBES)
-                } else {
-                    Vec::new()
-                }
-            })
-            .collect();
-        let far_shooters = mesh
-            .polygons
-            .iter()
-            .zip(&samples)
-            .map(|(pm, own)| {
-                (approximate && !pm.sky)
-                    .then(|| FarShooter::new(own))
-                    .flatten()
-            })
-            .collect();
+        let crowded = setup::crowded(mesh, visibility, &coarse, approximate);
+        let sky_probes = setup::sky_probes(mesh, &samples, approximate);
+        let far_shooters = setup::far_shooters(mesh, &samples, approximate);
         let mut solver = Progressive {
             mesh: mesh_ref.clone(),
             visibility,
@@ -1179,107 +1137,6 @@ impl<'a> Progressive<'a> {
         self.rays = state.rays;
         Ok(())
     }
-}
-
-/// The ambient term ([`Progressive::ambient`]) of a scene whose polygon
-/// `j` (of `mesh`) has reflectance `reflectance[j]`, sky power weight
-/// `power_weight[j]` ([`sky_power_weights`]) and mean unshot radiosity
-/// `unshot_mean(j)`.
-fn ambient_term(
-    mesh: &Mesh,
-    reflectance: &[Rgb],
-    power_weight: &[f64],
-    unshot_mean: impl Fn(usize) -> Rgb,
-) -> Rgb {
-    let (mut area, mut unshot, mut reflected) = (0.0, Rgb::BLACK, Rgb::BLACK);
-    for (j, (rho, pm)) in reflectance.iter().zip(&mesh.polygons).enumerate() {
-        // The sky is no part of the scene its light is spread over;
-        // what it has not shot yet is the light's source, counted as
-        // the power it would bring (see `sky_power_weights`).
-        if pm.sky {
-            unshot += unshot_mean(j) * pm.area * power_weight[j];
-            continue;
-        }
-        area += pm.area;
-        unshot += unshot_mean(j) * pm.area;
-        reflected += *rho * pm.area;
-    }
-    if area <= 0.0 {
-        return Rgb::BLACK;
-    }
-    let rho = reflected / area;
-    // Every reflectance channel is below 1, so their mean is too.
-    let r = Rgb::new(
-        1.0 / (1.0 - rho.r),
-        1.0 / (1.0 - rho.g),
-        1.0 / (1.0 - rho.b),
-    );
-    r * (unshot / area)
-}
-
-/// What a solve of `scene` on `mesh` shows before its first step, per mesh
-/// vertex in the scene's radiosity units: each vertex's emission plus its
-/// reflectance times the ambient term of the unshot emission (the value of
-/// [`Progressive::radiosity_with_ambient`] for a new solver), computed
-/// without building a solver (no samples, clusters or visibility), so a
-/// window can show a lit scene at once on a model whose solver takes a
-/// while to set up.
-pub fn first_look(scene: &Scene, mesh: &Mesh) -> Vec<Rgb> {
-    let material = |p: &crate::scene::Polygon| &scene.materials[p.material.index()];
-    let emission: Vec<Rgb> = scene
-        .polygons
-        .iter()
-        .map(|p| material(p).emission())
-        .collect();
-    let reflectance: Vec<Rgb> = scene
-        .polygons
-        .iter()
-        .map(|p| material(p).reflectance())
-        .collect();
-    if emission.len() != mesh.polygons.len() {
-        return vec![Rgb::BLACK; mesh.vertex_count()];
-    }
-    let ambient = ambient_term(mesh, &reflectance, &sky_power_weights(mesh), |j| {
-        emission[j]
-    });
-    mesh.vertex_polygon
-        .iter()
-        .map(|p| emission[p.index()] + reflectance[p.index()] * ambient)
-        .collect()
-}
-
-/// Per polygon of `mesh`, the factor its unshot power counts with: 1 for
-/// the scene's polygons; for the facets of a sky, the scene's area (every
-/// non-sky polygon's) over the sky's, so that the whole sky counts as
-/// `S · A_scene`.
-///
-/// A sky's own power, `S` times the area of an enclosure far outside the
-/// scene, is mostly light that never reaches it, and it depends on the
-/// enclosure's arbitrary radius. Counted whole it would make the first
-/// bounce in the scene look negligible against the initial power, and the
-/// threshold would stop the solve before any light was reflected. What a
-/// sky can bring to the scene is at most `S · A_scene` (each polygon's form
-/// factor to the sky is at most 1), which is also what an emitter of the
-/// scene's size would hold: the threshold then means what it means for
-/// any scene.
-fn sky_power_weights(mesh: &Mesh) -> Vec<f64> {
-    let (mut scene_area, mut sky_area) = (0.0, 0.0);
-    for pm in &mesh.polygons {
-        if pm.sky {
-            sky_area += pm.area;
-        } else {
-            scene_area += pm.area;
-        }
-    }
-    let sky_weight = if sky_area > 0.0 {
-        scene_area / sky_area
-    } else {
-        1.0
-    };
-    mesh.polygons
-        .iter()
-        .map(|pm| if pm.sky { sky_weight } else { 1.0 })
-        .collect()
 }
 
 #[cfg(test)]
