@@ -25,6 +25,7 @@ use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
 use crate::solver::accel::cluster::Clusters;
+use crate::solver::accel::facets::Facets;
 use crate::solver::accel::facets::Scratch;
 use crate::solver::accel::receivers::CoarseGrid;
 use crate::solver::accel::{probes, receivers, subcells};
@@ -33,7 +34,7 @@ use crate::solver::unshot::Shot;
 use crate::solver::{
     Progressive, LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
 };
-use crate::visibility::{LastBlocker, ShadowQuery};
+use crate::visibility::{LastBlocker, ShadowQuery, Visibility};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -69,120 +70,126 @@ impl<'a> Progressive<'a> {
         stage: Stage,
         cancel: &AtomicBool,
     ) -> Option<Gathered> {
-        let i = shooter.index();
-        let mesh: &Mesh = &self.mesh;
-        let visibility = self.visibility;
-        let culling = self.options.shaft_culling;
-        let groups = self.shooter_groups(i);
-        let receives = &self.receives;
-        let candidates = &self.candidates;
-        let small = &self.small;
-        let tile_candidates = &self.tile_candidates;
-        let tile_of = &self.tile_of;
-        let samples = &self.samples[i];
-        let shooter_normal = mesh.polygons[i].normal;
-        let reflectance = &self.reflectance;
-        let near_field = self.options.near_field;
-        let shot = &self.shot;
-        let directional = self.directional[i].as_ref();
-        let split = subcells::Split::of_polygon(&self.parts[i], &self.part_readings);
-        // The exact `Δrad` at receiving vertex `l` of polygon `j`, with the
-        // pairs and rays it took.
-        let facets = &self.facets;
-        let probes = &self.probes[i][..];
-        let far_shooter = self.far_shooters[i].as_ref();
-        let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
-            let x = mesh.sample_positions[l];
-            let tile = tile_of[l] as usize * groups;
-            let mut rays = 0u64;
-            let memo = &mut scratch.memo;
-            let nx = mesh.polygons[j.index()].normal;
-            let mut last = LastBlocker::default();
-            // Whether sample `k` at `s` is hidden from this vertex.
-            let mut ray = |k: usize, s: glam::Vec3| -> bool {
-                // A ray from elsewhere than the sample (the part of a near
-                // cell in front of the vertex) is the vertex's own and
-                // outside the shafts, which were built from the samples.
-                if s != samples[k].position {
-                    rays += 1;
-                    return visibility.occluded_remembering(s, x, (shooter, j), &mut last);
-                }
-                // A small facet's vertices share one ray per sample.
-                if let Some((hit, cast)) = facets.shared_ray(
-                    memo,
-                    visibility,
-                    (shooter, j),
-                    k as u32,
-                    s,
-                    samples[k].exact_r2,
-                ) {
-                    rays += cast;
-                    return hit;
-                }
-                // The thin shaft's polygons, when the receiver has a
-                // complete list of them.
-                let culled =
-                    culling && !small[j.index()] && candidates[j.index()].len() <= REFINE_MAX;
-                let blockers = culled.then(|| {
-                    tile_candidates
-                        .get(tile + k / SHOOTER_GROUP)
-                        .map_or(&[][..], |c| &c[..])
-                });
-                let query = ShadowQuery::choose(blockers, LINEAR_CANDIDATES);
-                rays += query.rays();
-                visibility.shadow_remembering(query, s, x, (shooter, j), &mut last)
+        let groups = self.shooter_groups(shooter.index());
+        self.gather_with(groups, |p, g, sums| {
+            let i = shooter.index();
+            let (mesh, visibility, facets) = (g.mesh, g.visibility, g.facets);
+            let samples = &p.samples[i];
+            let shooter_normal = mesh.polygons[i].normal;
+            let near_field = g.near_field;
+            let shot = &p.shot;
+            let directional = p.directional[i].as_ref();
+            let split = subcells::Split::of_polygon(&p.parts[i], &p.part_readings);
+            // The exact `Δrad` at receiving vertex `l` of polygon `j`, with
+            // the pairs and rays it took.
+            let probes = &p.probes[i][..];
+            let far_shooter = p.far_shooters[i].as_ref();
+            let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
+                let x = mesh.sample_positions[l];
+                let tile = g.tile(l);
+                let mut rays = 0u64;
+                let memo = &mut scratch.memo;
+                let nx = mesh.polygons[j.index()].normal;
+                let mut last = LastBlocker::default();
+                // Whether sample `k` at `s` is hidden from this vertex.
+                let mut ray = |k: usize, s: glam::Vec3| -> bool {
+                    // A ray from elsewhere than the sample (the part of a
+                    // near cell in front of the vertex) is the vertex's own
+                    // and outside the shafts, which were built from the
+                    // samples.
+                    if s != samples[k].position {
+                        rays += 1;
+                        return visibility.occluded_remembering(s, x, (shooter, j), &mut last);
+                    }
+                    // A small facet's vertices share one ray per sample.
+                    if let Some((hit, cast)) = facets.shared_ray(
+                        memo,
+                        visibility,
+                        (shooter, j),
+                        k as u32,
+                        s,
+                        samples[k].exact_r2,
+                    ) {
+                        rays += cast;
+                        return hit;
+                    }
+                    // The thin shaft's polygons, when the receiver has a
+                    // complete list of them.
+                    let blockers = g.culled(j).then(|| g.thin_shaft(tile, k / SHOOTER_GROUP));
+                    let query = ShadowQuery::choose(blockers, LINEAR_CANDIDATES);
+                    rays += query.rays();
+                    visibility.shadow_remembering(query, s, x, (shooter, j), &mut last)
+                };
+                // A sky facet's probes, when they agree, stand for all its
+                // directions; so do a far shooter's for all its samples.
+                let far_probes = far_shooter.and_then(|f| f.probes_from(x));
+                let verdict = match (probes, far_probes) {
+                    ([], None) => None,
+                    ([], Some(far)) => probes::verdict(far, samples, x, nx, &mut ray),
+                    (sky, _) => probes::verdict(sky, samples, x, nx, &mut ray),
+                };
+                let (f, pairs) = distribution::shot_point_to_samples(
+                    directional,
+                    x,
+                    nx,
+                    shooter_normal,
+                    samples,
+                    |k| shot[k],
+                    split.as_ref(),
+                    near_field,
+                    |k, s| match verdict {
+                        Some(blocked) => blocked,
+                        None => ray(k, s),
+                    },
+                );
+                (g.reflectance[j.index()] * f, pairs, rays)
             };
-            // A sky facet's probes, when they agree, stand for all its
-            // directions; so do a far shooter's for all its samples.
-            let far_probes = far_shooter.and_then(|f| f.probes_from(x));
-            let verdict = match (probes, far_probes) {
-                ([], None) => None,
-                ([], Some(far)) => probes::verdict(far, samples, x, nx, &mut ray),
-                (sky, _) => probes::verdict(sky, samples, x, nx, &mut ray),
-            };
-            let (f, pairs) = distribution::shot_point_to_samples(
-                directional,
-                x,
-                nx,
-                shooter_normal,
-                samples,
-                |k| shot[k],
-                split.as_ref(),
-                near_field,
-                |k, s| match verdict {
-                    Some(blocked) => blocked,
-                    None => ray(k, s),
-                },
-            );
-            (reflectance[j.index()] * f, pairs, rays)
+            // Reflected light may be interpolated across receiving grids;
+            // an emitter's shot, which draws the sharpest shadows, never is.
+            let on = p.clustered && p.options.receiver_interpolation && p.emission[i].is_black();
+            let cells = p.interpolating(on, p.clusters.of(shooter));
+            gather_passes(sums, mesh, &cells, cancel, exact, Work { vertices, stage })
+        })
+    }
+
+    /// Runs a gather `f` with its [`GatherContext`] (the shooter's points
+    /// culled in `groups` groups) and the buffers it writes ([`Sums`]),
+    /// which are taken out of the solver for the call, so that the
+    /// context and `f` may read all the rest of it, and put back after.
+    pub(in crate::solver) fn gather_with<F>(&mut self, groups: usize, f: F) -> Option<Gathered>
+    where
+        F: FnOnce(&Self, &GatherContext, Sums) -> Option<Gathered>,
+    {
+        let mut delta = std::mem::take(&mut self.delta);
+        let mut first = std::mem::take(&mut self.coarse_delta);
+        let mut spent = std::mem::take(&mut self.spent);
+        let sums = Sums {
+            delta: &mut delta,
+            first: &mut first,
+            spent: &mut spent,
         };
-        // Reflected light may be interpolated across receiving grids; an
-        // emitter's shot, which draws the sharpest shadows, never is.
-        let cells = Interpolating {
-            on: self.clustered
-                && self.options.receiver_interpolation
-                && self.emission[i].is_black(),
+        let gathered = f(self, &GatherContext::new(self, groups), sums);
+        self.delta = delta;
+        self.coarse_delta = first;
+        self.spent = spent;
+        gathered
+    }
+
+    /// The receiving grids' interpolation of a step shot by `cluster`
+    /// ([`Interpolating`]), `on` unless the step evaluates every vertex
+    /// exactly.
+    pub(in crate::solver) fn interpolating(&self, on: bool, cluster: usize) -> Interpolating<'_> {
+        Interpolating {
+            on,
             coarse: &self.coarse,
             crowded: &self.crowded,
             clusters: &self.clusters,
-            receives,
-            cluster: self.clusters.of(shooter),
-            shooter: self.clusters.bounds(self.clusters.of(shooter)),
-            positions: &mesh.positions,
+            receives: &self.receives,
+            cluster,
+            shooter: self.clusters.bounds(cluster),
+            positions: &self.mesh.positions,
             held: &self.radiosity,
-        };
-        gather_passes(
-            Sums {
-                delta: &mut self.delta,
-                first: &mut self.coarse_delta,
-                spent: &mut self.spent,
-            },
-            mesh,
-            &cells,
-            cancel,
-            exact,
-            Work { vertices, stage },
-        )
+        }
     }
 
     /// Phase 4 by hemicubes ([`hemicube::Shooting::gather`]): `Δrad` of
@@ -217,6 +224,79 @@ impl<'a> Progressive<'a> {
             cancel,
         )?;
         Some(Gathered { pairs, rays: 0 })
+    }
+}
+
+/// What both gathers (a polygon's, a cluster's) read of the step: the
+/// solver's inputs, the receivers and their shadow-ray candidates.
+pub(in crate::solver) struct GatherContext<'g> {
+    /// The mesh whose vertices receive.
+    pub(in crate::solver) mesh: &'g Mesh,
+    pub(in crate::solver) visibility: &'g Visibility,
+    /// The small facets whose vertices share their shadow rays.
+    pub(in crate::solver) facets: &'g Facets,
+    /// Per polygon: front reflectance.
+    pub(in crate::solver) reflectance: &'g [Rgb],
+    /// [`crate::solver::SolverOptions::near_field`].
+    pub(in crate::solver) near_field: bool,
+    /// [`crate::solver::SolverOptions::shaft_culling`].
+    culling: bool,
+    /// Per polygon: too small for a shaft of its own.
+    small: &'g [bool],
+    /// Per polygon: the polygons in its shaft to the shooter.
+    candidates: &'g [Vec<u32>],
+    /// Per tile and shooter group: the polygons in the thin shaft between
+    /// them.
+    tile_candidates: &'g [Vec<u32>],
+    /// Per vertex: its tile.
+    tile_of: &'g [u32],
+    /// Shooter groups per tile in `tile_candidates`.
+    groups: usize,
+}
+
+impl<'g> GatherContext<'g> {
+    /// The context of a gather by `p` whose shooter points were culled in
+    /// `groups` groups.
+    fn new(p: &'g Progressive, groups: usize) -> Self {
+        GatherContext {
+            mesh: &p.mesh,
+            visibility: p.visibility,
+            facets: &p.facets,
+            reflectance: &p.reflectance,
+            near_field: p.options.near_field,
+            culling: p.options.shaft_culling,
+            small: &p.small,
+            candidates: &p.candidates,
+            tile_candidates: &p.tile_candidates,
+            tile_of: &p.tile_of,
+            groups,
+        }
+    }
+
+    /// Whether receiver `j`'s rays are culled by its shafts: with shaft
+    /// culling, unless it is small or its shaft held too many polygons
+    /// to list ([`REFINE_MAX`]).
+    pub(in crate::solver) fn culled(&self, j: PolygonId) -> bool {
+        self.culling && !self.small[j.index()] && self.candidates[j.index()].len() <= REFINE_MAX
+    }
+
+    /// The polygons in receiver `j`'s shaft to the shooter.
+    pub(in crate::solver) fn shaft(&self, j: PolygonId) -> &'g [u32] {
+        &self.candidates[j.index()]
+    }
+
+    /// Where vertex `l`'s tile's thin shafts start ([`GatherContext::thin_shaft`]).
+    pub(in crate::solver) fn tile(&self, l: usize) -> usize {
+        self.tile_of[l] as usize * self.groups
+    }
+
+    /// The polygons in the thin shaft between the tile starting at `tile`
+    /// ([`GatherContext::tile`]) and shooter group `group`; empty when
+    /// none were culled.
+    pub(in crate::solver) fn thin_shaft(&self, tile: usize, group: usize) -> &'g [u32] {
+        self.tile_candidates
+            .get(tile + group)
+            .map_or(&[][..], |c| &c[..])
     }
 }
 
