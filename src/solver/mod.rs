@@ -500,9 +500,9 @@ pub struct Progressive<'a> {
     power_weight: Vec<f64>,
     /// Per polygon: shooter samples.
     samples: Vec<Vec<ShooterSample>>,
-    /// Per polygon: the parts of its shooter cells much larger than its
-    /// elements ([`subcells`]).
-    parts: Vec<SubCells>,
+    /// Per polygon: the sub-cells of its shooter cells much larger than
+    /// its elements ([`subcells`]).
+    subcells: Vec<SubCells>,
     /// Per polygon: its light distribution when it is a luminaire (its
     /// shot then weights directions by it, [`distribution`]).
     directional: Vec<Option<distribution::Directional>>,
@@ -517,10 +517,10 @@ pub struct Progressive<'a> {
     unshot: UnshotField,
     /// Scratch: the unshot radiosity each sample of the shooter carries.
     shot: Vec<Rgb>,
-    /// Scratch: what each part of the shooter's split cells sends
+    /// Scratch: what each sub-cell of the shooter's split cells sends
     /// ([`subcells`]), in the order of its [`SubCells::cells`]; empty in
-    /// the per-polygon scheme, whose parts would all send the same.
-    part_readings: Vec<Rgb>,
+    /// the per-polygon scheme, whose sub-cells would all send the same.
+    subcell_readings: Vec<Rgb>,
     /// Per vertex: scratch for the step's `Δrad`.
     delta: Vec<Rgb>,
     /// Per polygon: scratch, whether it receives in this step.
@@ -568,14 +568,15 @@ pub struct Progressive<'a> {
     /// strata.
     cells: Vec<Cell>,
     cell_samples: Vec<ShooterSample>,
-    /// Scratch for a cluster step, per cell: where its parts' values start
-    /// in `cell_part_values` when it is split, else [`subcells::NONE`].
-    cell_parts: Vec<u32>,
-    /// Scratch: what each part of a cluster step's split cells sends.
-    cell_part_values: Vec<Rgb>,
-    /// The leaves' values of the parts in `cell_part_values`,
-    /// [`subcells::LEAVES`] per part, apart from the parts' so that those
-    /// every receiver takes lie together in memory.
+    /// Scratch for a cluster step, per cell: where its sub-cells' values
+    /// start in `cell_subcell_values` when it is split, else
+    /// [`subcells::NONE`].
+    cell_subcells: Vec<u32>,
+    /// Scratch: what each sub-cell of a cluster step's split cells sends.
+    cell_subcell_values: Vec<Rgb>,
+    /// The leaves' values of the sub-cells in `cell_subcell_values`,
+    /// [`subcells::LEAVES`] per sub-cell, apart from the sub-cells' so that
+    /// those every receiver takes lie together in memory.
     cell_leaf_values: Vec<Rgb>,
     strata: Strata,
     /// Per polygon: its regular grid, whose vertices between coarse rows
@@ -650,14 +651,14 @@ impl<'a> Progressive<'a> {
             .map(|p| emission[p.index()])
             .collect();
         let covered = crate::mesh::covered::covered_vertices(scene, mesh);
-        let parts = SubCells::build_all(scene, mesh, &samples, options.near_field);
+        let subcells = SubCells::build_all(scene, mesh, &samples, options.near_field);
         let unshot = UnshotField::new(
             options.unshot,
             mesh,
             &emission,
             &samples,
             &sets,
-            &parts,
+            &subcells,
             covered,
         );
         let power_weight = sky_power_weights(mesh);
@@ -695,13 +696,13 @@ impl<'a> Progressive<'a> {
             reflectance,
             power_weight,
             samples,
-            parts,
+            subcells,
             directional: distribution::Directional::for_scene(scene),
             radiosity,
             vertex_area: mesh.vertex_areas(),
             unshot,
             shot: Vec::new(),
-            part_readings: Vec::new(),
+            subcell_readings: Vec::new(),
             delta: vec![Rgb::BLACK; mesh.vertex_count()],
             receives: vec![false; mesh.polygons.len()],
             candidates: vec![Vec::new(); mesh.polygons.len()],
@@ -718,8 +719,8 @@ impl<'a> Progressive<'a> {
             clustered,
             cells: Vec::new(),
             cell_samples: Vec::new(),
-            cell_parts: Vec::new(),
-            cell_part_values: Vec::new(),
+            cell_subcells: Vec::new(),
+            cell_subcell_values: Vec::new(),
             cell_leaf_values: Vec::new(),
             strata: Strata::default(),
             coarse,
@@ -980,14 +981,14 @@ impl<'a> Progressive<'a> {
             return None;
         }
         // Each polygon's cells as a step of it reads them: a split cell by
-        // its parts.
+        // its sub-cells.
         let shot: Vec<(Vec<Rgb>, Vec<Rgb>)> = self
             .unshot
             .shot_at_samples(&self.mesh, &self.radiosity)?
             .into_iter()
-            .zip(&self.parts)
-            .map(|((mut values, readings), parts)| {
-                subcells::carry_means(parts, &readings, &mut values);
+            .zip(&self.subcells)
+            .map(|((mut values, readings), subs)| {
+                subcells::carry_means(subs, &readings, &mut values);
                 (values, readings)
             })
             .collect();
@@ -1010,8 +1011,12 @@ impl<'a> Progressive<'a> {
                 let normal = refined.polygons[j.index()].normal;
                 let mut sum = Rgb::BLACK;
                 let mut rays = 0;
-                for (i, ((samples, (values, readings)), parts)) in
-                    self.samples.iter().zip(&shot).zip(&self.parts).enumerate()
+                for (i, ((samples, (values, readings)), subs)) in self
+                    .samples
+                    .iter()
+                    .zip(&shot)
+                    .zip(&self.subcells)
+                    .enumerate()
                 {
                     // Coplanar polygons exchange no light (see
                     // `Visibility::coplanar`).
@@ -1026,7 +1031,7 @@ impl<'a> Progressive<'a> {
                         self.mesh.polygons[i].normal,
                         samples,
                         |k| values[k],
-                        subcells::Split::of_polygon(parts, readings).as_ref(),
+                        subcells::Split::of_polygon(subs, readings).as_ref(),
                         near_field,
                         |_, s| visibility.occluded(s, x, (shooter, j)),
                     );

@@ -11,7 +11,7 @@
 //! - [`probes`]: a sky facet's directions probed first;
 //! - [`far_shooters`]: a far shooter's samples probed first;
 //! - [`subcells`]: shooter cells much larger than their elements, shot as
-//!   their parts.
+//!   their sub-cells.
 
 pub mod cluster;
 pub mod facets;

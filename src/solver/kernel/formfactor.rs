@@ -460,7 +460,7 @@ pub fn point_to_samples(
 /// [`point_to_samples`] with each sample's term multiplied by
 /// `weight(k)` (an unshot radiosity, say) before summing: returns
 /// `Σ_k weight(k) · F_k` and the number of visibility questions asked.
-/// A sample that `split` takes by its parts ([`Split`]) gives
+/// A sample that `split` takes by its sub-cells ([`Split`]) gives
 /// `Σ value · F` over them instead, under its one ray.
 #[allow(clippy::too_many_arguments)]
 #[inline]

@@ -15,7 +15,7 @@
 //! - **sky probes** and **far shooters**: a few rays first, their answer
 //!   for all when they agree ([`crate::solver::accel::probes`],
 //!   [`crate::solver::accel::far_shooters`]);
-//! - **sub-cells**: a split cell near the receiver sends as its parts
+//! - **sub-cells**: a split cell near the receiver sends as its sub-cells
 //!   ([`crate::solver::accel::subcells`]);
 //! - the **near field** of the form factor
 //!   ([`crate::solver::SolverOptions::near_field`]).
@@ -79,7 +79,7 @@ impl<'a> Progressive<'a> {
             let near_field = g.near_field;
             let shot = &p.shot;
             let directional = p.directional[i].as_ref();
-            let split = subcells::Split::of_polygon(&p.parts[i], &p.part_readings);
+            let split = subcells::Split::of_polygon(&p.subcells[i], &p.subcell_readings);
             // The exact `Δrad` at receiving vertex `l` of polygon `j`, with
             // the pairs and rays it took.
             let probes = &p.probes[i][..];

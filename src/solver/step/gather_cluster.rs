@@ -59,10 +59,10 @@ impl<'a> Progressive<'a> {
                 clusters: &p.clusters,
                 cells: &p.cells,
                 cell_samples: &p.cell_samples,
-                cell_parts: &p.cell_parts,
-                cell_part_values: &p.cell_part_values,
+                cell_subcells: &p.cell_subcells,
+                cell_subcell_values: &p.cell_subcell_values,
                 cell_leaf_values: &p.cell_leaf_values,
-                parts: &p.parts,
+                subcells: &p.subcells,
                 strata: &p.strata,
                 held: &p.radiosity,
                 lump_share: if p.options.receiver_interpolation {
@@ -99,10 +99,10 @@ struct ClusterShot<'g> {
     clusters: &'g Clusters,
     cells: &'g [Cell],
     cell_samples: &'g [ShooterSample],
-    cell_parts: &'g [u32],
-    cell_part_values: &'g [Rgb],
+    cell_subcells: &'g [u32],
+    cell_subcell_values: &'g [Rgb],
     cell_leaf_values: &'g [Rgb],
-    parts: &'g [SubCells],
+    subcells: &'g [SubCells],
     strata: &'g Strata,
     /// Per vertex, the radiosity before the step.
     held: &'g [Rgb],
@@ -317,25 +317,26 @@ impl ClusterShot<'_> {
         blocked: &mut impl FnMut(Vec3, PolygonId, f32, u32) -> bool,
     ) -> Option<(Rgb, u64)> {
         let (mesh, visibility, near_field) = (self.g.mesh, self.g.visibility, self.g.near_field);
-        let (cell_parts, parts) = (self.cell_parts, self.parts);
-        let (cell_part_values, cell_leaf_values) = (self.cell_part_values, self.cell_leaf_values);
+        let (cell_subcells, subs) = (self.cell_subcells, self.subcells);
+        let (cell_subcell_values, cell_leaf_values) =
+            (self.cell_subcell_values, self.cell_leaf_values);
         let rep = &self.cells[node.representative as usize];
         let rep_sample = &self.cell_samples[node.representative as usize];
         if rep.polygon == j || visibility.coplanar(rep.polygon, j) {
             return None;
         }
-        // A split cell by its parts, as when its
+        // A split cell by its sub-cells, as when its
         // polygon shoots alone.
-        let at = cell_parts[node.representative as usize];
+        let at = cell_subcells[node.representative as usize];
         let split = (at != subcells::NONE)
             .then(|| {
                 let at = at as usize;
                 subcells::Split::of_cell(
-                    &parts[rep.polygon.index()],
+                    &subs[rep.polygon.index()],
                     rep.sample as usize,
-                    &cell_part_values[at..at + subcells::PARTS],
+                    &cell_subcell_values[at..at + subcells::SUBCELLS],
                     &cell_leaf_values
-                        [at * subcells::LEAVES..(at + subcells::PARTS) * subcells::LEAVES],
+                        [at * subcells::LEAVES..(at + subcells::SUBCELLS) * subcells::LEAVES],
                 )
             })
             .flatten();

@@ -7,7 +7,7 @@
 //!   samples together what the step takes from the polygon
 //!   (`kernel::cell_integrals`);
 //! - **sub-cells**: a cell much larger than its elements is read as its
-//!   parts and leaves ([`crate::solver::accel::subcells`]);
+//!   sub-cells and leaves ([`crate::solver::accel::subcells`]);
 //! - **strata**: a cluster (or a polygon of weak light) shoots from a cut
 //!   of its strata, the fewer the weaker its light
 //!   ([`crate::solver::FULL_STRATA_SHARE`], [`crate::solver::MIN_STRATA`]);
@@ -53,8 +53,8 @@ impl<'a> Progressive<'a> {
     /// Phase 2, read the shooter's samples: fills `self.shot` with the
     /// radiosity each sample of `shooter` sends in a step that sends
     /// `shot` ([`UnshotField::read_shooter`]).
-    /// Its cells much larger than the elements carry their parts' mean,
-    /// and their parts' own light is read into `self.part_readings`
+    /// Its cells much larger than the elements carry their sub-cells'
+    /// mean, and their sub-cells' own light is read into `self.subcell_readings`
     /// ([`subcells`]).
     pub(in crate::solver) fn read_shooter(&mut self, shooter: PolygonId, shot: Shot) {
         let i = shooter.index();
@@ -66,14 +66,14 @@ impl<'a> Progressive<'a> {
             shot,
             &self.radiosity,
             &mut self.shot,
-            &mut self.part_readings,
+            &mut self.subcell_readings,
         );
-        subcells::carry_means(&self.parts[i], &self.part_readings, &mut self.shot);
+        subcells::carry_means(&self.subcells[i], &self.subcell_readings, &mut self.shot);
         // The samples read the field at their cells' centres; what they
         // send together must be what the step takes from the polygon.
         let sent = self.unshot.sent_power(&self.mesh, i, shot, &self.radiosity);
         unshot::send_what_is_spent(&mut self.shot, &self.samples[i], sent)
-            .apply(&mut self.part_readings);
+            .apply(&mut self.subcell_readings);
     }
 
     /// Cluster step, phase 2: the cluster's cells (every member's shooter
@@ -89,8 +89,8 @@ impl<'a> Progressive<'a> {
     ) {
         self.cells.clear();
         self.cell_samples.clear();
-        self.cell_parts.clear();
-        self.cell_part_values.clear();
+        self.cell_subcells.clear();
+        self.cell_subcell_values.clear();
         self.cell_leaf_values.clear();
         for member in 0..self.clusters.members(cluster).len() {
             let m = self.clusters.members(cluster)[member];
@@ -99,7 +99,7 @@ impl<'a> Progressive<'a> {
             // Each member's cells read as when it shoots alone.
             self.read_shooter(PolygonId(m), shot);
             let mesh: &Mesh = &self.mesh;
-            let parts = &self.parts[i];
+            let subs = &self.subcells[i];
 
             for (k, (sample, &unshot)) in self.samples[i].iter().zip(&self.shot).enumerate() {
                 let power = unshot.mean() * sample.area;
@@ -113,16 +113,16 @@ impl<'a> Progressive<'a> {
                         power,
                     });
                     self.cell_samples.push(*sample);
-                    let at = match parts.cell_values(k, &self.part_readings) {
-                        Some((parts, leaves)) => {
-                            let at = self.cell_part_values.len() as u32;
-                            self.cell_part_values.extend_from_slice(parts);
+                    let at = match subs.cell_values(k, &self.subcell_readings) {
+                        Some((values, leaves)) => {
+                            let at = self.cell_subcell_values.len() as u32;
+                            self.cell_subcell_values.extend_from_slice(values);
                             self.cell_leaf_values.extend_from_slice(leaves);
                             at
                         }
                         None => subcells::NONE,
                     };
-                    self.cell_parts.push(at);
+                    self.cell_subcells.push(at);
                 }
             }
         }
