@@ -11,7 +11,7 @@ use radiosity::config::{RunConfig, SceneSource};
 use radiosity::prepare::{self, Prepared};
 use radiosity::scene::Units;
 use radiosity::session::{Session, SessionOptions};
-use radiosity::solver::gather::FinalGather;
+use radiosity::solver::final_gather::FinalGather;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;

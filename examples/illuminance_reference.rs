@@ -41,7 +41,7 @@ use radiosity::config::{RunConfig, SceneSource};
 use radiosity::prepare;
 use radiosity::scene::{Scene, Units};
 use radiosity::session::{Session, SessionOptions};
-use radiosity::solver::gather::FinalGather;
+use radiosity::solver::final_gather::FinalGather;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::path::PathBuf;

@@ -29,7 +29,7 @@ use common::scenes::{
 use glam::Vec3;
 use radiosity::color::Rgb;
 use radiosity::scene::Scene;
-use radiosity::solver::formfactor::point_to_polygon;
+use radiosity::solver::kernel::formfactor::point_to_polygon;
 use radiosity::solver::{FormFactorMethod, ShooterSamples, SolverOptions, UnshotScheme};
 
 /// Exact form factor between two coaxial parallel unit squares one unit

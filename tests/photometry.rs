@@ -6,7 +6,7 @@
 use glam::Vec3;
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::{parse_str, Photometry, Scene, Sides, Units};
-use radiosity::solver::gather::{vertex_irradiance, FinalGather};
+use radiosity::solver::final_gather::{vertex_irradiance, FinalGather};
 use radiosity::solver::{FormFactorMethod, Progressive, SolverOptions};
 use radiosity::visibility::Visibility;
 use std::f64::consts::PI;

@@ -18,7 +18,7 @@ use crate::render::falsecolor::{self, Mapping, Quantity};
 use crate::render::{Frame, View};
 use crate::scene::import::points;
 use crate::scene::Photometric;
-use crate::solver::gather::{vertex_irradiance, FinalGather};
+use crate::solver::final_gather::{vertex_irradiance, FinalGather};
 use std::time::Instant;
 
 /// Checks what can be checked before solving: the points file parses and

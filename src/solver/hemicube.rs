@@ -807,5 +807,5 @@ impl Shooting {
 }
 
 #[cfg(test)]
-#[path = "hemicube_tests.rs"]
+#[path = "tests/hemicube.rs"]
 mod tests;

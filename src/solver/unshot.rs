@@ -58,10 +58,10 @@ enum Layout {
         /// Per polygon and shooter sample: where its unshot radiosity is
         /// read from.
         sources: Vec<Vec<SampleSource>>,
-        /// Per polygon and part of a split cell ([`SubCells::cells`]):
+        /// Per polygon and sub-cell of a split cell ([`SubCells::cells`]):
         /// where its unshot radiosity is read from.
-        part_sources: Vec<Vec<SampleSource>>,
-        /// Per polygon: the weights of the cells and parts that read
+        subcell_sources: Vec<Vec<SampleSource>>,
+        /// Per polygon: the weights of the cells and sub-cells that read
         /// their integral ([`SampleSource::Region`]), cell after cell.
         regions: Vec<Vec<(u32, f32)>>,
     },
@@ -182,15 +182,15 @@ impl UnshotField {
     /// marks the vertices hidden under a coplanar polygon laid over their
     /// own: they hold no unshot radiosity, and what they receive is not
     /// added to it, so light is not sent out twice from one place.
-    /// `parts` are every polygon's split cells ([`SubCells`]), read in the
-    /// per-vertex scheme (a polygon's one value has no parts to tell).
+    /// `subcells` are every polygon's split cells ([`SubCells`]), read in the
+    /// per-vertex scheme (a polygon's one value has no sub-cells to tell).
     pub(crate) fn new(
         scheme: UnshotScheme,
         mesh: &Mesh,
         emission: &[Rgb],
         samples: &[Vec<ShooterSample>],
         sets: &[SampleSet],
-        parts: &[SubCells],
+        subcells: &[SubCells],
         covered: Vec<bool>,
     ) -> Self {
         let is_covered = |l: usize| covered.get(l).copied().unwrap_or(false);
@@ -227,11 +227,11 @@ impl UnshotField {
                 }
             }
             UnshotScheme::Vertex => {
-                let (sources, (part_sources, regions)): (Vec<_>, (Vec<_>, Vec<_>)) = samples
+                let (sources, (subcell_sources, regions)): (Vec<_>, (Vec<_>, Vec<_>)) = samples
                     .par_iter()
                     .zip(&mesh.polygons)
                     .zip(sets)
-                    .zip(parts)
+                    .zip(subcells)
                     .map(|(((s, pm), &set), subs)| polygon_sources(mesh, pm, s, set, subs))
                     .map(|(a, b, c)| (a, (b, c)))
                     .unzip();
@@ -252,7 +252,7 @@ impl UnshotField {
                         vertex_area: mesh.vertex_areas(),
                         covered,
                         sources,
-                        part_sources,
+                        subcell_sources,
                         regions,
                     },
                 }
@@ -397,7 +397,7 @@ impl UnshotField {
     /// ([`Shot`], `>= 0`; `radiosity` as for [`UnshotField::sent_power`]):
     /// read from the polygon's value, or (per-vertex scheme) from the field
     /// at the sample. A vertex hidden under a coplanar polygon sends
-    /// nothing. `parts` (cleared first) gets the same for each part of the
+    /// nothing. `subcell_readings` (cleared first) gets the same for each sub-cell of the
     /// polygon's split cells ([`SubCells`]), in the per-vertex scheme.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn read_shooter(
@@ -408,10 +408,10 @@ impl UnshotField {
         shot: Shot,
         radiosity: &[Rgb],
         out: &mut Vec<Rgb>,
-        parts: &mut Vec<Rgb>,
+        subcell_readings: &mut Vec<Rgb>,
     ) {
         out.clear();
-        parts.clear();
+        subcell_readings.clear();
         let pm = &mesh.polygons[i];
         match &self.layout {
             Layout::Polygon { mean_weight } => {
@@ -423,7 +423,7 @@ impl UnshotField {
             Layout::Vertex {
                 vertex_area,
                 sources,
-                part_sources,
+                subcell_sources,
                 covered,
                 regions,
             } => {
@@ -436,7 +436,13 @@ impl UnshotField {
                 };
                 let mean = polygon_mean(pm, vertex_area, sent);
                 read_at_samples(&sources[i], &regions[i], sent, mean, out);
-                read_at_samples(&part_sources[i], &regions[i], sent, mean, parts);
+                read_at_samples(
+                    &subcell_sources[i],
+                    &regions[i],
+                    sent,
+                    mean,
+                    subcell_readings,
+                );
             }
         }
     }
@@ -534,7 +540,7 @@ impl UnshotField {
 
     /// Per polygon, what each of its shooter samples has shot so far:
     /// `b − Δb` (clamped at zero per channel) read at the sample as
-    /// shooting reads `Δb`, and the same for each part of its split cells
+    /// shooting reads `Δb`, and the same for each sub-cell of its split cells
     /// ([`SubCells`]). `radiosity` is `b` per mesh vertex. `None` for the
     /// per-polygon scheme, which cannot tell where on a polygon the light
     /// it shot came from.
@@ -547,7 +553,7 @@ impl UnshotField {
         let Layout::Vertex {
             vertex_area,
             sources,
-            part_sources,
+            subcell_sources,
             covered,
             regions,
         } = &self.layout
@@ -573,14 +579,14 @@ impl UnshotField {
         Some(
             mesh.polygons
                 .iter()
-                .zip(sources.iter().zip(part_sources).zip(regions))
-                .map(|(pm, ((sources, part_sources), regions))| {
-                    let (mut values, mut parts) = (Vec::new(), Vec::new());
+                .zip(sources.iter().zip(subcell_sources).zip(regions))
+                .map(|(pm, ((sources, subcell_sources), regions))| {
+                    let (mut values, mut subcells) = (Vec::new(), Vec::new());
                     let field = |l: usize| shot_field[l];
                     let mean = polygon_mean(pm, vertex_area, field);
                     read_at_samples(sources, regions, field, mean, &mut values);
-                    read_at_samples(part_sources, regions, field, mean, &mut parts);
-                    (values, parts)
+                    read_at_samples(subcell_sources, regions, field, mean, &mut subcells);
+                    (values, subcells)
                 })
                 .collect(),
         )
@@ -616,7 +622,7 @@ const MAX_SPEND_SCALE: f64 = 4.0;
 /// grid, every centre of the floor's 64 cells fell between the tables'
 /// shadows, and a step of the floor sent up to 7 % more light than it
 /// spent, which left the whole converged picture 3.7 % too bright (0.8 %
-/// at 128 samples, whose cells fall elsewhere). Cells and parts now read
+/// at 128 samples, whose cells fall elsewhere). Cells and sub-cells now read
 /// their integrals ([`super::cell_integrals`]), which add up to it but
 /// for what the hats' areas and the vertices' areas disagree on and
 /// for the samples that still read a point (a cell the elements do not
@@ -626,7 +632,7 @@ const MAX_SPEND_SCALE: f64 = 4.0;
 /// of the steps. A channel whose reading
 /// and whose target differ in sign, or by more than
 /// [`MAX_SPEND_SCALE`], is left as read. Returns what was done, for the
-/// parts of split cells ([`Rescale::apply`]) to follow their cells.
+/// sub-cells of split cells ([`Rescale::apply`]) to follow their cells.
 pub(crate) fn send_what_is_spent(
     values: &mut [Rgb],
     samples: &[ShooterSample],
@@ -680,8 +686,8 @@ pub(crate) struct Rescale {
 }
 
 impl Rescale {
-    /// Does the same to `values` (the parts of the shooter's split cells,
-    /// whose cells carry their mean, so cells and parts still agree).
+    /// Does the same to `values` (the sub-cells of the shooter's split cells,
+    /// whose cells carry their mean, so cells and sub-cells still agree).
     pub(crate) fn apply(&self, values: &mut [Rgb]) {
         if self.fill.is_black() && self.scale == Rgb::splat(1.0) {
             return;
@@ -754,9 +760,9 @@ fn read_at_samples(
 }
 
 /// Where polygon `pm`'s shooter `samples` (chosen as `set` says) and the
-/// parts of its split cells (`subs`) read their unshot radiosity, and the
+/// sub-cells of its split cells (`subs`) read their unshot radiosity, and the
 /// weights of those that read their cell's integral: every cell of a
-/// grid ([`SampleSet::AtMost`]) and every part
+/// grid ([`SampleSet::AtMost`]) and every sub-cell
 /// ([`super::cell_integrals`]). A sample without a cell, a sky facet's
 /// jittered one, and a cell the elements do not reach read the field at
 /// their point.
@@ -774,9 +780,9 @@ fn polygon_sources(
     } else {
         sample_sources(mesh, pm, samples, set)
     };
-    let parts: Vec<_> = subs.all().map(|c| (c.position, Some(c.corners))).collect();
-    let part_sources = cell_sources(mesh, pm, &parts, &mut regions);
-    (sources, part_sources, regions)
+    let subcells: Vec<_> = subs.all().map(|c| (c.position, Some(c.corners))).collect();
+    let subcell_sources = cell_sources(mesh, pm, &subcells, &mut regions);
+    (sources, subcell_sources, regions)
 }
 
 /// Where each of `cells` (a point of polygon `pm` and the cell it stands

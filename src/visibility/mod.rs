@@ -14,7 +14,10 @@
 //! blockers: a segment from a receiver vertex to a shooter sample touches
 //! both.
 
+mod query;
 pub mod shaft;
+
+pub use query::ShadowQuery;
 
 use crate::scene::{self, PolygonId, Scene};
 use glam::{DVec3, Vec3, Vec3A};

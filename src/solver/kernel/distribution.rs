@@ -20,9 +20,9 @@
 //! Visibility is the same one ray per sample as for any shooter.
 
 use super::formfactor::{weighted_point_to_samples, ShooterSample};
-use super::subcells::Split;
 use crate::color::Rgb;
 use crate::scene::{Photometry, Scene};
+use crate::solver::accel::subcells::Split;
 use glam::{DVec3, Vec3};
 use std::sync::Arc;
 
@@ -170,7 +170,7 @@ impl Directional {
 
 /// The form factor of a shot from a polygon: [`Directional::weighted`]
 /// when it has a distribution (its cells taken whole, each with its
-/// parts' mean), else [`weighted_point_to_samples`] (the arguments as
+/// sub-cells' mean), else [`weighted_point_to_samples`] (the arguments as
 /// there). The one place the solver's emitters differ.
 #[allow(clippy::too_many_arguments)]
 #[inline]

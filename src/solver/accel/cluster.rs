@@ -18,7 +18,7 @@
 //! emitter's own samples) and every sky facet.
 //!
 //! **Cluster shooting.** Each member contributes its shooter samples
-//! ([`super::formfactor`]), each carrying its unshot radiosity: these are
+//! ([`crate::solver::kernel::formfactor`]), each carrying its unshot radiosity: these are
 //! the cluster's *cells*, in the hierarchy's order. [`Strata::build`]
 //! makes a binary tree over them, each node split where its power is
 //! halved, and a cut of at most `k` nodes (the *strata*) of about equal

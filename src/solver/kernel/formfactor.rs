@@ -41,9 +41,9 @@
 //! and keep the disc term; so does every sample with the near field
 //! switched off.
 
-use super::subcells::{Split, FAR_SCALE};
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
+use crate::solver::accel::subcells::{Split, FAR_SCALE};
 use glam::{DVec3, Vec3, Vec4};
 use std::f64::consts::PI;
 
@@ -460,7 +460,7 @@ pub fn point_to_samples(
 /// [`point_to_samples`] with each sample's term multiplied by
 /// `weight(k)` (an unshot radiosity, say) before summing: returns
 /// `Σ_k weight(k) · F_k` and the number of visibility questions asked.
-/// A sample that `split` takes by its parts ([`Split`]) gives
+/// A sample that `split` takes by its sub-cells ([`Split`]) gives
 /// `Σ value · F` over them instead, under its one ray.
 #[allow(clippy::too_many_arguments)]
 #[inline]

@@ -4,9 +4,10 @@
 //! weak polygons through strata, negative light, large receivers cut into
 //! pieces in both passes of the hierarchical gather).
 
-use super::tests::same_bits;
+use super::same_bits;
 use super::*;
 use crate::mesh::{self, MeshOptions};
+use crate::solver::step::parts;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 

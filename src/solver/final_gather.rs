@@ -38,7 +38,7 @@ use super::{LINEAR_CANDIDATES, SHAFT_MIN_VERTICES};
 use crate::color::Rgb;
 use crate::mesh::{area_centroid, Mesh};
 use crate::scene::{PolygonId, Scene};
-use crate::visibility::Visibility;
+use crate::visibility::{ShadowQuery, Visibility};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -176,15 +176,8 @@ impl<'a> FinalGather<'a> {
                 );
             }
             let visibility = self.visibility;
-            let occluded = |s: Vec3| {
-                if !culled || candidates.len() > LINEAR_CANDIDATES {
-                    visibility.occluded(s, x, (id, id))
-                } else if candidates.is_empty() {
-                    false
-                } else {
-                    visibility.occluded_among_ends(s, x, &candidates, (id, id))
-                }
-            };
+            let query = ShadowQuery::choose(culled.then_some(&candidates[..]), LINEAR_CANDIDATES);
+            let occluded = |s: Vec3| visibility.shadow(query, s, x, (id, id));
             let e = match &source.directional {
                 Some(d) => d.gather(x, n, &source.samples, &source.radiosity, |_, s| occluded(s)),
                 None => {

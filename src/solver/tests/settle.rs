@@ -6,8 +6,8 @@
 //! it settles resumes to the same bits, and one thread or two give the
 //! same bits.
 
-use super::tests::{on_threads, same_bits};
 use super::*;
+use super::{on_threads, same_bits};
 use crate::testutil::{closed_box, cuboid, grey, mean_radiosity, polygon, regular_mesh, scene};
 
 /// The unit box of grey walls (reflectance 0.8) lit by a square lamp 0.2

@@ -18,9 +18,17 @@
 //! hierarchical gather (`Pass`); the polygon is applied once its last
 //! piece is done, as a receiving grid's interpolation and its check charges
 //! need all of its first pass. Without a budget a step is one chunk of
-//! every polygon: the solver as it was.
+//! every polygon: the solver as it was. `Plan` cuts the receivers into
+//! chunks; `Progressive::continue_step` runs them, each through phases 3
+//! to 5.
 //!
-//! [`SolverOptions::part_budget`]: super::SolverOptions::part_budget
+//! [`SolverOptions::part_budget`]: crate::solver::SolverOptions::part_budget
+
+use super::gather::Stage;
+use super::{How, Underway};
+use crate::scene::PolygonId;
+use crate::solver::{Progressive, StepReport};
+use std::sync::atomic::AtomicBool;
 
 use crate::mesh::PolygonMesh;
 use std::ops::Range;
@@ -52,7 +60,7 @@ const PIECE_GROWTH: f64 = 1.5;
 /// part of a step that then reached the rows under the shooting tables
 /// run to 0.13 s on the 150-table hall's finest mesh, and twice this,
 /// once the floor's cells round chair legs were exact in every step
-/// ([`super::receivers::CROWD_RATIO`]), let a piece of the 150-table
+/// ([`crate::solver::accel::receivers::CROWD_RATIO`]), let a piece of the 150-table
 /// hall's floor that reached them run to 0.12 s.
 pub const PIECE_WORK: u64 = 2 * CHUNK_WORK;
 
@@ -70,7 +78,7 @@ pub const NEAR_WEIGHT: u64 = 8;
 pub const WINDOW_PART_BUDGET: Duration = Duration::from_millis(50);
 
 /// Which pass of a receiving polygon's gather a piece runs
-/// ([`super::gather_passes`]).
+/// ([`super::gather::gather_passes`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Pass {
     /// The vertices evaluated exactly (every vertex when the step does
@@ -298,6 +306,118 @@ impl Plan {
     /// Whether a large polygon's gather has a second, interpolating pass.
     pub(crate) fn two_passes(&self) -> bool {
         self.two_passes
+    }
+}
+
+impl<'a> Progressive<'a> {
+    /// Gathers and applies chunks of the step under way until every
+    /// receiver is done (the step's report, `complete`) or, with a
+    /// [`SolverOptions::part_budget`], until the next chunk would take the
+    /// part past it, counted from `start` (a report of the part). `None`
+    /// once `cancel` is set:
+    /// the chunk in hand is dropped, and a step none of whose chunks was
+    /// applied is forgotten, leaving the state exactly as before it.
+    pub(in crate::solver) fn continue_step(
+        &mut self,
+        start: std::time::Instant,
+        cancel: &AtomicBool,
+    ) -> Option<StepReport> {
+        // On a worker of the thread pool: a part runs many short parallel
+        // loops, and each one called from outside the pool would wait for
+        // sleeping workers to wake and for the caller to be woken back.
+        if rayon::current_thread_index().is_none() {
+            return rayon::scope(|_| self.continue_step(start, cancel));
+        }
+        let mut u = self.underway.take()?;
+        let mut longest = std::time::Duration::ZERO;
+        u.part += 1;
+        loop {
+            let chunk_start = std::time::Instant::now();
+            let Some((chunk, after, work)) = self.next_chunk(&u) else {
+                break;
+            };
+            let piece = matches!(chunk, Chunk::Piece { .. });
+            if self.run_chunk(&mut u, chunk, cancel).is_none() {
+                u.part -= 1;
+                if u.spent {
+                    self.underway = Some(u);
+                }
+                return None;
+            }
+            let took = chunk_start.elapsed();
+            u.plan.advance(after);
+            u.plan.observe(piece, work, took);
+            longest = longest.max(took);
+            if u.plan.finished(self.mesh.polygons.len()) {
+                break;
+            }
+            if let Some(budget) = self.options.part_budget {
+                if start.elapsed() + longest >= budget {
+                    let report = self.part_report(&u, false);
+                    self.underway = Some(u);
+                    return Some(report);
+                }
+            }
+        }
+        Some(self.finish_step(&u))
+    }
+
+    /// The next chunk of step `u` ([`Plan::next`]).
+    /// The shooting cluster's own members count as near ones: their sums
+    /// descend to the cells around them.
+    pub(in crate::solver) fn next_chunk(&self, u: &Underway) -> Option<(Chunk, Cursor, u64)> {
+        let clustered = matches!(u.how, How::Cluster { .. });
+        let member = |j: usize| clustered && self.clusters.of(PolygonId(j as u32)) == u.cluster;
+        u.plan.next(&self.mesh.polygons, &self.receives, member)
+    }
+
+    /// Culls, gathers and (once its polygons are whole) applies one chunk
+    /// of the step `u`; `None` once `cancel` is set, with nothing of the
+    /// chunk applied.
+    pub(in crate::solver) fn run_chunk(
+        &mut self,
+        u: &mut Underway,
+        chunk: Chunk,
+        cancel: &AtomicBool,
+    ) -> Option<()> {
+        match chunk {
+            Chunk::Whole { polygons, vertices } => {
+                self.cull_chunk(u, polygons.clone());
+                let gathered = self.gather_chunk(u, vertices, Stage::All, cancel)?;
+                u.gathered.add(gathered);
+                self.apply_chunk(u, polygons);
+            }
+            Chunk::Piece {
+                polygon,
+                vertices,
+                all,
+                pass,
+                first,
+                last,
+            } => {
+                let two_passes = u.plan.two_passes();
+                let stage = match pass {
+                    Pass::Exact => {
+                        if first {
+                            self.cull_chunk(u, polygon..polygon + 1);
+                        }
+                        Stage::Exact {
+                            copy: (last && two_passes).then(|| all.clone()),
+                        }
+                    }
+                    Pass::Interpolated => Stage::Interpolated {
+                        charge: last.then(|| all.clone()),
+                    },
+                };
+                let gathered = self.gather_chunk(u, vertices, stage, cancel)?;
+                u.gathered.add(gathered);
+                let done = last && (pass == Pass::Interpolated || !two_passes);
+                if done {
+                    self.apply_chunk(u, polygon..polygon + 1);
+                }
+            }
+        }
+        Some(())
     }
 }
 

@@ -2,7 +2,7 @@
 //! the facet's directions, spread over it, and when they all agree (all
 //! open, all blocked) takes that answer for every direction of the facet.
 //!
-//! A sky facet shoots from [`super::formfactor::SKY_FACET_SAMPLES`]
+//! A sky facet shoots from [`crate::solver::kernel::formfactor::SKY_FACET_SAMPLES`]
 //! directions so that a window's or an overhang's edge draws a smooth
 //! penumbra, and a step cast a ray along each of them from every
 //! receiving vertex that faces them: 125 rays per vertex per step on a
@@ -23,7 +23,7 @@
 //! `--exact-receivers` and `--no-clustering`. A vertex's verdict depends
 //! only on its own rays, so the bits do not depend on the thread count.
 
-use super::formfactor::ShooterSample;
+use crate::solver::kernel::formfactor::ShooterSample;
 use glam::Vec3;
 
 /// How many of a sky facet's directions a receiving vertex asks first.

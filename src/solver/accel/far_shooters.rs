@@ -35,8 +35,8 @@
 //! `--exact-receivers` and `--no-clustering`. A vertex's answer depends
 //! only on its own rays, so the bits do not depend on the thread count.
 
-use super::formfactor::ShooterSample;
 use super::probes;
+use crate::solver::kernel::formfactor::ShooterSample;
 use glam::Vec3;
 
 /// A receiving vertex at least this many shooter diameters from the

@@ -1,8 +1,8 @@
 //! Sub-cells: a shooter cell much larger than its polygon's elements,
-//! shot as [`PARTS`] parts, each with the light it holds, and the parts
+//! shot as [`SUBCELLS`] sub-cells, each with the light it holds, and the sub-cells
 //! near a receiver as their leaves.
 //!
-//! A large polygon shoots from at most 64 cells ([`super::formfactor`]),
+//! A large polygon shoots from at most 64 cells ([`crate::solver::kernel::formfactor`]),
 //! one shadow ray each. Light pooled in a spot narrower than a cell (where
 //! a sphere rests on the floor, the floor's light gathers around the
 //! contact) is then sent as if spread over the whole cell, and the facets
@@ -13,29 +13,29 @@
 //!
 //! A cell that stands for more than [`ELEMENTS_PER_CELL`] elements and
 //! has something close over it (`Over`: a sphere's bottom, a block's
-//! foot, a lamp under the ceiling) is cut into 4 × 4 parts (a triangle
-//! into 16 congruent triangles), and each part again into 4 × 4 leaves.
-//! Each part and each leaf reads the light it holds (its integral over
+//! foot, a lamp under the ceiling) is cut into 4 × 4 sub-cells (a triangle
+//! into 16 congruent triangles), and each sub-cell again into 4 × 4 leaves.
+//! Each sub-cell and each leaf reads the light it holds (its integral over
 //! the elements, `cell_integrals`), and *every* receiver takes
-//! the cell as its parts: each part's own value and form factor (the
+//! the cell as its sub-cells: each sub-cell's own value and form factor (the
 //! quadrature of a cell or its point term), under the cell's one shadow
-//! ray, so the parts cost arithmetic, not rays. A receiver within
-//! [`EXACT_RATIO`] of a part's diameters takes that part as its leaves,
+//! ray, so the sub-cells cost arithmetic, not rays. A receiver within
+//! [`EXACT_RATIO`] of a sub-cell's diameters takes that sub-cell as its leaves,
 //! each by Lambert's exact form factor or its quadrature: so close, the
-//! light varies across the part (under a sphere's contact it falls to
+//! light varies across the sub-cell (under a sphere's contact it falls to
 //! nothing), and a facet just above sees the dark under it, not the
-//! part's mean. Without leaves the facets at a sphere's contact came out
+//! sub-cell's mean. Without leaves the facets at a sphere's contact came out
 //! 4 to 11 % brighter than the light around them gives them; with them,
 //! 0 to 3 %.
 //!
 //! Two shortcuts were tried and fail closed-form tests:
 //!
-//! - parts for near receivers only (those farther take the cell's mean):
-//!   a part near a receiver sends more of its light there than the mean
+//! - sub-cells for near receivers only (those farther take the cell's mean):
+//!   a sub-cell near a receiver sends more of its light there than the mean
 //!   does, while the receivers farther still get the mean, and a closed
 //!   box lit by a small lamp lost 1.3 % of its light;
-//! - parts only in steps whose light is uneven over the cell (by 10 %):
-//!   light that one step sends from its parts and another spreads over
+//! - sub-cells only in steps whose light is uneven over the cell (by 10 %):
+//!   light that one step sends from its sub-cells and another spreads over
 //!   the cell no longer adds up to what the cell has shot, and the
 //!   uniform enclosure's corners came out 1.1 % bright (0.05 % either
 //!   way when every step takes the same choice).
@@ -44,40 +44,40 @@
 //! cell made the bundled scenes take 1.5 times as long, for light that
 //! does not pool there.
 //!
-//! The cell itself carries the area-weighted mean of its parts
+//! The cell itself carries the area-weighted mean of its sub-cells
 //! ([`carry_means`]), so whatever takes it whole (a cluster's stratum seen
 //! from afar, a hemicube, a luminaire's distribution) sends the same
 //! power.
 
-use super::formfactor::{
-    cell_diameter2, lane_terms, point_to_polygon, quadrature, triangle_area, Quadrature,
-    ShooterSample, EXACT_RATIO, NEAR_FIELD_RATIO,
-};
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::{Polygon, Scene};
+use crate::solver::kernel::formfactor::{
+    cell_diameter2, lane_terms, point_to_polygon, quadrature, triangle_area, Quadrature,
+    ShooterSample, EXACT_RATIO, NEAR_FIELD_RATIO,
+};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// Parts per side of a split quadrilateral cell (a triangle is cut into
-/// `SIDE²` triangles), and leaves per side of a part.
+/// Sub-cells per side of a split quadrilateral cell (a triangle is cut into
+/// `SIDE²` triangles), and leaves per side of a sub-cell.
 pub const SIDE: usize = 4;
 
-/// Parts per split cell.
-pub const PARTS: usize = SIDE * SIDE;
+/// Sub-cells per split cell.
+pub const SUBCELLS: usize = SIDE * SIDE;
 
-/// Leaves per part: each part is cut again as a cell is, and a receiver
-/// within [`EXACT_RATIO`] of a part's diameters takes it as its leaves.
+/// Leaves per sub-cell: each sub-cell is cut again as a cell is, and a receiver
+/// within [`EXACT_RATIO`] of a sub-cell's diameters takes it as its leaves.
 pub const LEAVES: usize = SIDE * SIDE;
 
-/// A receiver within this many of a part's diameters takes the part as
-/// its leaves (the distance within which a part takes Lambert's exact
+/// A receiver within this many of a sub-cell's diameters takes the sub-cell as
+/// its leaves (the distance within which a sub-cell takes Lambert's exact
 /// form factor).
 pub const LEAF_RATIO: f32 = EXACT_RATIO;
 
-/// Values per split cell: one per part and one per leaf.
-pub const PER_CELL: usize = PARTS * (1 + LEAVES);
+/// Values per split cell: one per sub-cell and one per leaf.
+pub const PER_CELL: usize = SUBCELLS * (1 + LEAVES);
 
 /// A cell is split when it stands for more than this many of its
 /// polygon's elements (by area): finer than that, its centre's reading is
@@ -86,8 +86,8 @@ pub const ELEMENTS_PER_CELL: f64 = 4.0;
 
 /// A receiver farther than this factor of the cell's exact radius
 /// ([`ShooterSample::exact_r2`], itself 1.5 cell diameters), 2 cell
-/// diameters, is more than 6 of a part's diameters from every part, and
-/// takes their point terms, four at a time; nearer, each part is taken by
+/// diameters, is more than 6 of a sub-cell's diameters from every sub-cell, and
+/// takes their point terms, four at a time; nearer, each sub-cell is taken by
 /// the rules of a cell (Lambert's exact form factor within 1.5 of its
 /// diameters, its quadrature within 6, its point term beyond).
 pub const FAR_SCALE: f32 = 2.0 / 1.5;
@@ -95,12 +95,12 @@ pub const FAR_SCALE: f32 = 2.0 / 1.5;
 /// "Not split" in [`SubCells::first`] and in a step's [`Split::first`].
 pub const NONE: u32 = u32::MAX;
 
-/// One part of a split cell.
+/// One sub-cell of a split cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SubCell {
     /// Its centre, in scene units.
     pub position: Vec3,
-    /// The area it stands for, in square scene units; a cell's parts sum
+    /// The area it stands for, in square scene units; a cell's sub-cells sum
     /// to the cell's area.
     pub area: f64,
     /// Its corners, counter-clockwise from the front (a triangle repeats
@@ -112,28 +112,28 @@ pub struct SubCell {
     pub diameter2: f32,
 }
 
-/// The parts of one polygon's split cells.
+/// The sub-cells of one polygon's split cells.
 ///
 /// Invariant: `first` has one entry per shooter sample of the polygon,
 /// [`NONE`] or the index in `cells` of the first of the sample's
-/// [`PARTS`] parts, and the leaves of its parts.
+/// [`SUBCELLS`] sub-cells, and the leaves of its sub-cells.
 #[derive(Clone, Debug, Default)]
 pub struct SubCells {
-    /// Per shooter sample: where its parts start, or [`NONE`].
+    /// Per shooter sample: where its sub-cells start, or [`NONE`].
     pub first: Vec<u32>,
-    /// The parts, [`PARTS`] per split cell.
+    /// The sub-cells, [`SUBCELLS`] per split cell.
     pub cells: Vec<SubCell>,
-    /// The parts' centres and areas, four parts to a [`Quadrature`] (one
+    /// The sub-cells' centres and areas, four sub-cells to a [`Quadrature`] (one
     /// per SIMD lane), in the order of `cells`.
     pub centres: Vec<Quadrature>,
-    /// The parts' leaves, [`LEAVES`] per part in the order of `cells`
-    /// (part `p`'s from `p · LEAVES`), apart from the parts so that the
-    /// parts every receiver takes lie together in memory.
+    /// The sub-cells' leaves, [`LEAVES`] per sub-cell in the order of `cells`
+    /// (sub-cell `p`'s from `p · LEAVES`), apart from the sub-cells so that the
+    /// sub-cells every receiver takes lie together in memory.
     pub leaves: Vec<SubCell>,
 }
 
 impl SubCells {
-    /// Every polygon's parts: those of its cells that stand for more than
+    /// Every polygon's sub-cells: those of its cells that stand for more than
     /// [`ELEMENTS_PER_CELL`] of its elements and have something close over
     /// them (`Over`). None without the near field (`near_field` false), nor
     /// for samples without a cell, whose form factors have no cell to cut.
@@ -167,7 +167,7 @@ impl SubCells {
             .collect()
     }
 
-    /// The parts of the `samples` that `split` chooses (samples without a
+    /// The sub-cells of the `samples` that `split` chooses (samples without a
     /// cell are never split).
     pub fn build(samples: &[ShooterSample], split: impl Fn(&ShooterSample) -> bool) -> SubCells {
         let mut out = SubCells {
@@ -184,9 +184,9 @@ impl SubCells {
             out.first[k] = out.cells.len() as u32;
             let start = out.cells.len();
             cut(&cell, s.area, &mut out.cells);
-            for p in start..start + PARTS {
-                let part = out.cells[p];
-                cut(&part.corners, part.area, &mut out.leaves);
+            for p in start..start + SUBCELLS {
+                let subcell = out.cells[p];
+                cut(&subcell.corners, subcell.area, &mut out.leaves);
             }
             for four in out.cells[start..].chunks(4) {
                 out.centres.push(Quadrature::new(std::array::from_fn(|l| {
@@ -202,19 +202,19 @@ impl SubCells {
         self.cells.is_empty()
     }
 
-    /// Every part, then every leaf: the order of the values that go with
+    /// Every sub-cell, then every leaf: the order of the values that go with
     /// them ([`Split::of_polygon`]).
     pub fn all(&self) -> impl Iterator<Item = &SubCell> + '_ {
         self.cells.iter().chain(&self.leaves)
     }
 
-    /// How many values go with them: one per part and one per leaf.
+    /// How many values go with them: one per sub-cell and one per leaf.
     pub fn len(&self) -> usize {
         self.cells.len() + self.leaves.len()
     }
 
-    /// Split cell `k`'s parts' and leaves' values out of a polygon's
-    /// `values` (one per part, then one per leaf, as [`SubCells::all`]),
+    /// Split cell `k`'s sub-cells' and leaves' values out of a polygon's
+    /// `values` (one per sub-cell, then one per leaf, as [`SubCells::all`]),
     /// as [`Split::of_cell`] takes them; `None` unless `k` is split and
     /// `values` has one value each.
     pub fn cell_values<'v, W>(&self, k: usize, values: &'v [W]) -> Option<(&'v [W], &'v [W])> {
@@ -222,8 +222,8 @@ impl SubCells {
         if f == NONE as usize || values.len() != self.len() {
             return None;
         }
-        let leaves = self.cells.len() + f * LEAVES..self.cells.len() + (f + PARTS) * LEAVES;
-        Some((&values[f..f + PARTS], &values[leaves]))
+        let leaves = self.cells.len() + f * LEAVES..self.cells.len() + (f + SUBCELLS) * LEAVES;
+        Some((&values[f..f + SUBCELLS], &values[leaves]))
     }
 }
 
@@ -282,7 +282,8 @@ impl Over {
         inward: &[(Vec3, Vec3)],
         s: &ShooterSample,
     ) -> bool {
-        let diameter = (s.exact_r2.sqrt() / super::formfactor::EXACT_RATIO).max(f32::MIN_POSITIVE);
+        let diameter = (s.exact_r2.sqrt() / crate::solver::kernel::formfactor::EXACT_RATIO)
+            .max(f32::MIN_POSITIVE);
         let r2 = (REACH * diameter).powi(2);
         let (margin, ahead) = (EDGE_MARGIN * diameter, 1e-4 * diameter);
         let c = s.position;
@@ -323,7 +324,7 @@ fn inward_edges(polygon: &Polygon) -> Vec<(Vec3, Vec3)> {
         .collect()
 }
 
-/// Appends the [`PARTS`] parts of `cell` (3 or 4 corners, a triangle
+/// Appends the [`SUBCELLS`] sub-cells of `cell` (3 or 4 corners, a triangle
 /// repeating its last) to `out`, their areas scaled to sum to `area`
 /// exactly (the cell's, whatever the `f32` corners round to).
 fn cut(cell: &[Vec3; 4], area: f64, out: &mut Vec<SubCell>) {
@@ -338,10 +339,10 @@ fn cut(cell: &[Vec3; 4], area: f64, out: &mut Vec<SubCell>) {
             for i in 0..(SIDE - j) {
                 let (fi, fj) = (i as f32, j as f32);
                 let (p, q, r) = (at(fi, fj), at(fi + 1.0, fj), at(fi, fj + 1.0));
-                out.push(part([p, q, r, r]));
+                out.push(subcell([p, q, r, r]));
                 if i + j + 1 < SIDE {
                     let s = at(fi + 1.0, fj + 1.0);
-                    out.push(part([q, s, r, r]));
+                    out.push(subcell([q, s, r, r]));
                 }
             }
         }
@@ -353,7 +354,7 @@ fn cut(cell: &[Vec3; 4], area: f64, out: &mut Vec<SubCell>) {
             for i in 0..SIDE {
                 let (u0, u1) = (i as f32 / n, (i + 1) as f32 / n);
                 let (w0, w1) = (j as f32 / n, (j + 1) as f32 / n);
-                out.push(part([at(u0, w0), at(u1, w0), at(u1, w1), at(u0, w1)]));
+                out.push(subcell([at(u0, w0), at(u1, w0), at(u1, w1), at(u0, w1)]));
             }
         }
     }
@@ -365,10 +366,10 @@ fn cut(cell: &[Vec3; 4], area: f64, out: &mut Vec<SubCell>) {
     }
 }
 
-/// A part with the given corners: its centre is the corners' mean (the
+/// A sub-cell with the given corners: its centre is the corners' mean (the
 /// centroid for a triangle, the bilinear centre for a quadrilateral). Its
 /// quadrature is left for [`cut`] to set once the area is scaled.
-fn part(corners: [Vec3; 4]) -> SubCell {
+fn subcell(corners: [Vec3; 4]) -> SubCell {
     let triangle = corners[2] == corners[3];
     let position = if triangle {
         (corners[0] + corners[1] + corners[2]) / 3.0
@@ -391,23 +392,23 @@ fn part(corners: [Vec3; 4]) -> SubCell {
     }
 }
 
-/// A step's split cells and what their parts send.
+/// A step's split cells and what their sub-cells send.
 ///
 /// Invariant: `first` has one entry per sample of the shooter it is
-/// passed with, [`NONE`] or the index of the sample's first part in
+/// passed with, [`NONE`] or the index of the sample's first sub-cell in
 /// `cells` and `values` (a multiple of 4, its first [`Quadrature`] in
 /// `centres` being a quarter of it).
 #[derive(Clone, Copy, Debug)]
 pub struct Split<'a, W> {
-    /// Per sample: where its parts start, or [`NONE`] (taken whole).
+    /// Per sample: where its sub-cells start, or [`NONE`] (taken whole).
     pub first: &'a [u32],
-    /// The parts' geometry.
+    /// The sub-cells' geometry.
     pub cells: &'a [SubCell],
-    /// The parts' centres, four to a [`Quadrature`] ([`SubCells::centres`]).
+    /// The sub-cells' centres, four to a [`Quadrature`] ([`SubCells::centres`]).
     pub centres: &'a [Quadrature],
-    /// The parts' leaves, [`LEAVES`] per part in the order of `cells`.
+    /// The sub-cells' leaves, [`LEAVES`] per sub-cell in the order of `cells`.
     pub leaves: &'a [SubCell],
-    /// What each part sends (an unshot radiosity, say).
+    /// What each sub-cell sends (an unshot radiosity, say).
     pub values: &'a [W],
     /// What each leaf sends, in the order of `leaves`.
     pub leaf_values: &'a [W],
@@ -417,7 +418,7 @@ impl<'a, W> Split<'a, W>
 where
     W: Copy + Default + std::ops::AddAssign + std::ops::Mul<f64, Output = W>,
 {
-    /// The split of polygon `subs` with `values` one per part, when there
+    /// The split of polygon `subs` with `values` one per sub-cell, when there
     /// are as many (none in the per-polygon scheme).
     pub fn of_polygon(subs: &'a SubCells, values: &'a [W]) -> Option<Self> {
         (!subs.is_empty() && values.len() == subs.len()).then(|| {
@@ -433,8 +434,8 @@ where
         })
     }
 
-    /// The split of the single sample `k` of `subs` with its parts'
-    /// `values` ([`PARTS`] of them) and their leaves' `leaf_values`
+    /// The split of the single sample `k` of `subs` with its sub-cells'
+    /// `values` ([`SUBCELLS`] of them) and their leaves' `leaf_values`
     /// ([`SubCells::cell_values`]), for a shot of that one cell.
     pub fn of_cell(
         subs: &'a SubCells,
@@ -443,20 +444,21 @@ where
         leaf_values: &'a [W],
     ) -> Option<Self> {
         let f = *subs.first.get(k)? as usize;
-        if f == NONE as usize || values.len() != PARTS || leaf_values.len() != PARTS * LEAVES {
+        if f == NONE as usize || values.len() != SUBCELLS || leaf_values.len() != SUBCELLS * LEAVES
+        {
             return None;
         }
         Some(Split {
             first: &[0],
-            cells: &subs.cells[f..f + PARTS],
-            centres: &subs.centres[f / 4..f / 4 + PARTS / 4],
-            leaves: &subs.leaves[f * LEAVES..(f + PARTS) * LEAVES],
+            cells: &subs.cells[f..f + SUBCELLS],
+            centres: &subs.centres[f / 4..f / 4 + SUBCELLS / 4],
+            leaves: &subs.leaves[f * LEAVES..(f + SUBCELLS) * LEAVES],
             values,
             leaf_values,
         })
     }
 
-    /// Where sample `k`'s parts start, when it is split.
+    /// Where sample `k`'s sub-cells start, when it is split.
     #[inline]
     pub fn of(&self, k: usize) -> Option<usize> {
         match self.first.get(k) {
@@ -465,7 +467,7 @@ where
         }
     }
 
-    /// `Σ value · F` over the parts from `first` seen from `x` (unit normal
+    /// `Σ value · F` over the sub-cells from `first` seen from `x` (unit normal
     /// `nx`), the shooter's unit normal being `ns`, and `Σ F` alone (whether
     /// anything is seen). `far` says the receiver is more than
     /// [`FAR_SCALE`] of the cell's exact radius away.
@@ -473,10 +475,10 @@ where
     pub fn sum(&self, first: usize, x: Vec3, nx: Vec3, ns: Vec3, far: bool) -> (W, f64) {
         let mut sum = W::default();
         let mut total = 0.0;
-        let values = &self.values[first..first + PARTS];
-        let cells = &self.cells[first..first + PARTS];
+        let values = &self.values[first..first + SUBCELLS];
+        let cells = &self.cells[first..first + SUBCELLS];
         if far {
-            for (q, four) in self.centres[first / 4..first / 4 + PARTS / 4]
+            for (q, four) in self.centres[first / 4..first / 4 + SUBCELLS / 4]
                 .iter()
                 .zip(values.chunks_exact(4))
             {
@@ -492,7 +494,7 @@ where
             return (sum, total);
         }
         for (p, (c, &value)) in cells.iter().zip(values).enumerate() {
-            // A receiver this close sees the light vary across the part
+            // A receiver this close sees the light vary across the sub-cell
             // (where a sphere touches the floor it falls to nothing under
             // the contact): each leaf sends its own.
             if x.distance_squared(c.position) < LEAF_RATIO * LEAF_RATIO * c.diameter2 {
@@ -519,7 +521,7 @@ where
     }
 }
 
-/// The form factor from a receiver at `x` (unit normal `nx`) to part or
+/// The form factor from a receiver at `x` (unit normal `nx`) to sub-cell or
 /// leaf `c` of a shooter whose unit normal is `ns`, by the rules of a cell:
 /// Lambert's exact one within [`EXACT_RATIO`] of its diameters, its
 /// quadrature within [`NEAR_FIELD_RATIO`], its point term beyond; 0 when
@@ -534,7 +536,7 @@ fn part_term(c: &SubCell, x: Vec3, nx: Vec3, ns: Vec3) -> f64 {
         }
         point_to_polygon(x, nx, &c.corners)
     } else if r2 < NEAR_FIELD_RATIO * NEAR_FIELD_RATIO * c.diameter2 {
-        // A part reaching past the receiver's plane from behind it lights
+        // A sub-cell reaching past the receiver's plane from behind it lights
         // it by its part in front, as a cell does.
         if nx.dot(d) >= 0.0 {
             if c.corners.iter().all(|p| nx.dot(*p - x) <= 0.0) {
@@ -555,10 +557,10 @@ fn part_term(c: &SubCell, x: Vec3, nx: Vec3, ns: Vec3) -> f64 {
 }
 
 /// Sets each split cell's value in `cells` (one per shooter sample, as
-/// read at the cells' centres) to the area-weighted mean of its parts'
-/// `readings` (one per part, then one per leaf, as [`SubCells::all`]):
+/// read at the cells' centres) to the area-weighted mean of its sub-cells'
+/// `readings` (one per sub-cell, then one per leaf, as [`SubCells::all`]):
 /// what the cell sends when a step takes it whole. Does nothing unless
-/// there is one reading per part and leaf.
+/// there is one reading per sub-cell and leaf.
 pub fn carry_means(subs: &SubCells, readings: &[Rgb], cells: &mut [Rgb]) {
     if readings.len() != subs.len() {
         return;
@@ -567,7 +569,7 @@ pub fn carry_means(subs: &SubCells, readings: &[Rgb], cells: &mut [Rgb]) {
         if f == NONE {
             continue;
         }
-        let range = f as usize..f as usize + PARTS;
+        let range = f as usize..f as usize + SUBCELLS;
         let (mut sum, mut area) = (Rgb::BLACK, 0.0);
         for (c, &v) in subs.cells[range.clone()].iter().zip(&readings[range]) {
             sum += v * c.area;
@@ -598,7 +600,7 @@ mod tests {
         )
     }
 
-    /// The parts of a quadrilateral and of a triangle cover the cell: their
+    /// The sub-cells of a quadrilateral and of a triangle cover the cell: their
     /// areas sum to its area and their centres lie inside it.
     #[test]
     fn parts_cover_their_cell() {
@@ -616,12 +618,12 @@ mod tests {
                 Vec3::new(0.0, 3.0, 0.0),
             ],
         ] {
-            let mut parts = Vec::new();
+            let mut subcells = Vec::new();
             let expected = if cell[2] == cell[3] { 3.0 } else { 2.0 };
-            cut(&cell, expected, &mut parts);
-            assert_eq!(parts.len(), PARTS);
-            // The parts' own geometry, not the areas `cut` scaled.
-            let area: f64 = parts
+            cut(&cell, expected, &mut subcells);
+            assert_eq!(subcells.len(), SUBCELLS);
+            // The sub-cells' own geometry, not the areas `cut` scaled.
+            let area: f64 = subcells
                 .iter()
                 .map(|p| {
                     let c = p.corners;
@@ -629,14 +631,14 @@ mod tests {
                 })
                 .sum();
             assert!((area - expected).abs() < 1e-6, "{area} against {expected}");
-            for p in &parts {
+            for p in &subcells {
                 assert!(p.position.x > 0.0 && p.position.y > 0.0, "{p:?}");
-                assert!((p.area - expected / PARTS as f64).abs() < 1e-6);
+                assert!((p.area - expected / SUBCELLS as f64).abs() < 1e-6);
             }
         }
     }
 
-    /// The parts' form factors add up to the cell's exact one, near it
+    /// The sub-cells' form factors add up to the cell's exact one, near it
     /// (Lambert's and quadratures), a little farther (quadratures and
     /// point terms) and far away (point terms four at a time), within the
     /// errors the cell's own rules allow there.
@@ -645,7 +647,7 @@ mod tests {
         let s = square_cell(1.0);
         let subs = SubCells::build(std::slice::from_ref(&s), |_| true);
         assert_eq!(subs.len(), PER_CELL);
-        assert_eq!(subs.centres.len(), PARTS / 4);
+        assert_eq!(subs.centres.len(), SUBCELLS / 4);
         let ones = [1.0f64; PER_CELL];
         let split = Split::of_polygon(&subs, &ones).unwrap();
         let nx = -Vec3::Z;
@@ -667,9 +669,9 @@ mod tests {
 
     /// Just over a cell whose light falls to nothing under the receiver
     /// (a sphere resting on the floor), the leaves follow the light across
-    /// the parts: at 0.8 leaf widths over the dark point, against the light
+    /// the sub-cells: at 0.8 leaf widths over the dark point, against the light
     /// integrated over 128 × 128 squares, the leaves' sum is 6 % over and
-    /// the parts' alone 55 % (at 1.6 leaf widths, 2 % and 21 %).
+    /// the sub-cells' alone 55 % (at 1.6 leaf widths, 2 % and 21 %).
     #[test]
     fn leaves_follow_the_light_under_a_close_receiver() {
         let s = square_cell(1.0);
@@ -697,26 +699,26 @@ mod tests {
         let values: Vec<f64> = subs.all().map(|c| light(c.position)).collect();
         let split = Split::of_polygon(&subs, &values).unwrap();
         let (with_leaves, _) = split.sum(0, x, nx, Vec3::Z, false);
-        // Each part's leaves carrying its own value: the parts alone.
+        // Each sub-cell's leaves carrying its own value: the sub-cells alone.
         let mut flat = values.clone();
-        for p in 0..PARTS {
-            for leaf in &mut flat[PARTS + p * LEAVES..PARTS + (p + 1) * LEAVES] {
+        for p in 0..SUBCELLS {
+            for leaf in &mut flat[SUBCELLS + p * LEAVES..SUBCELLS + (p + 1) * LEAVES] {
                 *leaf = values[p];
             }
         }
         let split = Split::of_polygon(&subs, &flat).unwrap();
-        let (parts_alone, _) = split.sum(0, x, nx, Vec3::Z, false);
+        let (subcells_alone, _) = split.sum(0, x, nx, Vec3::Z, false);
         assert!(
             (with_leaves - exact).abs() < 0.08 * exact,
             "leaves {with_leaves} against {exact}"
         );
         assert!(
-            parts_alone > 1.4 * exact,
-            "parts {parts_alone} against {exact}"
+            subcells_alone > 1.4 * exact,
+            "subcells {subcells_alone} against {exact}"
         );
     }
 
-    /// A split cell carries its parts' mean; a cell without parts keeps
+    /// A split cell carries its sub-cells' mean; a cell without sub-cells keeps
     /// its own reading.
     #[test]
     fn a_split_cell_carries_its_parts_mean() {
@@ -724,8 +726,8 @@ mod tests {
         let mut subs = SubCells::build(&[s, s], |_| true);
         subs.first[0] = NONE;
         let mut readings = vec![Rgb::splat(1.0); 2 * PER_CELL];
-        // The second cell's first part (the parts come before the leaves).
-        readings[PARTS] = Rgb::splat(17.0);
+        // The second cell's first sub-cell (the sub-cells come before the leaves).
+        readings[SUBCELLS] = Rgb::splat(17.0);
         let mut cells = vec![Rgb::splat(3.0), Rgb::splat(5.0)];
         carry_means(&subs, &readings, &mut cells);
         assert_eq!(cells[0], Rgb::splat(3.0));
@@ -750,13 +752,13 @@ mod tests {
             .zip(&mesh.polygons)
             .map(|(p, pm)| shooter_samples(p, pm, &mesh, SampleSet::AtMost(64)))
             .collect();
-        let parts = SubCells::build_all(&s, &mesh, &samples, true);
+        let subcells = SubCells::build_all(&s, &mesh, &samples, true);
         let split_at = |polygon: usize, at: Vec3| {
             let k = samples[polygon]
                 .iter()
                 .position(|c| c.position.distance(at) < 1e-3)
                 .expect("a cell centred there");
-            parts[polygon].first[k] != NONE
+            subcells[polygon].first[k] != NONE
         };
         // The floor (y = 0) is polygon 2, the ceiling 3, the wall x = 0 is 0.
         assert!(split_at(2, Vec3::new(0.0625, 0.0, 0.0625)));
@@ -764,22 +766,22 @@ mod tests {
         assert!(!split_at(2, Vec3::new(0.9375, 0.0, 0.9375)));
         assert!(!split_at(2, Vec3::new(0.0625, 0.0, 0.9375)));
         assert!(!split_at(0, Vec3::new(0.0, 0.0625, 0.1875)));
-        assert!(parts[0].is_empty());
-        assert!(parts[3].is_empty());
+        assert!(subcells[0].is_empty());
+        assert!(subcells[3].is_empty());
         // The cube's faces are finer than their cells' split threshold.
-        assert!(parts[6..].iter().all(SubCells::is_empty));
-        // Every split cell's parts tile it.
-        for (p, samples) in parts.iter().zip(&samples) {
+        assert!(subcells[6..].iter().all(SubCells::is_empty));
+        // Every split cell's sub-cells tile it.
+        for (p, samples) in subcells.iter().zip(&samples) {
             for (k, &f) in p.first.iter().enumerate() {
                 if f != NONE {
                     let f = f as usize;
-                    let parts = &p.cells[f..f + PARTS];
-                    let area: f64 = parts.iter().map(|c| c.area).sum();
+                    let subcells = &p.cells[f..f + SUBCELLS];
+                    let area: f64 = subcells.iter().map(|c| c.area).sum();
                     assert!((area - samples[k].area).abs() < 1e-9 * samples[k].area);
-                    let leaves = &p.leaves[f * LEAVES..(f + PARTS) * LEAVES];
-                    for (part, leaves) in parts.iter().zip(leaves.chunks(LEAVES)) {
+                    let leaves = &p.leaves[f * LEAVES..(f + SUBCELLS) * LEAVES];
+                    for (subcell, leaves) in subcells.iter().zip(leaves.chunks(LEAVES)) {
                         let area: f64 = leaves.iter().map(|c| c.area).sum();
-                        assert!((area - part.area).abs() < 1e-9 * part.area);
+                        assert!((area - subcell.area).abs() < 1e-9 * subcell.area);
                     }
                 }
             }

@@ -90,7 +90,7 @@ fn far_shooters_probed_match_asking_every_sample() {
         );
     }
     let threads = |n| {
-        super::tests::on_threads(n, || {
+        super::on_threads(n, || {
             let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
             for _ in 0..5 {
                 if solver.step().is_none() {
@@ -100,5 +100,5 @@ fn far_shooters_probed_match_asking_every_sample() {
             solver.radiosity().to_vec()
         })
     };
-    assert!(super::tests::same_bits(&threads(1), &threads(2)));
+    assert!(super::same_bits(&threads(1), &threads(2)));
 }

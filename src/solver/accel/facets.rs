@@ -27,7 +27,7 @@
 //! widely for one to stand for the others (a chair leg where it meets the
 //! floor that shoots). So is a sample whose cell some vertex of the facet
 //! takes the exact point-to-cell form factor of
-//! ([`super::formfactor::EXACT_RATIO`]): such a vertex is close to a cell
+//! ([`crate::solver::kernel::formfactor::EXACT_RATIO`]): such a vertex is close to a cell
 //! large beside it and takes much of its light from it, by one ray that
 //! must end at the vertex itself. Measured on the 64-segment spheres: the
 //! tiny facets around a sphere's pole, where it touches the floor, lie
@@ -43,12 +43,12 @@
 //! the runs depend on work stealing (on the 100,000-triangle box, 4
 //! steps cast 12,319,995 to 12,320,055 rays over runs with the same
 //! picture bytes). On with clusters and hierarchical receivers
-//! ([`super::SolverOptions::receiver_interpolation`]); `--exact-receivers`
+//! ([`crate::solver::SolverOptions::receiver_interpolation`]); `--exact-receivers`
 //! and `--no-clustering` ask every ray per vertex.
 
-use super::SHAFT_MIN_VERTICES;
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
+use crate::solver::SHAFT_MIN_VERTICES;
 use crate::visibility::Visibility;
 use glam::Vec3;
 
@@ -120,7 +120,7 @@ impl Facets {
     /// enough from it, `None` when each vertex asks its own. `exact_r2`
     /// is the square of the distance (scene units) within which a
     /// receiver takes the exact form factor of `from`'s cell
-    /// ([`super::formfactor::ShooterSample::exact_r2`]; 0 for a far
+    /// ([`crate::solver::kernel::formfactor::ShooterSample::exact_r2`]; 0 for a far
     /// stratum): no vertex of a sharing facet may lie within it.
     #[inline]
     pub fn point(&self, j: usize, from: Vec3, exact_r2: f32) -> Option<Vec3> {

@@ -398,7 +398,7 @@ fn sky_probes_match_asking_every_direction() {
         "probes saved too few rays: {probed_rays} vs {every_rays}"
     );
     let threads = |n| {
-        super::tests::on_threads(n, || {
+        super::on_threads(n, || {
             let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
             for _ in 0..20 {
                 if solver.step().is_none() {
@@ -408,5 +408,5 @@ fn sky_probes_match_asking_every_direction() {
             solver.radiosity().to_vec()
         })
     };
-    assert!(super::tests::same_bits(&threads(1), &threads(2)));
+    assert!(super::same_bits(&threads(1), &threads(2)));
 }

@@ -1,0 +1,185 @@
+//! One shooting step, in five phases, one file each:
+//!
+//! 1. [`choose`]: choose the shooter (a polygon or a cluster) and what it
+//!    sends;
+//! 2. [`read`]: read what its samples (or a cluster's strata) carry;
+//! 3. [`cull`]: mark the receivers and cull their shadow-ray candidates;
+//! 4. [`gather`] (a polygon's or a hemicube's) and [`gather_cluster`]:
+//!    every receiving vertex's `Δrad`;
+//! 5. [`apply`]: add it to the receivers and report the step.
+//!
+//! Phases 3 to 5 run over the receivers in chunks, and with a part budget
+//! a step returns between chunks ([`parts`]). This module begins a step
+//! (phases 1 and 2) and runs it.
+
+use crate::scene::PolygonId;
+use crate::solver::{Expectation, Progressive, StepReport};
+use gather::Gathered;
+use std::sync::atomic::AtomicBool;
+
+pub mod apply;
+pub mod choose;
+pub mod cull;
+pub mod gather;
+pub mod gather_cluster;
+pub mod parts;
+pub mod read;
+
+/// A step begun: what it shoots, how, and how far it has got.
+#[derive(Clone, Debug)]
+pub(in crate::solver) struct Underway {
+    /// The shooting cluster (without clustering, the polygon's own).
+    cluster: usize,
+    /// Its member holding the most unshot power.
+    pub(in crate::solver) shooter: PolygonId,
+    /// What [`Progressive::choose_shooter`] found it to send, signed.
+    shot_power: f64,
+    /// The expected light the shooters were read with.
+    expected: Expectation,
+    how: How,
+    /// The receivers' chunks and how far they have been taken.
+    plan: parts::Plan,
+    /// Whether the shooters' unshot radiosity has been spent (with the
+    /// first receivers applied).
+    pub(in crate::solver) spent: bool,
+    /// Counts so far.
+    gathered: Gathered,
+    receivers: u64,
+    clear: u64,
+    /// Parts reported so far, the one running included.
+    part: u32,
+    /// The unshot fraction the last finished step left.
+    fraction_before: f64,
+}
+
+/// How a step shoots.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(in crate::solver) enum How {
+    /// One polygon from its own samples.
+    Alone,
+    /// A cluster (or a polygon of weak light) from strata, descending from
+    /// the strata tree's top when `from_top`.
+    Cluster { from_top: bool },
+}
+
+/// What [`Progressive::begin_step`] did.
+pub(in crate::solver) enum Begun {
+    /// The whole step (a hemicube step).
+    Done(StepReport),
+    /// The shooter is read and its receivers marked.
+    Underway(Underway),
+}
+
+impl<'a> Progressive<'a> {
+    /// One shooting step from the polygon with the most unshot power, or
+    /// with a [`crate::solver::SolverOptions::part_budget`] one part of it (the report
+    /// says whether the step is `complete`; the next call continues it).
+    /// Returns `None` (and does nothing) when no polygon has unshot power.
+    /// Does not look at the threshold or step limit: see
+    /// [`Progressive::is_done`].
+    pub fn step(&mut self) -> Option<StepReport> {
+        self.step_cancellable(&AtomicBool::new(false))
+    }
+
+    /// [`Progressive::step`] that gives up as soon as `cancel` is set (from
+    /// another thread) and returns `None`, leaving the state exactly as
+    /// before the step, or, in a step delivered in parts, as after its
+    /// last part (the next call continues it). A window uses it to quit
+    /// promptly during a long step.
+    pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+        // A step's first part counts choosing the shooter and reading it
+        // (building its strata) against its budget.
+        let start = std::time::Instant::now();
+        if self.underway.is_none() {
+            match self.begin_step(cancel)? {
+                Begun::Done(report) => return Some(report),
+                Begun::Underway(u) => self.underway = Some(u),
+            }
+        }
+        self.continue_step(start, cancel)
+    }
+
+    /// Whether a step delivered in parts ([`crate::solver::SolverOptions::part_budget`])
+    /// has begun and not finished: the next [`Progressive::step`]
+    /// continues it. The solution then holds the receivers done so far.
+    pub fn in_step(&self) -> bool {
+        self.underway.is_some()
+    }
+
+    /// Phases 1 and 2 of a step, and with hemicubes the whole step:
+    /// chooses the shooter, reads what it sends and marks its receivers.
+    /// `None` when nothing is due or, for a hemicube step, once `cancel`
+    /// is set.
+    pub(in crate::solver) fn begin_step(&mut self, cancel: &AtomicBool) -> Option<Begun> {
+        let expected = self.expectation();
+        let (cluster, shot_power, negative) = self.choose_shooter(expected)?;
+        let shooter = self.strongest_member(cluster, negative, expected);
+        let roots = self.step_roots(shot_power);
+        // Emitters, every polygon without clustering and every polygon of
+        // a scene where nothing clusters (a room of large walls, where
+        // strata would only add work) keep their own samples; a polygon
+        // whose light is weak shoots through strata, as a cluster of one.
+        let alone = self.clusters.members(cluster).len() == 1
+            && (!self.clustered
+                || self.clusters.grouped() == 0
+                || !self.emission[shooter.index()].is_black()
+                || roots >= self.samples[shooter.index()].len());
+        let by_hemicube = self.hemicube.is_some() && !self.mesh.polygons[shooter.index()].sky;
+        let shot = self.polygon_shot(shooter.index(), negative, expected);
+        let signed = if negative { -shot_power } else { shot_power };
+        let mut underway = Underway {
+            cluster,
+            shooter,
+            shot_power: signed,
+            expected,
+            how: How::Alone,
+            plan: parts::Plan::new(1, false, false),
+            spent: false,
+            gathered: Gathered { pairs: 0, rays: 0 },
+            receivers: 0,
+            clear: 0,
+            part: 0,
+            fraction_before: self.last_fraction,
+        };
+        if by_hemicube {
+            // A hemicube step renders all its receivers at once: one part.
+            self.read_shooter(shooter, shot);
+            self.mark_receivers(shooter.index());
+            let hemicubes = if self.options.clustering {
+                roots
+            } else {
+                usize::MAX
+            };
+            let gathered = self.gather_hemicube(shooter, shot, hemicubes, cancel)?;
+            let polygons = 0..self.mesh.polygons.len();
+            self.apply_chunk(&mut underway, polygons);
+            underway.gathered = gathered;
+            underway.part = 1;
+            return Some(Begun::Done(self.finish_step(&underway)));
+        }
+        let in_parts = self.options.part_budget.is_some();
+        if alone {
+            self.read_shooter(shooter, shot);
+            self.mark_receivers(shooter.index());
+            self.group_points.clear();
+            self.group_points
+                .extend(self.samples[shooter.index()].iter().map(|s| s.position));
+            // Reflected light may be interpolated across receiving grids;
+            // an emitter's shot, which draws the sharpest shadows, never is.
+            let interpolating = self.clustered
+                && self.options.receiver_interpolation
+                && self.emission[shooter.index()].is_black();
+            let per_vertex = self.samples[shooter.index()].len();
+            underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
+        } else {
+            self.read_cluster(cluster, roots, negative, expected);
+            self.mark_cluster_receivers();
+            let from_top = roots < self.step_roots(f64::INFINITY);
+            underway.how = How::Cluster { from_top };
+            let per_vertex = self.strata.roots.len();
+            let interpolating = self.options.receiver_interpolation;
+            underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
+        }
+        Some(Begun::Underway(underway))
+    }
+}

@@ -1,0 +1,131 @@
+//! Shadows: an occluder casts one, and shaft culling changes which rays
+//! are cast, never what they find.
+
+use super::*;
+
+/// A floor vertex right below an opaque black square gets no direct
+/// light from the lamp above it, while one outside its shadow does.
+#[test]
+fn occluder_casts_a_shadow() {
+    let s = scene(
+        vec![
+            polygon(
+                0,
+                &[[-0.5, 0., 2.], [-0.5, 1., 2.], [0.5, 1., 2.], [0.5, 0., 2.]],
+            ), // lamp, faces -z
+            polygon(
+                1,
+                &[[-3., -2., 0.], [3., -2., 0.], [3., 3., 0.], [-3., 3., 0.]],
+            ), // floor, faces +z
+            polygon(
+                2,
+                &[
+                    [-1., -0.5, 1.],
+                    [1., -0.5, 1.],
+                    [1., 1.5, 1.],
+                    [-1., 1.5, 1.],
+                ],
+            ), // blocker
+        ],
+        vec![
+            grey("lamp", 1.0, 0.0),
+            grey("floor", 0.0, 0.5),
+            grey("black", 0.0, 0.0),
+        ],
+    );
+    let solved = solve(
+        &s,
+        0.25,
+        0.0,
+        SolverOptions {
+            max_steps: Some(1),
+            ..Default::default()
+        },
+    );
+    let m = &solved.mesh;
+    let vertex_at = |x: f32, y: f32| {
+        m.polygons[1]
+            .vertices
+            .clone()
+            .min_by(|&a, &b| {
+                let da = m.positions[a as usize].distance(glam::Vec3::new(x, y, 0.0));
+                let db = m.positions[b as usize].distance(glam::Vec3::new(x, y, 0.0));
+                da.total_cmp(&db)
+            })
+            .unwrap() as usize
+    };
+    assert_eq!(solved.radiosity[vertex_at(0.0, 0.5)], Rgb::BLACK);
+    assert!(solved.radiosity[vertex_at(2.5, 0.5)].r > 0.0);
+}
+
+/// Shaft culling changes which rays are cast, never what they find: the
+/// radiosities are bit for bit those of testing every ray against the BVH,
+/// and fewer rays are cast.
+#[test]
+fn shaft_culling_changes_no_result_bit() {
+    let mut polygons = room_with_lamp(4.0);
+    // A table-like slab, a block on the floor and a thin wall piece.
+    polygons.push(polygon(
+        1,
+        &[
+            [1.0, 1.5, 1.0],
+            [3.0, 1.5, 1.0],
+            [3.0, 1.5, 3.0],
+            [1.0, 1.5, 3.0],
+        ],
+    ));
+    polygons.push(polygon(
+        2,
+        &[
+            [0.5, 0.0, 0.5],
+            [0.5, 1.0, 0.5],
+            [0.5, 1.0, 1.2],
+            [0.5, 0.0, 1.2],
+        ],
+    ));
+    polygons.push(polygon(
+        1,
+        &[
+            [3.2, 0.0, 0.2],
+            [3.2, 0.0, 1.0],
+            [3.2, 2.5, 1.0],
+            [3.2, 2.5, 0.2],
+        ],
+    ));
+    let s = scene(polygons, lamp_materials());
+    let mesh = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.3,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(&s);
+    let run = |shaft_culling: bool| {
+        let mut solver = Progressive::new(
+            &s,
+            &mesh,
+            &vis,
+            SolverOptions {
+                shaft_culling,
+                max_steps: Some(25),
+                ..Default::default()
+            },
+        );
+        while !solver.is_done() && solver.step().is_some() {}
+        (
+            solver.radiosity().to_vec(),
+            solver.rays(),
+            solver.pairs(),
+            solver.receiver_pairs(),
+        )
+    };
+    let (culled, culled_rays, culled_pairs, (receivers, clear)) = run(true);
+    let (exact, exact_rays, exact_pairs, _) = run(false);
+    assert!(same_bits(&culled, &exact));
+    assert_eq!(culled_pairs, exact_pairs);
+    assert_eq!(exact_rays, exact_pairs);
+    assert!(culled_rays < exact_rays, "{culled_rays} vs {exact_rays}");
+    assert!(clear > 0 && clear < receivers, "{clear} of {receivers}");
+}
