@@ -623,6 +623,11 @@ impl Strata {
         let mut centroid = glam::DVec3::ZERO;
         let mut weight = 0.0f64;
         for (c, cell) in cells[range.clone()].iter().enumerate() {
+            // The floor keeps every weight a normal `f32` (10⁻³⁰ is far
+            // above `f32::MIN_POSITIVE`, 1.2·10⁻³⁸), so `weight as f32` below
+            // is never 0 and the axis and centroid never `0 / 0`: a node
+            // whose cells carry less than the floor (the last steps of a
+            // solve run to exhaustion) takes its cells' plain mean.
             let w = cell.power.max(0.0) + 1e-30;
             axis += cell.normal * w as f32;
             let (a, b) = corners(range.start + c);
@@ -632,16 +637,16 @@ impl Strata {
         let mean_normal = axis / weight as f32;
         let mut bins = [(Rgb::BLACK, Vec3::ZERO); 6];
         let mut bin_weight = [0.0f64; 6];
+        let mut wide_normals = [glam::DVec3::ZERO; 6];
         for cell in &cells[range.clone()] {
             let b = Stratum::bin_of(cell.normal);
             bins[b].0 += cell.unshot * cell.area;
             bins[b].1 += cell.normal * cell.power.max(0.0) as f32;
+            wide_normals[b] += cell.normal.as_dvec3() * cell.power.max(0.0);
             bin_weight[b] += cell.power.max(0.0);
         }
-        for (bin, w) in bins.iter_mut().zip(bin_weight) {
-            if w > 0.0 {
-                bin.1 /= w as f32;
-            }
+        for ((bin, w), wide) in bins.iter_mut().zip(bin_weight).zip(wide_normals) {
+            bin.1 = mean_normal_of(bin.1, wide, w);
         }
         let mut bin_representatives = [u32::MAX; 6];
         let mut bin_acc = [0.0f64; 6];
@@ -689,6 +694,26 @@ impl Strata {
             self.nodes[index as usize].children = Some((left, right));
         }
         index
+    }
+}
+
+/// The power-weighted mean of a bin's cell normals (length at most 1):
+/// `narrow` is `Σ n_k p_k` summed in `f32`, `wide` the same sum in `f64`,
+/// `weight` is `Σ p_k` (`p_k ≥ 0`). A bin without power has no mean
+/// normal: zero, which faces no receiver. The `f32` sum is used while the
+/// weight is a normal `f32` (every normal run's bits, as before); below
+/// that range (the last steps of a solve run towards exhaustion,
+/// `--threshold 0`, shoot 10⁻⁴³ of the first step's power) each
+/// `p_k as f32` flushes to zero or loses its digits, and `narrow / weight`
+/// was `0 / 0`, a NaN that spread through every later step: there the
+/// `f64` sum, exact enough at any power a step can carry, gives the mean.
+fn mean_normal_of(narrow: Vec3, wide: glam::DVec3, weight: f64) -> Vec3 {
+    if weight <= 0.0 {
+        narrow
+    } else if (weight as f32).is_normal() {
+        narrow / weight as f32
+    } else {
+        (wide / weight).as_vec3()
     }
 }
 
@@ -805,6 +830,34 @@ mod tests {
         assert_eq!(cells[root.representative as usize].normal, Vec3::NEG_Z);
         let up = root.bin_representatives[Stratum::bin_of(Vec3::Z)];
         assert_eq!(cells[up as usize].normal, Vec3::Z);
+    }
+
+    /// Cells carrying less power than the smallest normal `f32` (the last
+    /// steps of a solve run to exhaustion) still give every node finite
+    /// bins with unit mean normals: their `f32` weights flush to zero, and
+    /// dividing by them made NaNs that spread through the rest of the solve.
+    #[test]
+    fn strata_of_vanishing_power_have_finite_unit_normals() {
+        let at = |_: usize| (Vec3::ZERO, Vec3::ONE);
+        for power in [1e-30, 1e-38, 1e-43, 1e-300, f64::MIN_POSITIVE] {
+            let cells: Vec<Cell> = (0..12)
+                .map(|i| Cell {
+                    normal: if i % 3 == 0 { Vec3::X } else { Vec3::Z },
+                    ..cell(power)
+                })
+                .collect();
+            let strata = Strata::build(&cells, 4, at);
+            for n in &strata.nodes {
+                assert!(n.mean_normal.is_finite() && n.axis.is_finite(), "{power}");
+                assert!(n.centroid.is_finite(), "{power}");
+                for (b, (light, normal)) in n.bins.iter().enumerate() {
+                    assert!(light.is_finite() && normal.is_finite(), "{power} bin {b}");
+                    if n.bin_representatives[b] != u32::MAX {
+                        assert!((normal.length() - 1.0).abs() < 1e-6, "{power} bin {b}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
