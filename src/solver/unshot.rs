@@ -752,7 +752,14 @@ fn read_at_samples(
                     sum += field(l as usize) * f64::from(w);
                     area += f64::from(w);
                 }
-                sum / area
+                // A cell whose weights are all zero (no element overlaps
+                // it) has no integral of its own: it reads the polygon's
+                // mean, as a one-sample polygon does, not `0 / 0`.
+                if area > 0.0 {
+                    sum / area
+                } else {
+                    mean
+                }
             }
         };
         out.push(value);
