@@ -228,8 +228,10 @@ impl<'p> Session<'p> {
 
     /// Does the next thing: one shooting step, the end of a pass, a
     /// refinement, or nothing once finished (see [`Event`]). Stops a step
-    /// promptly once `cancel` is set. Fails only if a refined pass could
-    /// not take over the last one's state, which is a bug.
+    /// promptly once `cancel` is set. Fails only if a step made a value
+    /// that is not finite ([`crate::solver::Progressive::fault`]) or a
+    /// refined pass could not take over the last one's state, which are
+    /// bugs.
     pub fn advance(&mut self, cancel: &AtomicBool) -> Result<Event, SolverError> {
         match self.phase {
             Phase::Finished => Ok(Event::Finished),
@@ -239,7 +241,13 @@ impl<'p> Session<'p> {
                     self.phase = Phase::Stopped(reason);
                     return Ok(Event::Stopped(reason));
                 }
-                match self.solver.step_cancellable(cancel) {
+                let stepped = self.solver.step_cancellable(cancel);
+                // A step that made a non-finite value ends the solve; its
+                // report, if it finished, is not passed on.
+                if let Some(fault) = self.solver.fault() {
+                    return Err(fault.clone());
+                }
+                match stepped {
                     Some(report) => Ok(Event::Step(report)),
                     None if cancel.load(Ordering::SeqCst) => Ok(Event::Cancelled),
                     // Nothing left to shoot: converged.

@@ -89,6 +89,7 @@ use accel::{cluster, facets, far_shooters, probes, receivers, subcells};
 pub use ambient::first_look;
 use ambient::{ambient_term, sky_power_weights};
 use kernel::{cell_integrals, distribution, formfactor};
+pub use step::StepPhase;
 use step::Underway;
 
 use crate::color::Rgb;
@@ -448,6 +449,21 @@ pub enum SolverError {
         /// Its unshot radiosity, in the scene's emission units.
         value: Rgb,
     },
+    /// A step made a value that is not finite (a bug when it happens).
+    /// Found before anything was applied (phases [`StepPhase::Read`] and
+    /// [`StepPhase::Gather`]), the step is dropped and the solution is
+    /// that of the step before; found after ([`StepPhase::Apply`]), the
+    /// solution holds it. The solver takes no further step
+    /// ([`Progressive::fault`]).
+    #[error("step {step} (shooter polygon {}) made a non-finite value while {phase}", shooter.0)]
+    NotFinite {
+        /// The step, from 1.
+        step: u64,
+        /// Its shooter (a cluster step's member holding the most light).
+        shooter: PolygonId,
+        /// The phase that made the value.
+        phase: StepPhase,
+    },
     /// A state to restore has other array sizes than this solve.
     #[error(
         "the saved state holds {radiosity} radiosity and {unshot} unshot values; \
@@ -602,6 +618,9 @@ pub struct Progressive<'a> {
     /// The step begun and not finished, when steps come in parts
     /// ([`SolverOptions::part_budget`]).
     underway: Option<Underway>,
+    /// The failed step, once one made a non-finite value
+    /// ([`SolverError::NotFinite`]); no step is taken after it.
+    fault: Option<SolverError>,
     /// The unshot fraction after the last finished step (1 before the
     /// first), which a part of a step not finished reports.
     last_fraction: f64,
@@ -739,6 +758,7 @@ impl<'a> Progressive<'a> {
             steps: 0,
             rays: 0,
             underway: None,
+            fault: None,
             last_fraction: 1.0,
             hemicube: (options.form_factor == FormFactorMethod::Hemicube)
                 .then(|| hemicube::Shooting::new(scene, mesh, options.hemicube_res)),
@@ -1054,6 +1074,9 @@ impl<'a> Progressive<'a> {
 
     /// Checks the invariants; returns the first broken one.
     pub fn validate(&self) -> Result<(), SolverError> {
+        if let Some(fault) = &self.fault {
+            return Err(fault.clone());
+        }
         if self.radiosity.len() != self.mesh.vertex_count() || !self.unshot.fits(&self.mesh) {
             return Err(SolverError::MeshMismatch);
         }
@@ -1137,6 +1160,7 @@ impl<'a> Progressive<'a> {
         self.radiosity = state.radiosity;
         self.unshot.set_values(state.unshot);
         self.underway = None;
+        self.fault = None;
         self.last_fraction = self.unshot_fraction();
         self.steps = state.steps;
         self.rays = state.rays;

@@ -5,7 +5,7 @@
 //! minus what it sent ahead, [`crate::solver::SolverOptions::overshoot`];
 //! negative light takes radiosity back, never below black).
 
-use super::Underway;
+use super::{StepPhase, Underway};
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::solver::{Progressive, StepReport};
@@ -56,6 +56,25 @@ impl<'a> Progressive<'a> {
         }
     }
 
+    /// Whether what the receiving polygons among `polygons` gathered
+    /// (their vertices' `Δrad`) is finite: checked before it is applied,
+    /// so a failed gather leaves the solution as the last step left it.
+    pub(in crate::solver) fn gathered_is_finite(&self, polygons: Range<usize>) -> bool {
+        let mesh: &Mesh = &self.mesh;
+        polygons.filter(|&j| self.receives[j]).all(|j| {
+            let vertices = mesh.polygons[j].vertices.clone();
+            self.delta[vertices.start as usize..vertices.end as usize]
+                .iter()
+                .all(|d| d.is_finite())
+        })
+    }
+
+    /// Whether every radiosity and unshot value is finite (a pass over
+    /// the mesh: for checks, not for every step of a release build).
+    pub fn values_are_finite(&self) -> bool {
+        self.radiosity.iter().all(|b| b.is_finite()) && self.unshot().iter().all(|d| d.is_finite())
+    }
+
     /// The report of a part of step `u` that leaves it unfinished.
     pub(in crate::solver) fn part_report(&self, u: &Underway, complete: bool) -> StepReport {
         StepReport {
@@ -87,6 +106,17 @@ impl<'a> Progressive<'a> {
         self.steps += 1;
         self.rays += u.gathered.rays;
         let report = self.part_report(u, true);
+        // The unshot fraction sums every unshot value, so a value that
+        // applying made infinite or NaN makes it so: a check at no cost.
+        // The step is counted; the solution holds what it applied.
+        if !report.unshot_fraction.is_finite() {
+            self.fail(report.step, u, StepPhase::Apply);
+        }
+        debug_assert!(
+            self.fault.is_some() || self.values_are_finite(),
+            "step {} left a radiosity or unshot value that is not finite",
+            self.steps
+        );
         self.last_fraction = report.unshot_fraction;
         report
     }

@@ -13,7 +13,7 @@
 //! (phases 1 and 2) and runs it.
 
 use crate::scene::PolygonId;
-use crate::solver::{Expectation, Progressive, StepReport};
+use crate::solver::{Expectation, Progressive, SolverError, StepReport};
 use gather::Gathered;
 use std::sync::atomic::AtomicBool;
 
@@ -62,6 +62,38 @@ pub(in crate::solver) enum How {
     Cluster { from_top: bool },
 }
 
+/// The phase of a step in which a value stopped being finite, as a failed
+/// step names it ([`crate::solver::SolverError::NotFinite`]). Each phase's
+/// products are checked before the next phase uses them, which costs a
+/// pass over what the phase made (the shooter's readings or strata, the
+/// receivers' `Δrad`): little beside making it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepPhase {
+    /// Phases 1 and 2: what the shooter sends, per sample or per stratum.
+    Read,
+    /// Phases 3 and 4: what each receiving vertex gathered.
+    Gather,
+    /// Phase 5: the radiosity and unshot radiosity after adding it.
+    Apply,
+}
+
+impl std::fmt::Display for StepPhase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            StepPhase::Read => "reading what the shooter sends",
+            StepPhase::Gather => "gathering at the receivers",
+            StepPhase::Apply => "applying to the receivers",
+        })
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test hook: the step (from 1) whose reading is made NaN on this
+    /// thread, to exercise what follows a failed step; 0 for none.
+    pub(crate) static POISON_READ_AT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
 /// What [`Progressive::begin_step`] did.
 pub(in crate::solver) enum Begun {
     /// The whole step (a hemicube step).
@@ -87,6 +119,9 @@ impl<'a> Progressive<'a> {
     /// last part (the next call continues it). A window uses it to quit
     /// promptly during a long step.
     pub fn step_cancellable(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+        if self.fault.is_some() {
+            return None;
+        }
         // A step's first part counts choosing the shooter and reading it
         // (building its strata) against its budget.
         let start = std::time::Instant::now();
@@ -97,6 +132,52 @@ impl<'a> Progressive<'a> {
             }
         }
         self.continue_step(start, cancel)
+    }
+
+    /// The step that made a non-finite value, if one did
+    /// ([`SolverError::NotFinite`]): the solve cannot go on, and
+    /// [`Progressive::step`] returns `None` from then on.
+    pub fn fault(&self) -> Option<&SolverError> {
+        self.fault.as_ref()
+    }
+
+    /// Records that step `u`, numbered `step`, made a non-finite value in
+    /// `phase`.
+    pub(in crate::solver) fn fail(&mut self, step: u64, u: &Underway, phase: StepPhase) {
+        self.fault = Some(SolverError::NotFinite {
+            step,
+            shooter: u.shooter,
+            phase,
+        });
+    }
+
+    /// Whether what the shooter of step `u` sends, as read in phase 2,
+    /// is finite: its samples' readings or its cluster's strata.
+    fn read_is_finite(&self, u: &Underway) -> bool {
+        match u.how {
+            How::Alone => self.shot.iter().all(|s| s.is_finite()),
+            How::Cluster { .. } => self.strata.nodes.iter().all(|n| {
+                n.power.is_finite()
+                    && n.mean_normal.is_finite()
+                    && n.centroid.is_finite()
+                    && n.axis.is_finite()
+                    && n.bins.iter().all(|b| b.0.is_finite() && b.1.is_finite())
+            }),
+        }
+    }
+
+    /// Test hook ([`POISON_READ_AT`]): makes step `u`'s reading NaN when
+    /// it is the step asked for.
+    #[cfg(test)]
+    fn poison_read(&mut self, u: &Underway) {
+        if POISON_READ_AT.get() != self.steps + 1 {
+            return;
+        }
+        let nan = crate::color::Rgb::splat(f64::NAN);
+        match u.how {
+            How::Alone => self.shot.iter_mut().for_each(|s| *s = nan),
+            How::Cluster { .. } => self.strata.nodes.iter_mut().for_each(|n| n.power = nan),
+        }
     }
 
     /// Whether a step delivered in parts ([`crate::solver::SolverOptions::part_budget`])
@@ -150,8 +231,18 @@ impl<'a> Progressive<'a> {
             } else {
                 usize::MAX
             };
+            #[cfg(test)]
+            self.poison_read(&underway);
+            if !self.read_is_finite(&underway) {
+                self.fail(self.steps + 1, &underway, StepPhase::Read);
+                return None;
+            }
             let gathered = self.gather_hemicube(shooter, shot, hemicubes, cancel)?;
             let polygons = 0..self.mesh.polygons.len();
+            if !self.gathered_is_finite(polygons.clone()) {
+                self.fail(self.steps + 1, &underway, StepPhase::Gather);
+                return None;
+            }
             self.apply_chunk(&mut underway, polygons);
             underway.gathered = gathered;
             underway.part = 1;
@@ -179,6 +270,12 @@ impl<'a> Progressive<'a> {
             let per_vertex = self.strata.roots.len();
             let interpolating = self.options.receiver_interpolation;
             underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
+        }
+        #[cfg(test)]
+        self.poison_read(&underway);
+        if !self.read_is_finite(&underway) {
+            self.fail(self.steps + 1, &underway, StepPhase::Read);
+            return None;
         }
         Some(Begun::Underway(underway))
     }

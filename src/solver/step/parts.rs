@@ -25,7 +25,7 @@
 //! [`SolverOptions::part_budget`]: crate::solver::SolverOptions::part_budget
 
 use super::gather::Stage;
-use super::{How, Underway};
+use super::{How, StepPhase, Underway};
 use crate::scene::PolygonId;
 use crate::solver::{Progressive, StepReport};
 use std::sync::atomic::AtomicBool;
@@ -372,8 +372,9 @@ impl<'a> Progressive<'a> {
     }
 
     /// Culls, gathers and (once its polygons are whole) applies one chunk
-    /// of the step `u`; `None` once `cancel` is set, with nothing of the
-    /// chunk applied.
+    /// of the step `u`; `None` once `cancel` is set or what it gathered is
+    /// not finite ([`Progressive::fault`]), with nothing of the chunk
+    /// applied.
     pub(in crate::solver) fn run_chunk(
         &mut self,
         u: &mut Underway,
@@ -385,6 +386,10 @@ impl<'a> Progressive<'a> {
                 self.cull_chunk(u, polygons.clone());
                 let gathered = self.gather_chunk(u, vertices, Stage::All, cancel)?;
                 u.gathered.add(gathered);
+                if !self.gathered_is_finite(polygons.clone()) {
+                    self.fail(self.steps + 1, u, StepPhase::Gather);
+                    return None;
+                }
                 self.apply_chunk(u, polygons);
             }
             Chunk::Piece {
@@ -413,6 +418,10 @@ impl<'a> Progressive<'a> {
                 u.gathered.add(gathered);
                 let done = last && (pass == Pass::Interpolated || !two_passes);
                 if done {
+                    if !self.gathered_is_finite(polygon..polygon + 1) {
+                        self.fail(self.steps + 1, u, StepPhase::Gather);
+                        return None;
+                    }
                     self.apply_chunk(u, polygon..polygon + 1);
                 }
             }
