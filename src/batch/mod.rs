@@ -20,8 +20,13 @@
 //! the solver state is saved every [`RunConfig::checkpoint_every`], on
 //! interruption and at the end ([`checkpoint`]); a resumed run continues
 //! to the same bits an uninterrupted one gives.
+//!
+//! **Failures.** A solve that stops on a solver error (a bug) still
+//! writes its step log, plot and checkpoint up to the last good step, and
+//! says which step, shooter and phase failed ([`failure`]).
 
 pub mod checkpoint;
+pub mod failure;
 pub mod outputs;
 pub mod photometry;
 pub mod progress;
@@ -84,6 +89,10 @@ pub enum RunError {
     /// The solver's state broke an invariant (a bug if it happens).
     #[error("{0}")]
     Solver(#[from] SolverError),
+    /// The solve stopped on a solver error (a bug if it happens), having
+    /// written its evidence up to the last good step.
+    #[error("{0}")]
+    Failed(failure::Failure),
     /// Rendering failed (a bug if it happens).
     #[error("{0}")]
     Render(#[from] RenderError),
@@ -104,6 +113,7 @@ impl RunError {
             self,
             RunError::Render(_)
                 | RunError::Solver(_)
+                | RunError::Failed(_)
                 | RunError::Write(_)
                 | RunError::Interrupted { .. }
                 | RunError::Checkpoint(CheckpointError::Write(_))
@@ -516,7 +526,16 @@ fn solve<'p>(
                 checkpoint: config.checkpoint.clone(),
             });
         }
-        match session.advance(cancel)? {
+        let event = match session.advance(cancel) {
+            Ok(event) => event,
+            Err(error) => {
+                progress.clear();
+                let failure =
+                    failure::stopped(config, prepared, session, &records, error, fingerprint);
+                return Err(RunError::Failed(failure));
+            }
+        };
+        match event {
             // A batch run asks for no parts: every report ends a step.
             Event::Step(report) if report.complete => {
                 records.push(StepRecord {
