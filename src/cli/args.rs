@@ -65,6 +65,10 @@ pub struct Args {
 
     /// Stop when the unshot power falls below this fraction of the emitted
     /// power.
+    ///
+    /// 0 means: run until --max-steps, or until nothing is left to shoot
+    /// (the unshot power is exactly zero; the run then ends as converged,
+    /// exit 0). Without --max-steps that can take many thousands of steps.
     #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD)]
     pub(crate) threshold: f64,
 
