@@ -92,7 +92,7 @@ pub enum RunError {
     /// The solve stopped on a solver error (a bug if it happens), having
     /// written its evidence up to the last good step.
     #[error("{0}")]
-    Failed(failure::Failure),
+    Failed(Box<failure::Failure>),
     /// Rendering failed (a bug if it happens).
     #[error("{0}")]
     Render(#[from] RenderError),
@@ -532,7 +532,7 @@ fn solve<'p>(
                 progress.clear();
                 let failure =
                     failure::stopped(config, prepared, session, &records, error, fingerprint);
-                return Err(RunError::Failed(failure));
+                return Err(RunError::Failed(Box::new(failure)));
             }
         };
         match event {
