@@ -142,9 +142,15 @@ fn main() {
         if let Some(t) = threshold {
             c.solver.threshold = t;
         }
-        c.solver.clustering = clustering;
-        c.solver.receiver_interpolation = interpolation;
-        c.solver.overshoot = overshoot;
+        c.solver.approximations.clusters = clustering;
+        c.solver.approximations = if interpolation {
+            c.solver.approximations
+        } else {
+            c.solver
+                .approximations
+                .without(&radiosity::solver::Heuristic::RECEIVERS)
+        };
+        c.solver.approximations.overshoot = overshoot;
         let mesh = &prepared.mesh;
         if reference.is_none() {
             if let Some(radiosity) = cache

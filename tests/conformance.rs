@@ -30,7 +30,9 @@ use glam::Vec3;
 use radiosity::color::Rgb;
 use radiosity::scene::Scene;
 use radiosity::solver::kernel::formfactor::point_to_polygon;
-use radiosity::solver::{FormFactorMethod, ShooterSamples, SolverOptions, UnshotScheme};
+use radiosity::solver::{
+    Approximations, FormFactorMethod, Heuristic, ShooterSamples, SolverOptions, UnshotScheme,
+};
 
 /// Exact form factor between two coaxial parallel unit squares one unit
 /// apart (Howell's catalogue, C-11).
@@ -109,7 +111,7 @@ fn row(
             form_factor,
             shooter_samples,
             unshot,
-            clustering,
+            approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
             ..SolverOptions::default()
         },
         claims,

@@ -16,7 +16,7 @@ use crate::mesh::DEFAULT_INSET;
 use crate::render::antialias;
 use crate::solver::hemicube::HemicubeRes;
 use crate::solver::{
-    FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_SETTLE, DEFAULT_THRESHOLD,
+    FormFactorMethod, Heuristic, ShooterSamples, UnshotScheme, DEFAULT_SETTLE, DEFAULT_THRESHOLD,
 };
 use std::path::PathBuf;
 
@@ -160,6 +160,25 @@ pub struct Args {
     /// light. This is the original algorithm, for comparison.
     #[arg(long)]
     pub(crate) no_overshoot: bool,
+
+    /// Turn these heuristics of the solver off (comma-separated).
+    ///
+    /// Each is one switch, measured against its twin: emitters-first,
+    /// overshoot, settling, near-field, shaft-culling, clusters, strata,
+    /// receiver-interpolation, weak-strata, crowded-cells, facet-rays,
+    /// sky-probes, far-shooters. `docs/accuracy.md` gives what each costs
+    /// and buys.
+    #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
+    pub(crate) without: Vec<Heuristic>,
+
+    /// Solve with no heuristic: the brute-force twin (slow).
+    ///
+    /// Every polygon shoots alone from all its cells in plain power order,
+    /// exactly the light it holds, to every receiving vertex with its own
+    /// shadow rays, each tested against the whole scene. The exact near
+    /// field and settling stay.
+    #[arg(long)]
+    pub(crate) exact: bool,
 
     /// Where unshot radiosity is kept between shooting steps.
     #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]

@@ -230,9 +230,9 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         ShooterSamples::All => u64::MAX,
         ShooterSamples::AtMost(n) => n as u64,
     });
-    h.word(options.near_field as u64);
-    h.word(options.clustering as u64);
-    h.word(options.receiver_interpolation as u64);
+    h.word(options.approximations.near_field as u64);
+    h.word(options.approximations.clusters as u64);
+    h.word(options.approximations.receiver_interpolation as u64);
     h.word(super::WEAK_STRATUM_SHARE.to_bits());
     h.word(u64::from(super::cluster::PLANE_DEPTH_RATIO.to_bits()));
     h.word(u64::from(super::cluster::TOP_DEPTH_RATIO.to_bits()));
@@ -245,7 +245,7 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
     h.word(super::probes::MIN_PROBES as u64);
     h.word(u64::from(super::far_shooters::FAR_SHOOTER_RATIO.to_bits()));
     h.word(super::far_shooters::FAR_PROBES as u64);
-    h.word(options.overshoot as u64);
+    h.word(options.approximations.overshoot as u64);
     h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
     h.word(match options.unshot {
         super::UnshotScheme::Polygon => 1,

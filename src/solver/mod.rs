@@ -77,6 +77,7 @@
 
 pub mod accel;
 mod ambient;
+mod approximations;
 pub mod checkpoint;
 pub mod final_gather;
 pub mod hemicube;
@@ -88,6 +89,7 @@ mod unshot;
 use accel::{cluster, facets, far_shooters, probes, receivers, subcells};
 pub use ambient::first_look;
 use ambient::{ambient_term, sky_power_weights};
+pub use approximations::{Approximations, Heuristic};
 use kernel::{cell_integrals, distribution, formfactor};
 use step::Underway;
 
@@ -310,26 +312,11 @@ pub struct SolverOptions {
     pub settle: f64,
     /// Stop after this many steps at most.
     pub max_steps: Option<u64>,
-    /// Use the exact point-to-cell form factor for receivers close to a
-    /// grid sample (see [`formfactor`]); off gives the plain disc sum.
-    pub near_field: bool,
-    /// Cull shadow rays with shafts between shooter and receiver (same
-    /// result bits; off tests every ray against the whole scene's BVH).
-    pub shaft_culling: bool,
+    /// Which heuristics the solve uses ([`Approximations`]: all by
+    /// default; [`Approximations::EXACT`] is the brute-force twin).
+    pub approximations: Approximations,
     /// Where unshot radiosity is kept.
     pub unshot: UnshotScheme,
-    /// Let nearby small polygons shoot together ([`cluster`]); off, every
-    /// polygon shoots alone (the brute-force twin). Only the Wallace
-    /// estimate on a grid ([`ShooterSamples::AtMost`]) clusters: the
-    /// other settings exist to reproduce the original algorithm.
-    pub clustering: bool,
-    /// Let a clustered step interpolate receiving grids from their coarse
-    /// vertices where [`receivers::accept`] allows, and take a near
-    /// stratum whose light is weak at a vertex as one term
-    /// ([`WEAK_STRATUM_SHARE`]); off, every receiving vertex is evaluated
-    /// exactly, every near stratum descended into (the twin it is
-    /// compared with).
-    pub receiver_interpolation: bool,
     /// Pixels across a hemicube's top face, for
     /// [`FormFactorMethod::Hemicube`] (ignored by the other methods).
     pub hemicube_res: hemicube::HemicubeRes,
@@ -338,13 +325,6 @@ pub struct SolverOptions {
     /// The finished step is bit-identical to one in a piece; `None` (the
     /// default) runs every step in one piece.
     pub part_budget: Option<std::time::Duration>,
-    /// Overshoot (Feda and Purgathofer 1992): a step also sends out the
-    /// light each point of its shooters is expected to receive later
-    /// (`Expectation`), leaving their unshot radiosity negative until
-    /// that light arrives; what the shrinking expectation no longer covers
-    /// is shot as negative light. Fewer steps to the same residual; off,
-    /// unshot radiosity never goes below zero (the original algorithm).
-    pub overshoot: bool,
 }
 
 /// Where unshot radiosity is kept between shooting steps.
@@ -370,13 +350,9 @@ impl Default for SolverOptions {
             threshold: DEFAULT_THRESHOLD,
             settle: DEFAULT_SETTLE,
             max_steps: None,
-            near_field: true,
-            shaft_culling: true,
+            approximations: Approximations::DEFAULT,
             unshot: UnshotScheme::Vertex,
-            clustering: true,
-            receiver_interpolation: true,
             hemicube_res: hemicube::HemicubeRes::default(),
-            overshoot: true,
             part_budget: None,
         }
     }
@@ -651,7 +627,8 @@ impl<'a> Progressive<'a> {
             .map(|p| emission[p.index()])
             .collect();
         let covered = crate::mesh::covered::covered_vertices(scene, mesh);
-        let subcells = SubCells::build_all(scene, mesh, &samples, options.near_field);
+        let subcells =
+            SubCells::build_all(scene, mesh, &samples, options.approximations.near_field);
         let unshot = UnshotField::new(
             options.unshot,
             mesh,
@@ -665,7 +642,7 @@ impl<'a> Progressive<'a> {
         let culling_groups = Clusters::build(scene, mesh, &emission);
         let clustered = matches!(
             (
-                options.clustering,
+                options.approximations.clusters,
                 options.form_factor,
                 options.shooter_samples
             ),
@@ -677,17 +654,18 @@ impl<'a> Progressive<'a> {
             Clusters::singletons(scene)
         };
         let (tiles, tile_of) = setup::tiles(mesh);
-        // Shared facet rays and sky probes go with the other receiver
-        // approximations.
-        let approximate = clustered && options.receiver_interpolation;
+        // The receiver heuristics act only in a solve that clusters; the
+        // crowded-cell guard only where receivers are interpolated.
+        let approx = &options.approximations;
         let coarse: Vec<Option<CoarseGrid>> = mesh
             .polygons
             .iter()
             .map(|pm| CoarseGrid::detect(mesh, pm))
             .collect();
-        let crowded = setup::crowded(mesh, visibility, &coarse, approximate);
-        let sky_probes = setup::sky_probes(mesh, &samples, approximate);
-        let far_shooters = setup::far_shooters(mesh, &samples, approximate);
+        let guarded = clustered && approx.receiver_interpolation && approx.crowded_cells;
+        let crowded = setup::crowded(mesh, visibility, &coarse, guarded);
+        let sky_probes = setup::sky_probes(mesh, &samples, clustered && approx.sky_probes);
+        let far_shooters = setup::far_shooters(mesh, &samples, clustered && approx.far_shooters);
         let mut solver = Progressive {
             mesh: mesh_ref.clone(),
             visibility,
@@ -726,7 +704,7 @@ impl<'a> Progressive<'a> {
             coarse,
             crowded,
             coarse_delta: vec![Rgb::BLACK; mesh.vertex_count()],
-            facets: Facets::new(mesh, approximate),
+            facets: Facets::new(mesh, clustered && approx.facet_rays),
             probes: sky_probes,
             far_shooters,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
@@ -924,32 +902,6 @@ impl<'a> Progressive<'a> {
         &self.facets
     }
 
-    /// This solver with every receiving vertex asking its own shadow rays
-    /// (no [`facets`] sharing), all else alike: the twin the sharing is
-    /// tested against.
-    #[cfg(test)]
-    pub(crate) fn without_shared_rays(mut self) -> Self {
-        self.facets = Facets::default();
-        self
-    }
-
-    /// This solver with every sky direction asked of every vertex (no
-    /// [`probes`]), all else alike: the twin probing is tested against.
-    #[cfg(test)]
-    pub(crate) fn without_sky_probes(mut self) -> Self {
-        self.probes.iter_mut().for_each(Vec::clear);
-        self
-    }
-
-    /// This solver with every sample of a far shooter asked of every
-    /// vertex (no [`far_shooters`] probes), all else alike: the twin
-    /// probing is tested against.
-    #[cfg(test)]
-    pub(crate) fn without_far_probes(mut self) -> Self {
-        self.far_shooters.iter_mut().for_each(|f| *f = None);
-        self
-    }
-
     /// The clusters the solve shoots from (each polygon alone without
     /// clustering).
     pub fn clusters(&self) -> &Clusters {
@@ -993,7 +945,7 @@ impl<'a> Progressive<'a> {
             })
             .collect();
         let visibility = self.visibility;
-        let near_field = self.options.near_field;
+        let near_field = self.options.approximations.near_field;
         let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
             .into_par_iter()
             .with_min_len(64)

@@ -166,6 +166,8 @@ pub struct Solved {
     pub radiosity: Vec<Rgb>,
     /// Shooting steps taken.
     pub steps: u64,
+    /// Shadow rays cast.
+    pub rays: u64,
     /// Unshot power before the first step (the emitted power).
     pub initial_power: f64,
     /// Net unshot power left at the end.
@@ -179,13 +181,14 @@ pub fn solve_on(s: &Scene, mesh: Mesh, options: SolverOptions) -> Solved {
     let mut solver = Progressive::new(s, &mesh, &vis, options);
     while !solver.is_done() && solver.step().is_some() {}
     solver.validate().expect("the solver's invariants hold");
-    let (radiosity, steps) = (solver.radiosity().to_vec(), solver.steps());
+    let (radiosity, steps, rays) = (solver.radiosity().to_vec(), solver.steps(), solver.rays());
     let (initial_power, unshot_power) = (solver.initial_unshot_power(), solver.net_unshot_power());
     drop(solver);
     Solved {
         mesh,
         radiosity,
         steps,
+        rays,
         initial_power,
         unshot_power,
     }

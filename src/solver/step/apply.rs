@@ -30,7 +30,7 @@ impl<'a> Progressive<'a> {
             }
             u.spent = true;
         }
-        let culling = self.options.shaft_culling;
+        let culling = self.options.approximations.shaft_culling;
         let mesh: &Mesh = &self.mesh;
         for j in polygons {
             if !self.receives[j] {

@@ -89,7 +89,7 @@ impl<'a> Progressive<'a> {
     /// the cluster's bounds), then in each thin shaft between a receiver
     /// tile and a group of shooter samples (or strata).
     pub(in crate::solver) fn cull_chunk(&mut self, u: &Underway, polygons: Range<usize>) {
-        if !self.options.shaft_culling {
+        if !self.options.approximations.shaft_culling {
             return;
         }
         match u.how {

@@ -146,7 +146,9 @@ impl<'a> Progressive<'a> {
             };
             // Reflected light may be interpolated across receiving grids;
             // an emitter's shot, which draws the sharpest shadows, never is.
-            let on = p.clustered && p.options.receiver_interpolation && p.emission[i].is_black();
+            let on = p.clustered
+                && p.options.approximations.receiver_interpolation
+                && p.emission[i].is_black();
             let cells = p.interpolating(on, p.clusters.of(shooter));
             gather_passes(sums, mesh, &cells, cancel, exact, Work { vertices, stage })
         })
@@ -263,8 +265,8 @@ impl<'g> GatherContext<'g> {
             visibility: p.visibility,
             facets: &p.facets,
             reflectance: &p.reflectance,
-            near_field: p.options.near_field,
-            culling: p.options.shaft_culling,
+            near_field: p.options.approximations.near_field,
+            culling: p.options.approximations.shaft_culling,
             small: &p.small,
             candidates: &p.candidates,
             tile_candidates: &p.tile_candidates,

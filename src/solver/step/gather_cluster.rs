@@ -65,7 +65,7 @@ impl<'a> Progressive<'a> {
                 subcells: &p.subcells,
                 strata: &p.strata,
                 held: &p.radiosity,
-                lump_share: if p.options.receiver_interpolation {
+                lump_share: if p.options.approximations.weak_strata {
                     WEAK_STRATUM_SHARE
                 } else {
                     0.0
@@ -74,7 +74,7 @@ impl<'a> Progressive<'a> {
             // The exact `Δrad` at receiving vertex `l` of polygon `j`, with
             // the pairs and rays it took.
             let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| shot.vertex(l, j, scratch);
-            let cells = p.interpolating(p.options.receiver_interpolation, cluster);
+            let cells = p.interpolating(p.options.approximations.receiver_interpolation, cluster);
             gather_passes(
                 sums,
                 g.mesh,

@@ -145,7 +145,7 @@ impl<'a> Progressive<'a> {
             // A hemicube step renders all its receivers at once: one part.
             self.read_shooter(shooter, shot);
             self.mark_receivers(shooter.index());
-            let hemicubes = if self.options.clustering {
+            let hemicubes = if self.options.approximations.clusters {
                 roots
             } else {
                 usize::MAX
@@ -167,7 +167,7 @@ impl<'a> Progressive<'a> {
             // Reflected light may be interpolated across receiving grids;
             // an emitter's shot, which draws the sharpest shadows, never is.
             let interpolating = self.clustered
-                && self.options.receiver_interpolation
+                && self.options.approximations.receiver_interpolation
                 && self.emission[shooter.index()].is_black();
             let per_vertex = self.samples[shooter.index()].len();
             underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
@@ -177,7 +177,7 @@ impl<'a> Progressive<'a> {
             let from_top = roots < self.step_roots(f64::INFINITY);
             underway.how = How::Cluster { from_top };
             let per_vertex = self.strata.roots.len();
-            let interpolating = self.options.receiver_interpolation;
+            let interpolating = self.options.approximations.receiver_interpolation;
             underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
         }
         Some(Begun::Underway(underway))

@@ -40,7 +40,7 @@ impl<'a> Progressive<'a> {
             ShooterSamples::AtMost(n) => n as usize,
             ShooterSamples::All => usize::MAX,
         };
-        if self.initial_unshot_power <= 0.0 {
+        if !self.options.approximations.strata || self.initial_unshot_power <= 0.0 {
             return cap;
         }
         let share = power / (FULL_STRATA_SHARE * self.initial_unshot_power);

@@ -20,7 +20,7 @@ fn energy_balance_with_clusters() {
         0.1,
         crate::mesh::DEFAULT_INSET,
         SolverOptions {
-            clustering: false,
+            approximations: options.approximations.with(Heuristic::Clusters, false),
             ..options
         },
     );
@@ -68,7 +68,7 @@ fn clusters_match_the_brute_force_twin() {
         &s,
         mesh.clone(),
         SolverOptions {
-            clustering: false,
+            approximations: options.approximations.with(Heuristic::Clusters, false),
             ..options
         },
     );
@@ -77,7 +77,11 @@ fn clusters_match_the_brute_force_twin() {
             &s,
             mesh.clone(),
             SolverOptions {
-                receiver_interpolation: interpolate,
+                approximations: if interpolate {
+                    options.approximations
+                } else {
+                    options.approximations.without(&Heuristic::RECEIVERS)
+                },
                 ..options
             },
         );
@@ -171,7 +175,7 @@ fn a_cluster_shot_matches_lambert() {
     let vis = Visibility::new(&s);
     // Without overshoot the step sends exactly the unshot light set here.
     let options = SolverOptions {
-        overshoot: false,
+        approximations: Approximations::DEFAULT.with(Heuristic::Overshoot, false),
         ..Default::default()
     };
     let mut solver = Progressive::new(&s, &mesh, &vis, options);
@@ -252,7 +256,11 @@ fn interpolated_receivers_match_exact_ones() {
     let run = |interpolate: bool| {
         let options = SolverOptions {
             threshold: 1e-4,
-            receiver_interpolation: interpolate,
+            approximations: if interpolate {
+                Approximations::DEFAULT
+            } else {
+                Approximations::DEFAULT.without(&Heuristic::RECEIVERS)
+            },
             ..Default::default()
         };
         let mut solver = Progressive::new(&s, &mesh, &vis, options);
@@ -335,10 +343,11 @@ fn shared_facet_rays_match_per_vertex_rays() {
         s.polygons.len()
     );
     let run = |shared: bool| {
+        let options = SolverOptions {
+            approximations: options.approximations.with(Heuristic::FacetRays, shared),
+            ..options
+        };
         let mut solver = Progressive::new(&s, &mesh, &vis, options);
-        if !shared {
-            solver = solver.without_shared_rays();
-        }
         while !solver.is_done() && solver.step().is_some() {}
         solver.validate().unwrap();
         (solver.radiosity().to_vec(), solver.rays())

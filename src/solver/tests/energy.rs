@@ -181,7 +181,7 @@ fn a_step_sends_what_it_spends_from_cells_larger_than_elements() {
             SolverOptions {
                 threshold: 1e-5,
                 shooter_samples: ShooterSamples::AtMost(4),
-                clustering,
+                approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
                 ..Default::default()
             },
         );

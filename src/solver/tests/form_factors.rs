@@ -39,7 +39,7 @@ fn more_shooter_samples_converge_to_the_exact_value() {
         TOP,
         SolverOptions {
             shooter_samples: ShooterSamples::AtMost(4),
-            near_field: false,
+            approximations: Approximations::DEFAULT.with(Heuristic::NearField, false),
             ..Default::default()
         },
     );
@@ -48,7 +48,7 @@ fn more_shooter_samples_converge_to_the_exact_value() {
         TOP,
         SolverOptions {
             shooter_samples: ShooterSamples::AtMost(400),
-            near_field: false,
+            approximations: Approximations::DEFAULT.with(Heuristic::NearField, false),
             ..Default::default()
         },
     );
@@ -318,7 +318,7 @@ fn a_leg_on_a_glowing_floor_at(x0: f32, y0: f32) {
             crate::mesh::DEFAULT_INSET,
             SolverOptions {
                 max_steps: Some(1),
-                clustering,
+                approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
                 ..Default::default()
             },
         );

@@ -26,8 +26,9 @@ fn run(s: &Scene, lenmax: f32, threshold: f64, overshoot: bool, clustering: bool
         lenmax,
         SolverOptions {
             threshold,
-            overshoot,
-            clustering,
+            approximations: Approximations::DEFAULT
+                .with(Heuristic::Overshoot, overshoot)
+                .with(Heuristic::Clusters, clustering),
             ..Default::default()
         },
     )
@@ -169,13 +170,13 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     };
     let base = SolverOptions {
         threshold: 1e-5,
-        overshoot: false,
+        approximations: Approximations::DEFAULT.with(Heuristic::Overshoot, false),
         ..Default::default()
     };
     let alone = error(
         "unclustered",
         SolverOptions {
-            clustering: false,
+            approximations: base.approximations.with(Heuristic::Clusters, false),
             ..base
         },
     );
@@ -183,7 +184,7 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     let exact = error(
         "exact receivers",
         SolverOptions {
-            receiver_interpolation: false,
+            approximations: base.approximations.without(&Heuristic::RECEIVERS),
             ..base
         },
     );
@@ -195,7 +196,7 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     let over = error(
         "overshooting",
         SolverOptions {
-            overshoot: true,
+            approximations: base.approximations.with(Heuristic::Overshoot, true),
             ..base
         },
     );

@@ -65,7 +65,7 @@ fn a_step_in_parts_is_bit_identical_to_one_in_a_piece() {
     for base in [
         SolverOptions::default(),
         SolverOptions {
-            clustering: false,
+            approximations: Approximations::DEFAULT.with(Heuristic::Clusters, false),
             unshot: UnshotScheme::Polygon,
             ..Default::default()
         },

@@ -83,7 +83,7 @@ fn the_gap_under_a_resting_ball_matches_the_unclustered_twin() {
     let mesh = regular_mesh(&s, LENMAX);
     let options = SolverOptions {
         threshold: THRESHOLD,
-        receiver_interpolation: false,
+        approximations: Approximations::DEFAULT.without(&Heuristic::RECEIVERS),
         ..Default::default()
     };
     let grouped = Progressive::new(&s, &mesh, &Visibility::new(&s), options)
@@ -95,7 +95,7 @@ fn the_gap_under_a_resting_ball_matches_the_unclustered_twin() {
         &s,
         &mesh,
         SolverOptions {
-            clustering: false,
+            approximations: options.approximations.with(Heuristic::Clusters, false),
             ..options
         },
     );

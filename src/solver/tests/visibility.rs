@@ -108,7 +108,8 @@ fn shaft_culling_changes_no_result_bit() {
             &mesh,
             &vis,
             SolverOptions {
-                shaft_culling,
+                approximations: Approximations::DEFAULT
+                    .with(Heuristic::ShaftCulling, shaft_culling),
                 max_steps: Some(25),
                 ..Default::default()
             },
