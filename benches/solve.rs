@@ -8,7 +8,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::{self, Scene};
-use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions, DEFAULT_SETTLE};
+use radiosity::solver::tuning::DEFAULT_SETTLE;
+use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions};
 use radiosity::visibility::Visibility;
 use std::path::Path;
 use std::time::Instant;

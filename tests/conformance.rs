@@ -129,7 +129,7 @@ fn row(
 fn configurations() -> Vec<Config> {
     use FormFactorMethod::{Center, Hemicube, Wallace};
     use UnshotScheme::{Polygon, Vertex};
-    let grid = ShooterSamples::AtMost(radiosity::solver::DEFAULT_SHOOTER_SAMPLES);
+    let grid = ShooterSamples::AtMost(radiosity::solver::tuning::DEFAULT_SHOOTER_SAMPLES);
     let all = ShooterSamples::All;
     vec![
         row("wallace grid, polygon, clustered", Wallace, grid, Polygon, true, wallace_grid(Polygon)),

@@ -39,8 +39,9 @@
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
 //! materials (those `--emit` changed, and the facets and radiosity of a
-//! `--sky`), the mesh's vertices and sample points, and the form-factor
-//! options. It leaves out the stopping rule (threshold, step limit), so a
+//! `--sky`), the mesh's vertices and sample points, the form-factor
+//! options, every approximation switch ([`super::Approximations`]) and
+//! every tuning constant ([`super::tuning::INDEX`]). It leaves out the stopping rule (threshold, step limit), so a
 //! resumed run may go further than the interrupted one would have. A
 //! driver refuses a checkpoint whose fingerprint differs from its solve's;
 //! [`decode`] refuses a truncated or corrupted one by its length or
@@ -230,23 +231,14 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         ShooterSamples::All => u64::MAX,
         ShooterSamples::AtMost(n) => n as u64,
     });
-    h.word(options.approximations.near_field as u64);
-    h.word(options.approximations.clusters as u64);
-    h.word(options.approximations.receiver_interpolation as u64);
-    h.word(super::WEAK_STRATUM_SHARE.to_bits());
-    h.word(u64::from(super::cluster::PLANE_DEPTH_RATIO.to_bits()));
-    h.word(u64::from(super::cluster::TOP_DEPTH_RATIO.to_bits()));
-    h.word(u64::from(super::cluster::STRATUM_NEAR_RATIO.to_bits()));
-    h.word(u64::from(super::cluster::RESTING_NEAR_FACTOR.to_bits()));
-    h.word(u64::from(super::receivers::CROWD_RATIO.to_bits()));
-    h.word(u64::from(super::facets::SCALE_RATIO.to_bits()));
-    h.word(u64::from(super::facets::NEAR_RATIO.to_bits()));
-    h.word(super::probes::SKY_PROBES as u64);
-    h.word(super::probes::MIN_PROBES as u64);
-    h.word(u64::from(super::far_shooters::FAR_SHOOTER_RATIO.to_bits()));
-    h.word(super::far_shooters::FAR_PROBES as u64);
-    h.word(options.approximations.overshoot as u64);
-    h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
+    // Every switch and every tuning constant: a build tuned otherwise
+    // would not continue to the same bits.
+    h.word(options.approximations.bits());
+    h.word(super::tuning::INDEX.len() as u64);
+    for tuned in super::tuning::INDEX {
+        h.bytes(tuned.name.as_bytes());
+        h.word(tuned.value.to_bits());
+    }
     h.word(match options.unshot {
         super::UnshotScheme::Polygon => 1,
         super::UnshotScheme::Vertex => 2,

@@ -38,19 +38,9 @@
 
 use super::distribution::Directional;
 use crate::mesh::Mesh;
+use crate::solver::tuning::{DEFAULT_HEMICUBE_RES, HEMICUBE_EDGE_SLACK, HEMICUBE_NEAR_FRACTION};
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
-
-/// Default [`HemicubeRes`]: pixels across the top face. Measured
-/// (`docs/accuracy.md`, "Hemicube"): the unit squares' form factors from
-/// 64 hemicubes are within 0.03 % of the exact midpoint rule at 64
-/// pixels and 0.016 % at 128; the pictures of `rtable` and `cornell` are
-/// 3.0 % from the reference at 64, 2.4 to 2.8 % at 128 and 2.3 to 2.8 %
-/// at 256, while a solve at 128 takes 1.2 to 1.4 times as long as at 64
-/// and one at 256 1.6 to 1.7 times as long again. 128 buys most of what
-/// more pixels give; past it the error is mostly the shooter's
-/// quadrature (more cells, `--shooter-samples`, reduce it).
-pub const DEFAULT_HEMICUBE_RES: u32 = 128;
 
 /// Smallest resolution accepted: with fewer pixels a side face has under
 /// four rows and whole walls vanish between pixel centres.
@@ -60,18 +50,6 @@ pub const MIN_HEMICUBE_RES: u32 = 8;
 /// take 200 MB and each thread's item and depth buffers 134 MB, beyond
 /// any use (the error stops falling well before: `docs/accuracy.md`).
 pub const MAX_HEMICUBE_RES: u32 = 4096;
-
-/// A pixel's centre counts as inside a triangle when none of its
-/// barycentric weights is below minus this: a slack so that pixel
-/// centres on an edge shared by two triangles are never missed by both
-/// to rounding (a crack would let a farther element show through).
-const EDGE_SLACK: f32 = 1e-6;
-
-/// Near clipping distance of a hemicube, as a fraction of the square root
-/// of the area its shooter sample stands for: small enough that only an
-/// element passing within a hair of the eye is cut, large enough that
-/// `1/w` stays finite in `f32`.
-pub const NEAR_FRACTION: f32 = 1e-5;
 
 /// Pixels across the top face of a hemicube: an even number in
 /// [`MIN_HEMICUBE_RES`]`..=`[`MAX_HEMICUBE_RES`] (the side faces have
@@ -304,7 +282,7 @@ impl Hemicube {
     /// skip a polygon wholly outside a face. Writes `(element, F)` pairs
     /// into `out` (cleared first), sorted by element, each `F > 0`; their
     /// sum is at most 1. `near` is the near clipping distance in scene
-    /// units (see [`NEAR_FRACTION`]).
+    /// units (see [`HEMICUBE_NEAR_FRACTION`]).
     ///
     /// `weight`, when given, multiplies each pixel's delta form factor by
     /// its value at the pixel centre's direction (in the hemicube's
@@ -562,7 +540,7 @@ impl Face<'_> {
             return;
         }
         let inv_area = 1.0 / area;
-        let slack = -EDGE_SLACK;
+        let slack = -HEMICUBE_EDGE_SLACK;
         let x_min = p0[0].min(p1[0]).min(p2[0]);
         let x_max = p0[0].max(p1[0]).max(p2[0]);
         let y_min = p0[1].min(p1[1]).min(p2[1]);
@@ -751,7 +729,7 @@ impl Shooting {
                         }
                     }));
                     let seed = ((shooter as u64) << 32) ^ k as u64;
-                    let near = NEAR_FRACTION * (sample.area as f32).sqrt();
+                    let near = HEMICUBE_NEAR_FRACTION * (sample.area as f32).sqrt();
                     let frame = frame(normal, seed);
                     let weight = directional.map(|d| luminaire_weight(d, frame));
                     cube.form_factors(

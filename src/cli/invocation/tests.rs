@@ -23,7 +23,7 @@ fn config(args: &[&str]) -> RunConfig {
 fn no_arguments_give_the_library_defaults_and_the_window() {
     let i = invocation(&[]).unwrap();
     // Also keeps the literal default of --shooter-samples equal to
-    // solver::DEFAULT_SHOOTER_SAMPLES.
+    // crate::solver::tuning::DEFAULT_SHOOTER_SAMPLES.
     assert_eq!(
         i.config,
         RunConfig {

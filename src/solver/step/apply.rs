@@ -2,7 +2,7 @@
 //! step's report.
 //!
 //! Heuristics acting here: **overshooting** (a shooter is left holding
-//! minus what it sent ahead, [`crate::solver::SolverOptions::overshoot`];
+//! minus what it sent ahead, [`crate::solver::Approximations::overshoot`];
 //! negative light takes radiosity back, never below black).
 
 use super::Underway;

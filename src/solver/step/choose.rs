@@ -4,21 +4,22 @@
 //! power due shoots next, its member with the most shooting for it.
 //! Heuristics acting here:
 //! - **emitters first**: an emitter that has not shot its light yet
-//!   ([`crate::solver::PENDING_EMISSION`]) shoots before any reflector;
+//!   ([`crate::solver::tuning::PENDING_EMISSION`]) shoots before any reflector;
 //! - **overshooting**: what each point expects to receive later
 //!   (`Expectation`, `OVERSHOOT_SHARE`),
 //!   sent ahead, and the negative part shot once the expectation no
 //!   longer covers it;
 //! - **settling**: past the threshold, the cluster holding the most light
 //!   of points not yet settled ([`crate::solver::SolverOptions::settle`],
-//!   [`crate::solver::SETTLE_FLOOR`]);
+//!   [`crate::solver::tuning::SETTLE_FLOOR`]);
 //! - **sky power weights**: a sky facet's power counts as the light it
 //!   can bring (`sky_power_weights`).
 
 use crate::color::Rgb;
 use crate::scene::PolygonId;
+use crate::solver::tuning::{OVERSHOOT_SHARE, PENDING_EMISSION, SETTLE_FLOOR};
 use crate::solver::unshot::Shot;
-use crate::solver::{Expectation, Progressive, OVERSHOOT_SHARE, PENDING_EMISSION, SETTLE_FLOOR};
+use crate::solver::{Expectation, Progressive};
 
 impl<'a> Progressive<'a> {
     /// The power polygon `j` sends out in a step that sends `shot`
@@ -51,7 +52,7 @@ impl<'a> Progressive<'a> {
     }
 
     /// What the next step expects every point to receive later
-    /// ([`Expectation`]); nothing without [`SolverOptions::overshoot`].
+    /// ([`Expectation`]); nothing without [`Approximations::overshoot`].
     pub(in crate::solver) fn expectation(&self) -> Expectation {
         if !self.options.approximations.overshoot {
             return Expectation::NONE;

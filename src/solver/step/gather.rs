@@ -10,7 +10,7 @@
 //!   shooter ([`crate::solver::accel::receivers`], `Interpolating`);
 //! - **shadow-ray choice**: no ray in an empty shaft, a short candidate
 //!   list tested one by one, else the BVH ([`ShadowQuery`],
-//!   [`crate::solver::LINEAR_CANDIDATES`]);
+//!   [`crate::solver::tuning::LINEAR_CANDIDATES`]);
 //! - **shared facet rays** ([`crate::solver::accel::facets`]);
 //! - **sky probes** and **far shooters**: a few rays first, their answer
 //!   for all when they agree ([`crate::solver::accel::probes`],
@@ -18,7 +18,7 @@
 //! - **sub-cells**: a split cell near the receiver sends as its sub-cells
 //!   ([`crate::solver::accel::subcells`]);
 //! - the **near field** of the form factor
-//!   ([`crate::solver::SolverOptions::near_field`]).
+//!   ([`crate::solver::Approximations::near_field`]).
 
 use super::{How, Underway};
 use crate::color::Rgb;
@@ -30,10 +30,11 @@ use crate::solver::accel::facets::Scratch;
 use crate::solver::accel::receivers::CoarseGrid;
 use crate::solver::accel::{probes, receivers, subcells};
 use crate::solver::kernel::distribution;
-use crate::solver::unshot::Shot;
-use crate::solver::{
-    Progressive, LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
+use crate::solver::tuning::{
+    LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
 };
+use crate::solver::unshot::Shot;
+use crate::solver::Progressive;
 use crate::visibility::{LastBlocker, ShadowQuery, Visibility};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -239,9 +240,9 @@ pub(in crate::solver) struct GatherContext<'g> {
     pub(in crate::solver) facets: &'g Facets,
     /// Per polygon: front reflectance.
     pub(in crate::solver) reflectance: &'g [Rgb],
-    /// [`crate::solver::SolverOptions::near_field`].
+    /// [`crate::solver::Approximations::near_field`].
     pub(in crate::solver) near_field: bool,
-    /// [`crate::solver::SolverOptions::shaft_culling`].
+    /// [`crate::solver::Approximations::shaft_culling`].
     culling: bool,
     /// Per polygon: too small for a shaft of its own.
     small: &'g [bool],

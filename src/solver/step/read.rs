@@ -10,7 +10,7 @@
 //!   sub-cells and leaves ([`crate::solver::accel::subcells`]);
 //! - **strata**: a cluster (or a polygon of weak light) shoots from a cut
 //!   of its strata, the fewer the weaker its light
-//!   ([`crate::solver::FULL_STRATA_SHARE`], [`crate::solver::MIN_STRATA`]);
+//!   ([`crate::solver::tuning::FULL_STRATA_SHARE`], [`crate::solver::tuning::MIN_STRATA`]);
 //! - **hemicube runs**: a weak hemicube step merges its cells into fewer
 //!   hemicubes by the same cut.
 
@@ -20,10 +20,9 @@ use crate::scene::PolygonId;
 use crate::solver::accel::cluster::{Cell, Strata};
 use crate::solver::accel::subcells;
 use crate::solver::kernel::formfactor::ShooterSample;
+use crate::solver::tuning::{FULL_STRATA_SHARE, MIN_STRATA};
 use crate::solver::unshot::Shot;
-use crate::solver::{
-    unshot, Expectation, Progressive, ShooterSamples, FULL_STRATA_SHARE, MIN_STRATA,
-};
+use crate::solver::{unshot, Expectation, Progressive, ShooterSamples};
 
 impl<'a> Progressive<'a> {
     /// How many strata a clustered step shoots from at most, for a step

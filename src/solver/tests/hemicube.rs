@@ -592,7 +592,10 @@ fn weak_steps_merge_cells_into_fewer_hemicubes_with_the_same_power() {
     let i = shooter.index();
     solver.read_shooter(shooter, crate::solver::unshot::Shot::PLAIN);
     let cells = solver.samples[i].len();
-    assert_eq!(cells, crate::solver::DEFAULT_SHOOTER_SAMPLES as usize);
+    assert_eq!(
+        cells,
+        crate::solver::tuning::DEFAULT_SHOOTER_SAMPLES as usize
+    );
     assert!(solver.hemicube_points(shooter, cells).is_none());
     let polygon = &s.polygons[i];
     let (lo, hi) = polygon.vertices.iter().fold(

@@ -1,4 +1,4 @@
-//! Overshooting ([`SolverOptions::overshoot`]) against its plain twin and
+//! Overshooting ([`Approximations::overshoot`]) against its plain twin and
 //! the closed forms: it must reach the same solution in fewer steps, keep
 //! the energy balance with signed unshot light, and save and resume a
 //! state holding negative unshot light bit for bit.
@@ -147,7 +147,7 @@ fn overshooting_matches_the_plain_solve() {
 /// its stratum's light, and what it misses has no sign of its own. It
 /// moves with the far test's strictness: with the plane test asking 3,
 /// 4, 5, 6, 8 and 12 half depths above a weak step's cut
-/// ([`super::cluster::TOP_DEPTH_RATIO`], 6) it measured −0.090, −0.116,
+/// ([`crate::solver::tuning::TOP_DEPTH_RATIO`], 6) it measured −0.090, −0.116,
 /// −0.110, −0.107, −0.050 and +0.159 %. With the
 /// default interpolating receivers, within 0.2 % with and without
 /// overshooting (measured −0.08 % and −0.06 %; −0.50 % and −0.46 % when

@@ -1,7 +1,7 @@
 //! A tessellated ball resting on a floor, clustered against the
 //! unclustered twin: the thin gap between the two surfaces is lit only by
 //! light going back and forth between them, so an error in one cluster
-//! shot there adds up at every bounce ([`super::cluster::PLANE_DEPTH_RATIO`]).
+//! shot there adds up at every bounce ([`crate::solver::tuning::PLANE_DEPTH_RATIO`]).
 
 use super::*;
 use crate::testutil::sphere_box::uv_sphere;
