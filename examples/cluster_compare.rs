@@ -180,8 +180,8 @@ fn main() {
         let frame = radiosity::render::render(mesh, &radiosity, &view).expect("renders");
         let areas = mesh.vertex_areas();
         let means = polygon_means(mesh, &radiosity);
-        let solver = session.solver();
-        let clusters = solver.clusters();
+        let solver = session.solver().as_progressive();
+        let clusters = solver.expect("a progressive solve").clusters();
         let head = format!(
             "| {label} | {} ({} grouped) | {} | {:.1} M | {seconds:.1} |",
             clusters.len(),

@@ -9,7 +9,10 @@
 //! an open box; a shadow; and the same bits on one thread and on two.
 //! The closed forms and scenes are those of the solver's unit tests, which
 //! checked one configuration at a time; here a configuration is a row of
-//! [`configurations`] listing its tolerance per check with the reason. A
+//! [`configurations`] listing its tolerance per check with the reason,
+//! and every solve is built through the solver's seam
+//! (`radiosity::solver::build`, in `common::scenes::solve_on`), so a new
+//! method is one more row. A
 //! bound the unit tests stated is kept; where none was stated (the
 //! estimates with known losses), the bound is what the configuration
 //! measures today with a margin, and a check a configuration cannot pass

@@ -50,7 +50,7 @@
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::solver::{FormFactorMethod, Progressive, ShooterSamples, SolverOptions};
+use crate::solver::{FormFactorMethod, ShooterSamples, SolverOptions};
 
 /// The first eight bytes of every checkpoint file.
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
@@ -78,7 +78,7 @@ const CHECKSUM_LEN: usize = 8;
 
 /// Everything a progressive solve needs to continue exactly where it was.
 ///
-/// Invariants a solver checks on restore ([`Progressive::restore`]):
+/// Invariants a solver checks on restore ([`crate::solver::Method::restore`]):
 /// `radiosity` has one entry per mesh vertex, `unshot` one per polygon or
 /// per mesh vertex (by [`SolverOptions::unshot`]), every channel finite and
 /// `>= 0`.
@@ -257,22 +257,10 @@ pub struct Checkpoint {
     pub record: Vec<u8>,
 }
 
-/// The bytes of a checkpoint of `solver`'s current state, with the
-/// driver's `record` (opaque here).
-pub fn encode(fingerprint: u64, solver: &Progressive, record: &[u8]) -> Vec<u8> {
-    encode_parts(
-        fingerprint,
-        solver.radiosity(),
-        solver.unshot(),
-        solver.charges(),
-        solver.steps(),
-        solver.rays(),
-        record,
-    )
-}
-
-/// The bytes of a checkpoint of `state`, with the driver's `record`.
-pub fn encode_state(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
+/// The bytes of a checkpoint of `state` (a solver's
+/// [`crate::solver::Method::state`]), with the driver's `record` (opaque
+/// here).
+pub fn encode(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
     encode_parts(
         fingerprint,
         &state.radiosity,
@@ -417,7 +405,7 @@ mod tests {
 
     #[test]
     fn round_trip_keeps_every_bit() {
-        let bytes = encode_state(0xfeed, &state(), b"log");
+        let bytes = encode(0xfeed, &state(), b"log");
         let Checkpoint {
             fingerprint: fp,
             state: back,
@@ -440,7 +428,7 @@ mod tests {
     /// Version `v` bytes made from version 3 bytes of an uncharged state:
     /// the header cut to `header` bytes, the record kept or not.
     fn older(v: u32, header: usize, record: &[u8]) -> Vec<u8> {
-        let v3 = encode_state(5, &uncharged(), record);
+        let v3 = encode(5, &uncharged(), record);
         let mut out = v3[..8].to_vec();
         out.extend_from_slice(&v.to_le_bytes());
         out.extend_from_slice(&v3[12..header]);
@@ -471,7 +459,7 @@ mod tests {
 
     #[test]
     fn damage_of_any_kind_is_refused() {
-        let bytes = encode_state(1, &state(), b"record");
+        let bytes = encode(1, &state(), b"record");
         // Every truncation.
         for len in 0..bytes.len() {
             assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");

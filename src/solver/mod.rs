@@ -74,18 +74,26 @@
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
 //! whatever the thread count.
+//!
+//! Drivers see a solve through [`Method`], built by [`build`] from the
+//! options: progressive shooting is one method, the hemicube another
+//! ([`methods`]).
 
 pub mod accel;
 mod ambient;
 mod approximations;
 pub mod checkpoint;
 pub mod final_gather;
-pub mod hemicube;
 pub mod kernel;
+pub mod method;
+pub mod methods;
 mod setup;
 pub mod step;
 pub mod tuning;
 mod unshot;
+
+pub use method::{build, Method};
+pub use methods::hemicube;
 
 use crate::solver::tuning::{
     DEFAULT_SETTLE, DEFAULT_SHOOTER_SAMPLES, DEFAULT_THRESHOLD, SHAFT_MIN_VERTICES, TILE_VERTICES,
@@ -471,15 +479,15 @@ pub struct Progressive<'a> {
     /// The unshot fraction after the last finished step (1 before the
     /// first), which a part of a step not finished reports.
     last_fraction: f64,
-    /// The hemicube's tables and scratch, with
-    /// [`FormFactorMethod::Hemicube`].
-    hemicube: Option<hemicube::Shooting>,
 }
 
 impl<'a> Progressive<'a> {
     /// Starts a solve: every vertex at `b = e`, every polygon's unshot
     /// radiosity at `Δb = e`. `mesh` and `visibility` must be built from
-    /// `scene`.
+    /// `scene`. It shoots by rays (Wallace's or the centre estimate);
+    /// with [`FormFactorMethod::Hemicube`] its sample set is the
+    /// hemicube's but it still shoots by rays: [`build`] makes the
+    /// hemicube method ([`hemicube::HemicubeMethod`]), which steps it.
     pub fn new(
         scene: &Scene,
         mesh: impl Into<MeshRef<'a>>,
@@ -608,8 +616,6 @@ impl<'a> Progressive<'a> {
             rays: 0,
             underway: None,
             last_fraction: 1.0,
-            hemicube: (options.form_factor == FormFactorMethod::Hemicube)
-                .then(|| hemicube::Shooting::new(scene, mesh, options.hemicube_res)),
         };
         solver.initial_unshot_power = solver.unshot_power();
         solver

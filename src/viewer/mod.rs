@@ -11,7 +11,7 @@
 //! solving, each published with the receivers it finished
 //! ([`crate::solver::step::parts`]), so the picture moves while a large scene's
 //! step runs; quitting cancels the part under way
-//! ([`Progressive::step_cancellable`](crate::solver::Progressive::step_cancellable)).
+//! ([`Method::step_cancellable`](crate::solver::Method::step_cancellable)).
 //!
 //! With adaptive subdivision the worker refines the mesh once a solve
 //! converges and solves again on the refined mesh; meanwhile the window

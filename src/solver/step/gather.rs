@@ -1,5 +1,5 @@
-//! Phase 4 of a step: the gather of a polygon shooting alone, the
-//! hemicube's, and the two passes every gather runs.
+//! Phase 4 of a step: the gather of a polygon shooting alone, and the
+//! two passes every gather runs.
 //!
 //! Every receiving vertex sums `ρ_j · Σ_k Δb_k · F(l → sample k)`, in
 //! parallel, each vertex independent of the others. Heuristics acting
@@ -33,7 +33,6 @@ use crate::solver::kernel::distribution;
 use crate::solver::tuning::{
     LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
 };
-use crate::solver::unshot::Shot;
 use crate::solver::Progressive;
 use crate::visibility::{LastBlocker, ShadowQuery, Visibility};
 use rayon::prelude::*;
@@ -193,40 +192,6 @@ impl<'a> Progressive<'a> {
             positions: &self.mesh.positions,
             held: &self.radiosity,
         }
-    }
-
-    /// Phase 4 by hemicubes ([`hemicube::Shooting::gather`]): `Δrad` of
-    /// every receiving vertex into `self.delta`, from what `shot` sends
-    /// (read into `self.shot`), from at most `hemicubes` hemicubes
-    /// ([`Progressive::hemicube_points`]).
-    pub(in crate::solver) fn gather_hemicube(
-        &mut self,
-        shooter: PolygonId,
-        shot: Shot,
-        hemicubes: usize,
-        cancel: &AtomicBool,
-    ) -> Option<Gathered> {
-        let i = shooter.index();
-        let power = self.unshot.sent_power(&self.mesh, i, shot, &self.radiosity);
-        let merged = self.hemicube_points(shooter, hemicubes);
-        let (samples, shot) = match &merged {
-            Some((samples, shot)) => (&samples[..], &shot[..]),
-            None => (&self.samples[i][..], &self.shot[..]),
-        };
-        let hemicube = self.hemicube.as_mut()?;
-        let pairs = hemicube.gather(
-            &self.mesh,
-            i,
-            self.directional[i].as_ref(),
-            samples,
-            shot,
-            power,
-            &self.receives,
-            &self.reflectance,
-            &mut self.delta,
-            cancel,
-        )?;
-        Some(Gathered { pairs, rays: 0 })
     }
 }
 

@@ -220,22 +220,6 @@ fn a_cluster_shot_matches_lambert() {
     assert!(worst < 0.01 * peak, "worst error {worst} of peak {peak}");
 }
 
-/// Clustered solves give the same bits on one thread and on two.
-#[test]
-fn clustered_solves_do_not_depend_on_the_thread_count() {
-    let s = tiled_box(true, 4);
-    let options = SolverOptions {
-        max_steps: Some(25),
-        ..Default::default()
-    };
-    let run = |threads| {
-        on_threads(threads, || {
-            solve(&s, 0.15, crate::mesh::DEFAULT_INSET, options)
-        })
-    };
-    assert!(same_bits(&run(1).radiosity, &run(2).radiosity));
-}
-
 /// Hierarchical receivers: interpolating reflected light across coarse
 /// cells of the walls gives what evaluating every vertex gives (vertices
 /// within 0.5 % relative L1, every polygon's mean within 1 %, the darkest

@@ -230,7 +230,7 @@ fn negative_unshot_light_saves_and_resumes_bit_for_bit() {
         solver.unshot().iter().any(|u| u.min_channel() < 0.0),
         "negative unshot light is held"
     );
-    let bytes = checkpoint::encode(7, &solver, b"");
+    let bytes = checkpoint::encode(7, &solver.state(), b"");
     let saved = checkpoint::decode(&bytes).unwrap().state;
     let mut resumed = Progressive::new(&s, &mesh, &vis, options);
     let mut bad = saved.clone();

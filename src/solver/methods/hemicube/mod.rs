@@ -29,18 +29,21 @@
 //! hemicubes do not line up (Cohen et al. 1988 rotate for the same
 //! reason).
 //!
-//! The solver ([`super::Progressive`]) places one hemicube at each of the
-//! shooter's grid samples (its `--shooter-samples` cells), each carrying
-//! its cell's area and unshot radiosity (a weak step merges its cells
-//! into fewer runs, one hemicube each: `Progressive::hemicube_points`),
-//! and spreads what the elements receive to their vertices
-//! ([`spread_to_vertices`]).
+//! The solver method ([`HemicubeMethod`], in `method.rs`) places one
+//! hemicube at each of the shooter's grid samples (its
+//! `--shooter-samples` cells), each carrying its cell's area and unshot
+//! radiosity (a weak step merges its cells into fewer runs, one hemicube
+//! each: `Progressive::hemicube_points`), and spreads what the elements
+//! receive to their vertices ([`spread_to_vertices`]).
 
-use super::distribution::Directional;
 use crate::mesh::Mesh;
+use crate::solver::kernel::distribution::Directional;
 use crate::solver::tuning::{DEFAULT_HEMICUBE_RES, HEMICUBE_EDGE_SLACK, HEMICUBE_NEAR_FRACTION};
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
+
+mod method;
+pub use method::HemicubeMethod;
 
 /// Smallest resolution accepted: with fewer pixels a side face has under
 /// four rows and whole walls vanish between pixel centres.
@@ -640,7 +643,7 @@ pub fn luminaire_weight(directional: &Directional, frame: Frame) -> impl Fn(DVec
 
 /// What a hemicube step needs beyond the solver's own state: the delta
 /// form factors, every polygon's corners, and scratch. Built once per
-/// solve ([`super::Progressive::new`] with [`super::FormFactorMethod::Hemicube`]).
+/// solve ([`HemicubeMethod::new`]).
 #[derive(Debug)]
 pub(crate) struct Shooting {
     deltas: DeltaFormFactors,
@@ -691,7 +694,7 @@ impl Shooting {
         mesh: &Mesh,
         shooter: usize,
         directional: Option<&Directional>,
-        samples: &[super::formfactor::ShooterSample],
+        samples: &[crate::solver::kernel::formfactor::ShooterSample],
         shot: &[crate::color::Rgb],
         power: crate::color::Rgb,
         receives: &[bool],
@@ -785,5 +788,4 @@ impl Shooting {
 }
 
 #[cfg(test)]
-#[path = "tests/hemicube.rs"]
 mod tests;
