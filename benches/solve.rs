@@ -8,7 +8,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::{self, Scene};
-use radiosity::solver::{Progressive, SolverOptions, DEFAULT_SETTLE};
+use radiosity::solver::tuning::DEFAULT_SETTLE;
+use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions};
 use radiosity::visibility::Visibility;
 use std::path::Path;
 use std::time::Instant;
@@ -25,7 +26,7 @@ fn solve(scene: &Scene, clustering: bool, settle: f64) -> (u64, u64) {
     let mesh = mesh::build(scene, &MeshOptions::for_scene(scene)).expect("mesh");
     let visibility = Visibility::new(scene);
     let options = SolverOptions {
-        clustering,
+        approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
         settle,
         ..SolverOptions::default()
     };

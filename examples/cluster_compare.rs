@@ -142,9 +142,15 @@ fn main() {
         if let Some(t) = threshold {
             c.solver.threshold = t;
         }
-        c.solver.clustering = clustering;
-        c.solver.receiver_interpolation = interpolation;
-        c.solver.overshoot = overshoot;
+        c.solver.approximations.clusters = clustering;
+        c.solver.approximations = if interpolation {
+            c.solver.approximations
+        } else {
+            c.solver
+                .approximations
+                .without(&radiosity::solver::Heuristic::RECEIVERS)
+        };
+        c.solver.approximations.overshoot = overshoot;
         let mesh = &prepared.mesh;
         if reference.is_none() {
             if let Some(radiosity) = cache
@@ -174,8 +180,8 @@ fn main() {
         let frame = radiosity::render::render(mesh, &radiosity, &view).expect("renders");
         let areas = mesh.vertex_areas();
         let means = polygon_means(mesh, &radiosity);
-        let solver = session.solver();
-        let clusters = solver.clusters();
+        let solver = session.solver().as_progressive();
+        let clusters = solver.expect("a progressive solve").clusters();
         let head = format!(
             "| {label} | {} ({} grouped) | {} | {:.1} M | {seconds:.1} |",
             clusters.len(),

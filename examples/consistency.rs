@@ -158,8 +158,8 @@ fn main() {
         (true, true, "default"),
     ] {
         let mut c = config.clone();
-        c.solver.clustering = clustering;
-        c.solver.overshoot = overshoot;
+        c.solver.approximations.clusters = clustering;
+        c.solver.approximations.overshoot = overshoot;
         let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
         session
             .run_to_end(&AtomicBool::new(false))

@@ -69,8 +69,8 @@ fn main() {
     let mut columns = Vec::new();
     for clustering in [false, true] {
         let mut c = config.clone();
-        c.solver.clustering = clustering;
-        c.solver.overshoot = clustering;
+        c.solver.approximations.clusters = clustering;
+        c.solver.approximations.overshoot = clustering;
         let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
         session
             .run_to_end(&AtomicBool::new(false))

@@ -92,7 +92,7 @@ fn main() {
     // all its cells (no merging of weak steps' cells), and 256 cells.
     let variant = |clustering: bool, cells: u32| {
         let mut c = with(FormFactorMethod::Hemicube, 128, lenmax);
-        c.solver.clustering = clustering;
+        c.solver.approximations.clusters = clustering;
         c.solver.shooter_samples = ShooterSamples::AtMost(cells);
         c
     };

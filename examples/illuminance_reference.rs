@@ -118,7 +118,7 @@ fn main() {
         mesh,
         prepared.visibility(),
         radiosity,
-        config.solver.near_field,
+        config.solver.approximations.near_field,
     );
     let gathered: Vec<f64> = gather
         .irradiance_at(&points)

@@ -1,6 +1,6 @@
 //! How often the window's picture moves: solves a scene as the window does,
 //! with steps delivered in parts of about
-//! [`WINDOW_PART_BUDGET`](radiosity::solver::step::parts::WINDOW_PART_BUDGET)
+//! [`WINDOW_PART_BUDGET`](radiosity::solver::tuning::WINDOW_PART_BUDGET)
 //! (`docs/performance.md`), and prints the solver time between pictures
 //! (each part) against the time of whole steps:
 //!
@@ -21,7 +21,7 @@
 use radiosity::config::{RunConfig, SceneSource};
 use radiosity::prepare;
 use radiosity::session::{Event, Session, SessionOptions};
-use radiosity::solver::step::parts::WINDOW_PART_BUDGET;
+use radiosity::solver::tuning::WINDOW_PART_BUDGET;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};

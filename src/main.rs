@@ -3,9 +3,8 @@
 //! an exit code: 0 success, 1 a failure writing results, 2 bad input or
 //! usage, 130 interrupted (Ctrl-C).
 
-use clap::Parser;
 use radiosity::batch::{self, RunError};
-use radiosity::cli::{Args, Invocation, UsageError};
+use radiosity::cli::{Invocation, UsageError};
 use radiosity::drive;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -36,7 +35,7 @@ fn main() -> ExitCode {
 
 /// Parse, configure, run.
 fn run() -> Result<(), Stop> {
-    let args = Args::try_parse().map_err(Stop::Clap)?;
+    let args = radiosity::cli::parse().map_err(Stop::Clap)?;
     let invocation = Invocation::try_from(args).map_err(Stop::Usage)?;
     if let Some(threads) = invocation.threads {
         rayon::ThreadPoolBuilder::new()

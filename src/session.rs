@@ -1,7 +1,8 @@
 //! One solve, from a prepared scene to a converged (and, with adaptive
 //! subdivision, refined) solution: the loop every driver runs.
 //!
-//! A [`Session`] owns the [`Progressive`] solver, the [`Refiner`] with its
+//! A [`Session`] owns the solver (a [`Method`], built by
+//! [`crate::solver::build`] from the options), the [`Refiner`] with its
 //! element-limit clamp, the per-pass statistics and the choice of what is
 //! shown (the solution, or the solution with the ambient term). It
 //! advances by one call, [`Session::advance`], which returns what happened
@@ -19,7 +20,7 @@
 //!
 //! **Refined passes continue the solve.** With per-vertex unshot radiosity
 //! the solve on the refined mesh starts from
-//! [`Progressive::refined_state`]: the vertices both meshes share keep
+//! [`Method::refined_state`]: the vertices both meshes share keep
 //! their values, the new ones gather the light every polygon has shot so
 //! far, and shooting goes on from there. With per-polygon unshot each
 //! refined mesh is solved afresh.
@@ -31,7 +32,7 @@ use crate::mesh::weld::Weld;
 use crate::mesh::{Mesh, MeshRef};
 use crate::prepare::Prepared;
 use crate::scene::Scene;
-use crate::solver::{Progressive, SolverError, SolverOptions, StepReport, StopReason};
+use crate::solver::{self, Method, SolverError, SolverOptions, StepReport, StopReason};
 use crate::visibility::Visibility;
 use serde::Serialize;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -50,8 +51,8 @@ pub struct SessionOptions {
     /// [`Event::Refused`]) before its mesh would have more elements than
     /// this or than [`RefineOptions::max_elements`], whichever is smaller.
     pub max_elements: u64,
-    /// Show the ambient term ([`Progressive::ambient`]) on top of the
-    /// solution in [`Session::shown`].
+    /// Show the ambient term ([`Method::radiosity_with_ambient`]) on top
+    /// of the solution in [`Session::shown`].
     pub ambient: bool,
 }
 
@@ -151,7 +152,7 @@ pub struct Session<'p> {
     options: SessionOptions,
     /// The refiner and its options with the element limit applied.
     refiner: Option<(Refiner, RefineOptions)>,
-    solver: Progressive<'p>,
+    solver: Box<dyn Method<'p> + 'p>,
     phase: Phase,
     passes: Vec<PassStats>,
     /// Counts of the finished passes' solvers.
@@ -187,7 +188,7 @@ impl<'p> Session<'p> {
             };
             (Refiner::new(mesh), clamped)
         });
-        let solver = Progressive::new(scene, mesh, visibility, options.solver);
+        let solver = solver::build(scene, mesh, visibility, options.solver);
         Session {
             weld: Weld::new(scene, mesh),
             scene,
@@ -320,7 +321,7 @@ impl<'p> Session<'p> {
         pass.refine_seconds = refining.elapsed().as_secs_f64();
         pass.seconds = self.pass_start.time.elapsed().as_secs_f64();
         self.close_pass(pass);
-        let mut solver = Progressive::new(
+        let mut solver = solver::build(
             self.scene,
             Arc::new(mesh),
             self.visibility,
@@ -373,8 +374,8 @@ impl<'p> Session<'p> {
     }
 
     /// The solver of the current pass.
-    pub fn solver(&self) -> &Progressive<'p> {
-        &self.solver
+    pub fn solver(&self) -> &(dyn Method<'p> + 'p) {
+        &*self.solver
     }
 
     /// The mesh of the current pass: the prepared one, or its latest

@@ -18,7 +18,7 @@ use radiosity::config::{RunConfig, SceneSource};
 use radiosity::prepare::prepare;
 use radiosity::scene::Scene;
 use radiosity::session::{Event, Session, SessionOptions};
-use radiosity::solver::{Progressive, SolverOptions, StopReason};
+use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions, StopReason};
 use radiosity::visibility::Visibility;
 use std::sync::atomic::AtomicBool;
 
@@ -113,8 +113,9 @@ fn generated_scenes_stay_finite_to_exhaustion() {
             let vis = Visibility::new(&s);
             for (clustering, overshoot) in [(true, true), (true, false), (false, true)] {
                 let options = SolverOptions {
-                    clustering,
-                    overshoot,
+                    approximations: Approximations::DEFAULT
+                        .with(Heuristic::Clusters, clustering)
+                        .with(Heuristic::Overshoot, overshoot),
                     ..exhausting(400)
                 };
                 let name = format!(

@@ -194,6 +194,8 @@ fn solve(dir: &Path, left: LeftWall, split: bool) -> (Scene, Mesh, Vec<f64>) {
     let mut session = Session::new(&scene, &mesh, &visibility, options);
     assert!(session.run_to_end(&AtomicBool::new(false)).unwrap());
     let radiosity = session.radiosity().iter().map(|b| b.r).collect();
+    // The session's solver borrows both until it is gone.
+    drop(session);
     (scene, mesh, radiosity)
 }
 

@@ -5,7 +5,7 @@ use radiosity::mesh::{self, MeshOptions};
 use radiosity::render::render;
 use radiosity::render::View;
 use radiosity::scene::{parse_str, Scene};
-use radiosity::solver::{Progressive, SolverOptions};
+use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions};
 use radiosity::visibility::Visibility;
 
 const MATERIALS: &str = "\
@@ -27,7 +27,7 @@ fn solve_checked(text: &str, lenmax: Option<f32>, inset: f32, steps: u32) -> Vec
     let visibility = Visibility::new(&scene);
     for near_field in [true, false] {
         let options = SolverOptions {
-            near_field,
+            approximations: Approximations::DEFAULT.with(Heuristic::NearField, near_field),
             ..SolverOptions::default()
         };
         let mut solver = Progressive::new(&scene, &mesh, &visibility, options);

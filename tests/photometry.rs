@@ -187,7 +187,7 @@ fn luminaire_floor_with(
     options.lenmax = s(0.25) as f32;
     let mesh = mesh::build(&scene, &options).unwrap();
     let visibility = Visibility::new(&scene);
-    let mut solver = Progressive::new(&scene, &mesh, &visibility, solver_options);
+    let mut solver = radiosity::solver::build(&scene, &mesh, &visibility, solver_options);
     while solver.step().is_some() {}
     let gather = FinalGather::new(&scene, &mesh, &visibility, solver.radiosity(), true);
     let at: Vec<(Vec3, Vec3)> = points

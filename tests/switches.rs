@@ -1,16 +1,22 @@
-//! Each approximation switch of [`SolverOptions`] against its twin: a
-//! solve with every switch at its default, and the same solve with one
-//! switch turned off, must give the same radiosity bits (for a switch
-//! that changes no result) or stay within a relative L1 difference of
-//! the picture's radiosity. A switch is a row of [`switches`]; a new one
-//! is one more line.
+//! Each heuristic of the solver ([`Approximations`]) against its twin: a
+//! solve with every switch on, and the same solve with one switch turned
+//! off, must give the same radiosity bits (for a switch that changes no
+//! result) or stay within a relative L1 difference of the picture's
+//! radiosity; so must the groups `--exact-receivers` turns off and the
+//! brute-force twin [`Approximations::EXACT`]. Every switch must also act
+//! on one of the scenes (change bits or rays), so no row passes by
+//! testing nothing. A switch is a row of [`switches`]; a new one is one
+//! more line.
 
 mod common;
 
-use common::scenes::{regular_mesh, relative_l1, same_bits, solve_on, tiled_shadowed_box};
+use common::scenes::{
+    grey, polygon, regular_mesh, relative_l1, same_bits, scene, solve_on, tiled, tiled_shadowed_box,
+};
+use radiosity::color::Rgb;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::Scene;
-use radiosity::solver::SolverOptions;
+use radiosity::solver::{Approximations, Heuristic, SolverOptions};
 
 /// How close a switch's twin must come.
 #[derive(Clone, Copy, Debug)]
@@ -24,70 +30,116 @@ enum Tolerance {
 
 use Tolerance::*;
 
-/// One approximation switch: its name, how to turn it off (the twin), and
-/// how close the twin must come to the default on every scene.
+/// One switch or group of switches: its name, the heuristics it turns off
+/// (the twin), and how close the twin must come to the default on every
+/// scene.
 struct Switch {
-    /// The option's name, for messages.
+    /// The switch's name, for messages.
     name: &'static str,
-    /// Turns the switch off in the default options.
-    off: fn(&mut SolverOptions),
+    /// The approximations of the twin.
+    twin: Approximations,
     /// How close the default must be to the twin.
     tolerance: Tolerance,
+    /// Scenes this row leaves out, for time: the brute-force twin on the
+    /// spheres' 2,188 facets takes 2,500 steps (33 s); the unclustered
+    /// row checks them there.
+    skip: &'static [&'static str],
 }
 
-/// Every switch. A relative L1 bound is what the switch gives today on
-/// both scenes (measured on the Cornell box, then on the tiled box, in
-/// the row's comment), with a margin of two or more; the solves are
-/// deterministic, so the margin is for changes to come, not for noise.
+/// A row turning off one heuristic.
+fn off(h: Heuristic, tolerance: Tolerance) -> Switch {
+    Switch {
+        name: format!("{h:?}").leak(),
+        twin: Approximations::DEFAULT.with(h, false),
+        tolerance,
+        skip: &[],
+    }
+}
+
+/// Every switch, then the groups. A relative L1 bound is the largest the
+/// switch gives today on the four scenes (in the row's comment, in the
+/// order Cornell box, tiled box, spheres, sky, wide floor), with a margin of two or
+/// more; the solves are deterministic, so the margin is for changes to
+/// come, not for noise.
 // A table: one row per line.
 #[rustfmt::skip]
 fn switches() -> Vec<Switch> {
+    use Heuristic::*;
     vec![
+        // 0, 9.5e-5, 0, 0, 0: only the tiled box's weak lamp waits.
+        off(EmittersFirst, RelativeL1(3e-4)),
+        // 4.6e-4, 9.5e-4, 4.2e-4, 1.1e-6, 3e-8: both stop at the same
+        // threshold, by different paths.
+        off(Overshoot, RelativeL1(2e-3)),
+        // 8.4e-6, 0, 2.1e-4, 3.5e-7, 2.9e-5: the pockets under the balls.
+        off(Settling, RelativeL1(1e-3)),
+        // 2.7 %, 6.3 %, 1.7 %, 2e-5, 1.5e-4: the plain disc sum is what the
+        // near field corrects, receivers close to a shooter's samples
+        // (the walls along their shared edges, the tiles side by side).
+        off(NearField, RelativeL1(0.1)),
         // Shaft culling changes which rays are cast, never what they find.
-        Switch { name: "shaft_culling", off: |o| o.shaft_culling = false, tolerance: SameBits },
-        // 0.027 %, 0.063 % (the Cornell box has no clusters: what
-        // changes is the receivers' interpolation, which goes with it).
-        Switch { name: "clustering", off: |o| o.clustering = false, tolerance: RelativeL1(0.002) },
-        // 0.027 %, 0.043 %.
-        Switch { name: "receiver_interpolation", off: |o| o.receiver_interpolation = false, tolerance: RelativeL1(0.002) },
-        // 2.7 %, 6.3 %: the plain disc sum is what the near field
-        // corrects, receivers close to a shooter's samples (the walls
-        // along their shared edges, the tiles next to each other).
-        Switch { name: "near_field", off: |o| o.near_field = false, tolerance: RelativeL1(0.1) },
-        // 0.046 %, 0.093 %: both stop at the same threshold, by different
-        // paths.
-        Switch { name: "overshoot", off: |o| o.overshoot = false, tolerance: RelativeL1(0.002) },
-        // 0.0008 %, 0: neither scene has a pocket for settling to fill
-        // (the solver's settle tests build one).
-        Switch { name: "settle", off: |o| o.settle = 0.0, tolerance: RelativeL1(1e-4) },
+        off(ShaftCulling, SameBits),
+        // 2.7e-4, 5.9e-4, 3.0e-4, 8.8e-7, 5e-7 (the Cornell box has no
+        // clusters: what changes there is the receiver heuristics, which
+        // act only in a solve that clusters).
+        off(Clusters, RelativeL1(2e-3)),
+        // 0, 4.9e-4, 3.0e-4, 4.9e-7, 4e-7.
+        off(Strata, RelativeL1(2e-3)),
+        // 2.7e-4, 1.4e-4, 0, 3.4e-7, 7e-8.
+        off(ReceiverInterpolation, RelativeL1(1e-3)),
+        // 0, 4.0e-4, 2.9e-4, 3.4e-7, 1.9e-7.
+        off(WeakStrata, RelativeL1(1e-3)),
+        // 9.7e-5, 4.5e-4, 0, 1e-7, 0.
+        off(CrowdedCells, RelativeL1(1.5e-3)),
+        // 3e-7 on the spheres, 0 elsewhere.
+        off(FacetRays, RelativeL1(1e-5)),
+        // 9e-8 under the sky, 0 elsewhere.
+        off(SkyProbes, RelativeL1(1e-5)),
+        // 0 everywhere: the far lamp's probes agree; it casts fewer rays.
+        off(FarShooters, RelativeL1(1e-5)),
+        // 2.7e-4, 4.2e-4, 2.9e-4, 6e-7, 2.5e-7.
+        Switch { name: "--exact-receivers", twin: Approximations::DEFAULT.without(&Heuristic::RECEIVERS), tolerance: RelativeL1(1.5e-3), skip: &[] },
+        // 5.7e-4, 5.9e-4, (3.5e-4), 1.3e-6, 5e-7. The brute-force twin, but
+        // for shaft culling, which changes no bit (its own row) and
+        // would only multiply the rays.
+        Switch { name: "Approximations::EXACT", twin: Approximations::EXACT.with(ShaftCulling, true), tolerance: RelativeL1(2e-3), skip: &["spheres"] },
     ]
 }
 
 /// Solves `s` on `mesh` with the default options and with each switch
-/// turned off, and fails with every switch whose twin is not within its
-/// tolerance, naming the scene, the switch, the tolerance and what was
-/// measured.
-fn check_switches(name: &str, s: &Scene, mesh: &Mesh) {
+/// turned off; returns, per row of [`switches`], whether the twin acted
+/// (other bits or other rays), and the failures: every row whose twin is
+/// not within its tolerance, naming the scene, the switch, the tolerance
+/// and what was measured.
+fn check_switches(name: &str, s: &Scene, mesh: &Mesh) -> (Vec<bool>, Vec<String>) {
     let defaults = SolverOptions::default();
     let reference = solve_on(s, mesh.clone(), defaults);
     let mut failures = Vec::new();
+    let mut acted = Vec::new();
     for switch in switches() {
-        let mut options = defaults;
-        (switch.off)(&mut options);
+        if switch.skip.contains(&name) {
+            acted.push(false);
+            continue;
+        }
+        let options = SolverOptions {
+            approximations: switch.twin,
+            ..defaults
+        };
+        let clock = std::time::Instant::now();
         let twin = solve_on(s, mesh.clone(), options);
+        let seconds = clock.elapsed().as_secs_f64();
+        let same = same_bits(&reference.radiosity, &twin.radiosity);
+        acted.push(!same || twin.rays != reference.rays);
         let (passed, measured) = match switch.tolerance {
-            SameBits => {
-                let same = same_bits(&reference.radiosity, &twin.radiosity);
-                (same, format!("same bits: {same}"))
-            }
+            SameBits => (same, format!("same bits: {same}")),
             RelativeL1(bound) => {
                 let l1 = relative_l1(mesh, &reference.radiosity, &twin.radiosity);
                 (l1 <= bound, format!("relative L1 {l1:e}"))
             }
         };
         eprintln!(
-            "{name}, {} off: {measured} ({} steps against {})",
-            switch.name, twin.steps, reference.steps
+            "{name}, {} off: {measured} ({} steps, {} rays against {}, {}; {seconds:.2} s)",
+            switch.name, twin.steps, twin.rays, reference.steps, reference.rays
         );
         if !passed {
             failures.push(format!(
@@ -96,23 +148,161 @@ fn check_switches(name: &str, s: &Scene, mesh: &Mesh) {
             ));
         }
     }
-    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+    (acted, failures)
 }
 
-/// The bundled Cornell box on its default mesh.
-#[test]
-fn switches_on_the_cornell_box() {
-    let s = radiosity::scene::load(&common::scene("cornell.sc")).expect("cornell.sc loads");
-    let mesh = mesh::build(&s, &MeshOptions::for_scene(&s)).expect("the scene meshes");
-    check_switches("cornell.sc", &s, &mesh);
+/// The five scenes: what each heuristic acts on is in one of them.
+fn scenes() -> Vec<(&'static str, Scene, Mesh)> {
+    let cornell = radiosity::scene::load(&common::scene("cornell.sc")).expect("cornell.sc loads");
+    let cornell_mesh = mesh::build(&cornell, &MeshOptions::for_scene(&cornell)).expect("meshes");
+    let tiled = tiled_box_with_a_weak_lamp();
+    let tiled_mesh = regular_mesh(&tiled, 0.15);
+    // McGuire's Cornell box with two spheres (a real export, 2,188
+    // faces): clusters of small facets, facets smaller than half an
+    // element that share their rays, pockets under the balls.
+    let path = common::root().join("tests/models/mcguire/CornellBox-Sphere.obj");
+    let spheres = radiosity::scene::load(&path).expect("CornellBox-Sphere.obj loads");
+    let spheres_mesh = regular_mesh(&spheres, 0.25);
+    let sky = courtyard();
+    let sky_mesh = regular_mesh(&sky, 0.25);
+    let far = lamp_over_a_wide_floor();
+    let far_mesh = regular_mesh(&far, 0.25);
+    vec![
+        ("cornell.sc", cornell, cornell_mesh),
+        ("tiled box", tiled, tiled_mesh),
+        ("spheres", spheres, spheres_mesh),
+        ("courtyard under a sky", sky, sky_mesh),
+        ("lamp over a wide floor", far, far_mesh),
+    ]
 }
 
 /// A 2-unit room lit by its glowing ceiling, with a square floating over
 /// the floor casting a shadow, every wall cut into 4 × 4 tiles so that
-/// clusters form; elements 0.15 across.
+/// clusters form, and a weak lamp on the floor: the walls the ceiling
+/// lights hold more power than it emits, so the order of shooting depends
+/// on whether emitters go first.
+fn tiled_box_with_a_weak_lamp() -> Scene {
+    let mut s = tiled_shadowed_box(4);
+    s.materials.push(grey("weak lamp", 0.5, 0.3));
+    let weak = (s.materials.len() - 1) as u32;
+    s.polygons.push(polygon(
+        weak,
+        &[
+            [0.2, 0.01, 0.2],
+            [0.2, 0.01, 0.5],
+            [0.5, 0.01, 0.5],
+            [0.5, 0.01, 0.2],
+        ],
+    ));
+    s
+}
+
+/// A 20 × 20 floor under a lamp 0.8 across, 3 over one corner, with a
+/// table top over the floor: most of the floor lies more than twelve lamp
+/// diameters away (far shooters).
+fn lamp_over_a_wide_floor() -> Scene {
+    let w = 20.0;
+    let polygons = vec![
+        polygon(0, &[[0., 0., 0.], [0., 0., w], [w, 0., w], [w, 0., 0.]]),
+        polygon(
+            1,
+            &[[1., 3., 1.], [1.8, 3., 1.], [1.8, 3., 1.8], [1., 3., 1.8]],
+        ),
+        // The table top's upper and lower faces.
+        polygon(
+            0,
+            &[
+                [8., 0.75, 8.],
+                [8., 0.75, 9.],
+                [9., 0.75, 9.],
+                [9., 0.75, 8.],
+            ],
+        ),
+        polygon(
+            0,
+            &[[8., 0.7, 8.], [9., 0.7, 8.], [9., 0.7, 9.], [8., 0.7, 9.]],
+        ),
+    ];
+    scene(
+        polygons,
+        vec![grey("grey", 0.0, 0.5), grey("lamp", 10.0, 0.0)],
+    )
+}
+
+/// A 4 × 4 courtyard of tiled walls 1.5 high, open to a uniform sky, with
+/// a small lamp in one corner.
+fn courtyard() -> Scene {
+    let floor = polygon(
+        1,
+        &[
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 4.0],
+            [4.0, 0.0, 4.0],
+            [4.0, 0.0, 0.0],
+        ],
+    );
+    let walls = [
+        [
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [4.0, 1.5, 0.0],
+            [0.0, 1.5, 0.0],
+        ],
+        [
+            [4.0, 0.0, 4.0],
+            [0.0, 0.0, 4.0],
+            [0.0, 1.5, 4.0],
+            [4.0, 1.5, 4.0],
+        ],
+        [
+            [0.0, 0.0, 4.0],
+            [0.0, 0.0, 0.0],
+            [0.0, 1.5, 0.0],
+            [0.0, 1.5, 4.0],
+        ],
+    ];
+    // Facing down, 1 over the floor.
+    let lamp = polygon(
+        0,
+        &[
+            [3.5, 1.0, 3.5],
+            [3.7, 1.0, 3.5],
+            [3.7, 1.0, 3.7],
+            [3.5, 1.0, 3.7],
+        ],
+    );
+    let mut polygons = tiled(&floor, 4);
+    for w in walls {
+        polygons.extend(tiled(&polygon(1, &w), 4));
+    }
+    polygons.push(lamp);
+    let mut s = scene(
+        polygons,
+        vec![grey("lamp", 20.0, 0.0), grey("stone", 0.0, 0.6)],
+    );
+    s.add_sky(Rgb::splat(1.0))
+        .expect("a sky fits around the courtyard");
+    s
+}
+
+/// Every switch within its tolerance on every scene, and every switch
+/// acting on at least one of them.
 #[test]
-fn switches_on_a_tiled_box() {
-    let s = tiled_shadowed_box(4);
-    let mesh = regular_mesh(&s, 0.15);
-    check_switches("tiled box", &s, &mesh);
+fn each_switch_against_its_twin() {
+    let mut acted = vec![false; switches().len()];
+    let mut failures = Vec::new();
+    for (name, s, mesh) in scenes() {
+        let (a, f) = check_switches(name, &s, &mesh);
+        acted.iter_mut().zip(a).for_each(|(x, a)| *x |= a);
+        failures.extend(f);
+    }
+    for (switch, acted) in switches().iter().zip(acted) {
+        if !acted {
+            failures.push(format!(
+                "{} changed nothing on any scene: untested",
+                switch.name
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }

@@ -12,7 +12,7 @@
 use crate::output::convergence::StepRecord;
 use crate::output::{self, OutputError};
 use crate::solver::checkpoint::{self, DecodeError, SolverState};
-use crate::solver::{Progressive, SolverError};
+use crate::solver::SolverError;
 use std::path::{Path, PathBuf};
 
 /// Why a checkpoint could not be read or used. Every message names the file.
@@ -73,16 +73,16 @@ pub enum CheckpointError {
 /// Bytes of one step in the log saved with a checkpoint.
 pub const LOG_RECORD_LEN: usize = 56;
 
-/// Saves `solver`'s state and the step log so far to `path` atomically
+/// Saves a solver's `state` and the step log so far to `path` atomically
 /// (temporary file + rename): the file is always either the previous
 /// checkpoint or the new one.
 pub fn save(
     path: &Path,
     fingerprint: u64,
-    solver: &Progressive,
+    state: &SolverState,
     log: &[StepRecord],
 ) -> Result<(), CheckpointError> {
-    let bytes = checkpoint::encode(fingerprint, solver, &encode_log(log));
+    let bytes = checkpoint::encode(fingerprint, state, &encode_log(log));
     Ok(output::write_atomically(path, |w| w.write_all(&bytes))?)
 }
 
@@ -189,7 +189,7 @@ mod tests {
             rays: 1 << 33,
             seconds: 2.5,
         }];
-        let bytes = checkpoint::encode_state(7, &state, &encode_log(&log));
+        let bytes = checkpoint::encode(7, &state, &encode_log(&log));
         output::write_atomically(&path, |w| w.write_all(&bytes)).unwrap();
         assert_eq!(load(&path, 7).unwrap(), (state, log));
         let e = load(&path, 8).unwrap_err();

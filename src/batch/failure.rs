@@ -106,7 +106,7 @@ pub(super) fn stopped(
     if let Some(path) = &config.checkpoint {
         let solver = session.solver();
         if solver.values_are_finite() && !solver.in_step() {
-            match checkpoint::save(path, fingerprint, solver, records) {
+            match checkpoint::save(path, fingerprint, &solver.state(), records) {
                 Ok(()) => written.push(path.clone()),
                 Err(e) => not_written.push(e.to_string()),
             }

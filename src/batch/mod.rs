@@ -510,7 +510,7 @@ fn solve<'p>(
     let clock_offset = records.last().map_or(0.0, |r: &StepRecord| r.seconds);
     let save = |session: &Session, records: &[StepRecord]| -> Result<(), RunError> {
         if let Some(path) = &config.checkpoint {
-            checkpoint::save(path, fingerprint, session.solver(), records)?;
+            checkpoint::save(path, fingerprint, &session.solver().state(), records)?;
         }
         Ok(())
     };

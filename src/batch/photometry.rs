@@ -64,7 +64,7 @@ pub fn write(
         }
     };
     let p = &config.photometry;
-    let near_field = config.solver.near_field;
+    let near_field = config.solver.approximations.near_field;
     let gather = || {
         FinalGather::new(
             &prepared.scene,

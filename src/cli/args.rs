@@ -15,9 +15,8 @@ use crate::mesh::refine;
 use crate::mesh::DEFAULT_INSET;
 use crate::render::antialias;
 use crate::solver::hemicube::HemicubeRes;
-use crate::solver::{
-    FormFactorMethod, ShooterSamples, UnshotScheme, DEFAULT_SETTLE, DEFAULT_THRESHOLD,
-};
+use crate::solver::tuning::{DEFAULT_SETTLE, DEFAULT_THRESHOLD};
+use crate::solver::{FormFactorMethod, Heuristic, ShooterSamples, UnshotScheme};
 use std::path::PathBuf;
 
 /// The exit codes, shown after both the short and the long help.
@@ -98,7 +97,7 @@ pub struct Args {
     /// near field; slow on fine meshes). Unit-square form factors are
     /// within 0.06 % of exact at 16 or more; more points sample penumbrae
     /// more finely.
-    // The literal is solver::DEFAULT_SHOOTER_SAMPLES (ShooterSamples has no
+    // The literal is crate::solver::tuning::DEFAULT_SHOOTER_SAMPLES (ShooterSamples has no
     // Display for `default_value_t`); a unit test keeps the two equal.
     #[arg(long, value_name = "N|all", default_value = "64", value_parser = parse_shooter_samples)]
     pub(crate) shooter_samples: ShooterSamples,
@@ -107,16 +106,14 @@ pub struct Args {
     ///
     /// An even number from 8 to 4096; the side faces have N × N/2 pixels.
     /// One hemicube stands at each shooter sample (--shooter-samples).
-    // The literal is solver::hemicube::DEFAULT_HEMICUBE_RES; a unit test
+    // The literal is crate::solver::tuning::DEFAULT_HEMICUBE_RES; a unit test
     // keeps the two equal.
     #[arg(long, value_name = "N", default_value = "128", value_parser = parse_hemicube_res)]
     pub(crate) hemicube_res: HemicubeRes,
 
     /// Use the disc approximation however near the receiver.
-    ///
-    /// Every shooter sample then uses the plain disc approximation
-    /// a/(πr² + a); by default the exact point-to-cell form factor is used
-    /// within 1.5 cell diameters, a quadrature of the cell to 6.
+    // The long help quotes tuning constants: it is written from them in
+    // `cli/help.rs`.
     #[arg(long)]
     pub(crate) no_near_field: bool,
 
@@ -128,42 +125,41 @@ pub struct Args {
     pub(crate) no_shaft_culling: bool,
 
     /// Shoot every polygon alone (the solver without clusters).
-    ///
-    /// By default nearby small polygons (a tessellated sphere, a chair)
-    /// shoot their unshot power together in one step, from strata of their
-    /// cells; emitters and polygons larger than an eighth of the scene
-    /// always shoot alone. This is the brute-force twin, for comparison.
+    // The long help quotes tuning constants: it is written from them in
+    // `cli/help.rs`.
     #[arg(long)]
     pub(crate) no_clustering: bool,
 
     /// Evaluate every receiving vertex exactly, in every step.
-    ///
-    /// By default, with clusters, a step of reflected light evaluates large
-    /// receiving grids at every fourth row and column and at a check vertex
-    /// in each cell between, and interpolates the cell's other vertices
-    /// where the corners predict the check vertex within 2 % (or 0.1 % of
-    /// what it already holds), and a vertex takes a nearby part of the
-    /// shooting cluster as one term when its light there is too weak to
-    /// matter (within 0.3 % of what the vertex holds). A facet under half
-    /// an element across asks one shadow ray per shooter sample for all
-    /// its vertices, in every step, and a vertex asks 16 of a sky facet's
-    /// directions first, the other 240 only when those disagree; a vertex
-    /// six or more diameters from a lamp asks four of its samples first,
-    /// the others only when those disagree. Emitters' shots are otherwise
-    /// always exact. This is the exact twin, for comparison.
+    // The long help quotes tuning constants: it is written from them in
+    // `cli/help.rs`.
     #[arg(long)]
     pub(crate) exact_receivers: bool,
 
     /// Shoot exactly the unshot light, never more.
-    ///
-    /// By default each point of a shooter also sends out the light it can
-    /// expect to receive later (what it has received so far times the ratio
-    /// of light still to come to light shot, at most half its reflectance
-    /// times the ambient term), which converges in fewer steps; what it
-    /// sent ahead and never received is taken back by steps of negative
-    /// light. This is the original algorithm, for comparison.
+    // The long help quotes tuning constants: it is written from them in
+    // `cli/help.rs`.
     #[arg(long)]
     pub(crate) no_overshoot: bool,
+
+    /// Turn these heuristics of the solver off (comma-separated).
+    ///
+    /// Each is one switch, measured against its twin: emitters-first,
+    /// overshoot, settling, near-field, shaft-culling, clusters, strata,
+    /// receiver-interpolation, weak-strata, crowded-cells, facet-rays,
+    /// sky-probes, far-shooters. `docs/accuracy.md` gives what each costs
+    /// and buys.
+    #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
+    pub(crate) without: Vec<Heuristic>,
+
+    /// Solve with no heuristic: the brute-force twin (slow).
+    ///
+    /// Every polygon shoots alone from all its cells in plain power order,
+    /// exactly the light it holds, to every receiving vertex with its own
+    /// shadow rays, each tested against the whole scene. The exact near
+    /// field and settling stay.
+    #[arg(long)]
+    pub(crate) exact: bool,
 
     /// Where unshot radiosity is kept between shooting steps.
     #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]

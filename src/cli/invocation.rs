@@ -14,7 +14,7 @@ use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
 use crate::render::Exposure;
 use crate::scene::Sides;
-use crate::solver::SolverOptions;
+use crate::solver::{Approximations, Heuristic, SolverOptions};
 use std::num::NonZeroUsize;
 use std::time::Duration;
 
@@ -111,6 +111,29 @@ struct PhotometryArgs {
 /// The photometric part of the configuration; the work plane's files are
 /// `PREFIX.csv` and `PREFIX.png`, `PREFIX` by default
 /// `<scene-stem>-workplane`.
+/// The solver's heuristics as the switches ask: `--exact` starts from the
+/// brute-force twin, and `--without` and the older single switches
+/// (`--no-clustering`, `--exact-receivers`, ...) turn theirs off.
+fn approximations(args: &Args) -> Approximations {
+    let start = if args.exact {
+        Approximations::EXACT
+    } else {
+        Approximations::DEFAULT
+    };
+    let singles = [
+        (args.no_near_field, Heuristic::NearField),
+        (args.no_shaft_culling, Heuristic::ShaftCulling),
+        (args.no_clustering, Heuristic::Clusters),
+        (args.no_overshoot, Heuristic::Overshoot),
+    ];
+    let mut off = args.without.clone();
+    off.extend(singles.iter().filter(|(on, _)| *on).map(|&(_, h)| h));
+    if args.exact_receivers {
+        off.extend(Heuristic::RECEIVERS);
+    }
+    start.without(&off)
+}
+
 fn photometry(a: &PhotometryArgs) -> PhotometryConfig {
     PhotometryConfig {
         units: a.units,
@@ -202,6 +225,7 @@ impl TryFrom<Args> for Invocation {
             falsecolor_scale: args.falsecolor_scale,
             falsecolor_max: args.falsecolor_max,
         };
+        let approximations = approximations(&args);
         let config = RunConfig {
             scene: args.scene.map_or(SceneSource::Bundled, SceneSource::File),
             output: args.output,
@@ -213,13 +237,9 @@ impl TryFrom<Args> for Invocation {
                 threshold: args.threshold,
                 settle: args.settle,
                 max_steps: args.max_steps,
-                near_field: !args.no_near_field,
-                shaft_culling: !args.no_shaft_culling,
+                approximations,
                 unshot: args.unshot,
-                clustering: !args.no_clustering,
-                receiver_interpolation: !args.exact_receivers,
                 hemicube_res: args.hemicube_res,
-                overshoot: !args.no_overshoot,
                 // A window asks for parts ([`crate::viewer`]); a batch run
                 // has no picture between steps.
                 part_budget: None,

@@ -19,9 +19,11 @@
 //! ```
 
 mod args;
+mod help;
 mod invocation;
 mod values;
 
 pub use args::{Args, EXIT_CODES};
+pub use help::{command, parse, parse_from};
 pub use invocation::{Invocation, Mode, UsageError};
 pub use values::{parse_emit, parse_shooter_samples, parse_size, parse_sky, ValueError};

@@ -48,7 +48,7 @@ fn a_session_is_the_bare_solver_loop() {
     let m = build(&s, 0.25);
     let vis = Visibility::new(&s);
     let o = options(None);
-    let mut bare = Progressive::new(&s, &m, &vis, o.solver);
+    let mut bare = crate::solver::build(&s, &m, &vis, o.solver);
     let mut bare_steps = 0;
     while !bare.is_done() && bare.step().is_some() {
         bare_steps += 1;
@@ -134,7 +134,7 @@ fn adaptive_passes_refine_and_add_up() {
     // The continued solve is the solve of its final mesh: a fresh solve
     // of that mesh agrees within 0.5 % of the mean on every polygon.
     let mesh = session.mesh();
-    let mut fresh = Progressive::new(&s, mesh, &vis, options(None).solver);
+    let mut fresh = crate::solver::build(&s, mesh, &vis, options(None).solver);
     while !fresh.is_done() && fresh.step().is_some() {}
     let areas = mesh.vertex_areas();
     let mean = |radiosity: &[Rgb], j: usize| {

@@ -39,8 +39,9 @@
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
 //! materials (those `--emit` changed, and the facets and radiosity of a
-//! `--sky`), the mesh's vertices and sample points, and the form-factor
-//! options. It leaves out the stopping rule (threshold, step limit), so a
+//! `--sky`), the mesh's vertices and sample points, the form-factor
+//! options, every approximation switch ([`super::Approximations`]) and
+//! every tuning constant ([`super::tuning::INDEX`]). It leaves out the stopping rule (threshold, step limit), so a
 //! resumed run may go further than the interrupted one would have. A
 //! driver refuses a checkpoint whose fingerprint differs from its solve's;
 //! [`decode`] refuses a truncated or corrupted one by its length or
@@ -49,7 +50,7 @@
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::solver::{FormFactorMethod, Progressive, ShooterSamples, SolverOptions};
+use crate::solver::{FormFactorMethod, ShooterSamples, SolverOptions};
 
 /// The first eight bytes of every checkpoint file.
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
@@ -77,7 +78,7 @@ const CHECKSUM_LEN: usize = 8;
 
 /// Everything a progressive solve needs to continue exactly where it was.
 ///
-/// Invariants a solver checks on restore ([`Progressive::restore`]):
+/// Invariants a solver checks on restore ([`crate::solver::Method::restore`]):
 /// `radiosity` has one entry per mesh vertex, `unshot` one per polygon or
 /// per mesh vertex (by [`SolverOptions::unshot`]), every channel finite and
 /// `>= 0`.
@@ -230,23 +231,14 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         ShooterSamples::All => u64::MAX,
         ShooterSamples::AtMost(n) => n as u64,
     });
-    h.word(options.near_field as u64);
-    h.word(options.clustering as u64);
-    h.word(options.receiver_interpolation as u64);
-    h.word(super::WEAK_STRATUM_SHARE.to_bits());
-    h.word(u64::from(super::cluster::PLANE_DEPTH_RATIO.to_bits()));
-    h.word(u64::from(super::cluster::TOP_DEPTH_RATIO.to_bits()));
-    h.word(u64::from(super::cluster::STRATUM_NEAR_RATIO.to_bits()));
-    h.word(u64::from(super::cluster::RESTING_NEAR_FACTOR.to_bits()));
-    h.word(u64::from(super::receivers::CROWD_RATIO.to_bits()));
-    h.word(u64::from(super::facets::SCALE_RATIO.to_bits()));
-    h.word(u64::from(super::facets::NEAR_RATIO.to_bits()));
-    h.word(super::probes::SKY_PROBES as u64);
-    h.word(super::probes::MIN_PROBES as u64);
-    h.word(u64::from(super::far_shooters::FAR_SHOOTER_RATIO.to_bits()));
-    h.word(super::far_shooters::FAR_PROBES as u64);
-    h.word(options.overshoot as u64);
-    h.word(u64::from(super::formfactor::SKY_FACET_SAMPLES));
+    // Every switch and every tuning constant: a build tuned otherwise
+    // would not continue to the same bits.
+    h.word(options.approximations.bits());
+    h.word(super::tuning::INDEX.len() as u64);
+    for tuned in super::tuning::INDEX {
+        h.bytes(tuned.name.as_bytes());
+        h.word(tuned.value.to_bits());
+    }
     h.word(match options.unshot {
         super::UnshotScheme::Polygon => 1,
         super::UnshotScheme::Vertex => 2,
@@ -265,22 +257,10 @@ pub struct Checkpoint {
     pub record: Vec<u8>,
 }
 
-/// The bytes of a checkpoint of `solver`'s current state, with the
-/// driver's `record` (opaque here).
-pub fn encode(fingerprint: u64, solver: &Progressive, record: &[u8]) -> Vec<u8> {
-    encode_parts(
-        fingerprint,
-        solver.radiosity(),
-        solver.unshot(),
-        solver.charges(),
-        solver.steps(),
-        solver.rays(),
-        record,
-    )
-}
-
-/// The bytes of a checkpoint of `state`, with the driver's `record`.
-pub fn encode_state(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
+/// The bytes of a checkpoint of `state` (a solver's
+/// [`crate::solver::Method::state`]), with the driver's `record` (opaque
+/// here).
+pub fn encode(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
     encode_parts(
         fingerprint,
         &state.radiosity,
@@ -425,7 +405,7 @@ mod tests {
 
     #[test]
     fn round_trip_keeps_every_bit() {
-        let bytes = encode_state(0xfeed, &state(), b"log");
+        let bytes = encode(0xfeed, &state(), b"log");
         let Checkpoint {
             fingerprint: fp,
             state: back,
@@ -448,7 +428,7 @@ mod tests {
     /// Version `v` bytes made from version 3 bytes of an uncharged state:
     /// the header cut to `header` bytes, the record kept or not.
     fn older(v: u32, header: usize, record: &[u8]) -> Vec<u8> {
-        let v3 = encode_state(5, &uncharged(), record);
+        let v3 = encode(5, &uncharged(), record);
         let mut out = v3[..8].to_vec();
         out.extend_from_slice(&v.to_le_bytes());
         out.extend_from_slice(&v3[12..header]);
@@ -479,7 +459,7 @@ mod tests {
 
     #[test]
     fn damage_of_any_kind_is_refused() {
-        let bytes = encode_state(1, &state(), b"record");
+        let bytes = encode(1, &state(), b"record");
         // Every truncation.
         for len in 0..bytes.len() {
             assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");

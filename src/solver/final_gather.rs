@@ -14,9 +14,9 @@
 //! to the element, with the visibility of one ray from the element's
 //! centre. The form factor is the solver's own
 //! ([`super::formfactor::weighted_point_to_samples`]): each element is a cell
-//! sample, so a point within [`super::formfactor::NEAR_FIELD_RATIO`] cell
+//! sample, so a point within [`crate::solver::tuning::NEAR_FIELD_RATIO`] cell
 //! diameters gets the cell's quadrature and within
-//! [`super::formfactor::EXACT_RATIO`] the exact point-to-cell form factor, and a
+//! [`crate::solver::tuning::EXACT_RATIO`] the exact point-to-cell form factor, and a
 //! point on a polygon's edge or in a room's corner stays finite. The rays
 //! are the solver's: shaft culling between the point and each polygon
 //! ([`Visibility::box_shaft_candidates`]), the BVH where the shaft holds
@@ -34,7 +34,7 @@
 
 use super::distribution::Directional;
 use super::formfactor::{weighted_point_to_samples, ShooterSample};
-use super::{LINEAR_CANDIDATES, SHAFT_MIN_VERTICES};
+use super::tuning::{LINEAR_CANDIDATES, SHAFT_MIN_VERTICES};
 use crate::color::Rgb;
 use crate::mesh::{area_centroid, Mesh};
 use crate::scene::{PolygonId, Scene};
@@ -74,7 +74,7 @@ impl<'a> FinalGather<'a> {
     /// Prepares the gather over `mesh` (built from `scene`, refined or not)
     /// with `radiosity` one value per mesh vertex (the solver's solution,
     /// in the scene's radiosity units). `near_field` as
-    /// [`super::SolverOptions::near_field`].
+    /// [`super::Approximations::near_field`].
     pub fn new(
         scene: &Scene,
         mesh: &Mesh,

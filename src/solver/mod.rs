@@ -14,7 +14,7 @@
 //! Δb_i  = 0
 //! ```
 //!
-//! **Overshooting** ([`SolverOptions::overshoot`], on by default; Feda and
+//! **Overshooting** ([`Approximations::overshoot`], on by default; Feda and
 //! Purgathofer 1992, the over-relaxation of Gortler, Cohen and Slusallek's
 //! Southwell view of progressive refinement): each point of a shooter
 //! also sends the light it expects to receive later (`Expectation`:
@@ -36,23 +36,23 @@
 //!
 //! A sky (`--sky`, [`crate::scene::Scene::add_sky`]) is an enclosure of
 //! emitting facets that reflect nothing: each shoots like any emitter, from
-//! its own grid of [`formfactor::SKY_FACET_SAMPLES`] points, and its unshot
+//! its own grid of [`crate::solver::tuning::SKY_FACET_SAMPLES`] points, and its unshot
 //! power counts as the light it can bring to the scene, not its own (see
 //! [`Progressive::unshot_power`]).
 //!
-//! **Clusters** ([`cluster`], on unless [`SolverOptions::clustering`] is
+//! **Clusters** ([`cluster`], on unless [`Approximations::clusters`] is
 //! off): nearby small polygons form clusters, and a step shoots from the
 //! *cluster* with the most unshot power, all its members at once, from
 //! strata of their samples (a tessellated sphere's thousand triangles in
 //! one step rather than a thousand). Emitters always shoot alone from
 //! their own samples; any other polygon whose step carries less than
-//! [`FULL_STRATA_SHARE`] of the initial power shoots through strata too,
-//! fewer of them the weaker its light (see [`FULL_STRATA_SHARE`]).
+//! [`FULL_STRATA_SHARE`](crate::solver::tuning::FULL_STRATA_SHARE) of the initial power shoots through strata too,
+//! fewer of them the weaker its light (see [`FULL_STRATA_SHARE`](crate::solver::tuning::FULL_STRATA_SHARE)).
 //! Shadow-ray candidates are culled by the same groups in both modes, so
 //! a tessellated object beside a thin shaft costs one box test.
 //!
 //! **Hierarchical receivers** ([`receivers`], with clusters, unless
-//! [`SolverOptions::receiver_interpolation`] is off): a step of reflected
+//! [`Approximations::receiver_interpolation`] is off): a step of reflected
 //! light evaluates large receiving grids at every fourth row and column
 //! and at a check vertex per coarse cell, and interpolates the cell's
 //! other vertices when the check shows the interpolation holds.
@@ -62,7 +62,7 @@
 //! stratum, to its middle, for all its vertices, where no vertex is near
 //! the sample's cell.
 //!
-//! **Sky probes** ([`probes`], with the same switch): a receiving
+//! **Sky probes** ([`accel::probes`], with the same switch): a receiving
 //! vertex asks a few of a sky facet's directions first and, when they
 //! agree, takes their answer for all of them.
 //!
@@ -74,20 +74,34 @@
 //! processed in parallel; each vertex's sum is independent and the
 //! per-polygon sums run in a fixed order, so the result is bit-identical
 //! whatever the thread count.
+//!
+//! Drivers see a solve through [`Method`], built by [`build`] from the
+//! options: progressive shooting is one method, the hemicube another
+//! ([`methods`]).
 
 pub mod accel;
 mod ambient;
+mod approximations;
 pub mod checkpoint;
 pub mod final_gather;
-pub mod hemicube;
 pub mod kernel;
+pub mod method;
+pub mod methods;
 mod setup;
 pub mod step;
+pub mod tuning;
 mod unshot;
 
-use accel::{cluster, facets, far_shooters, probes, receivers, subcells};
+pub use method::{build, Method};
+pub use methods::hemicube;
+
+use crate::solver::tuning::{
+    DEFAULT_SETTLE, DEFAULT_SHOOTER_SAMPLES, DEFAULT_THRESHOLD, SHAFT_MIN_VERTICES, TILE_VERTICES,
+};
+use accel::{cluster, facets, far_shooters, receivers, subcells};
 pub use ambient::first_look;
 use ambient::{ambient_term, sky_power_weights};
+pub use approximations::{Approximations, Heuristic};
 use kernel::{cell_integrals, distribution, formfactor};
 pub use step::StepPhase;
 use step::Underway;
@@ -106,86 +120,9 @@ use receivers::CoarseGrid;
 use subcells::SubCells;
 use unshot::{Shot, UnshotField};
 
-/// Receiver vertices are grouped in runs of this many consecutive vertices
-/// of one polygon (a stretch of a grid row) for shaft culling: a shaft to
-/// a whole wall holds most of a room, one to a short run is thin and often
-/// clear. Sixteen keeps the shaft work per step well below the ray work it
-/// saves.
-pub const TILE_VERTICES: u32 = 16;
-
-/// Shooter samples are grouped in runs of this many (a stretch of their
-/// grid) for shaft culling, for the same reason as [`TILE_VERTICES`].
-pub const SHOOTER_GROUP: usize = 8;
-
-/// A receiver polygon with fewer element vertices than this tests its rays
-/// against the BVH rather than building a shaft to the shooter: a shaft
-/// query walks the BVH much as a ray does, and a small facet (a triangle
-/// of a tessellated sphere) casts too few rays to pay for it. Same result
-/// bits either way.
-pub const SHAFT_MIN_VERTICES: u32 = 8;
-
-/// A receiver whose shaft to the shooter holds more polygons than this
-/// skips the thin shafts and tests its rays against the BVH: narrowing a
-/// long list costs a box test per polygon per tile and sample group, and
-/// what remains of it is still too long to test one by one. Same result
-/// bits either way.
-pub const REFINE_MAX: usize = 256;
-
-/// An emitter whose unshot power is at least this share of the power it
-/// emits has not shot its light yet, and shoots before any reflector
-/// (`Progressive::choose_pending_emitter`). Once shot, what it holds is
-/// the light it reflects, far less in any ordinary scene.
-pub const PENDING_EMISSION: f64 = 0.5;
-
-/// A receiver whose shaft holds at most this many polygons tests its rays
-/// against them one by one; more, and the BVH is faster.
-pub const LINEAR_CANDIDATES: usize = 8;
-
-/// A clustered step that shoots at least this fraction of the initial
-/// unshot power shoots from as many strata as the shooter sample cap; a
-/// weaker one from fewer, by the square root of its share of this, at
-/// least [`MIN_STRATA`]: a stratum's one ray decides the visibility of its
-/// whole power, so the weaker the light the coarser its strata may be (the
-/// power oracle of Hanrahan, Salzman and Aupperle's BF refinement). At
-/// 1 % the two spheres of 32 segments in the Cornell box solve in 18 s
-/// rather than 29 s, with the picture 0.05 % from the unclustered solve;
-/// at 5 %, 17 s and 0.1 %.
-pub const FULL_STRATA_SHARE: f64 = 0.01;
-
-/// A stratum a receiving vertex would descend into (nearer than
-/// [`cluster::STRATUM_NEAR_RATIO`] diameters) is taken as one term when
-/// the bound on what it brings ([`cluster::Stratum::bound_at`], times the
-/// receiver's reflectance) fits in this share of what the vertex holds,
-/// the bounds of all strata so taken in a step summed (after Hanrahan,
-/// Salzman and Aupperle's BF refinement: a link is refined only when what
-/// it carries matters). The term is the far term, held to the bound.
-/// Measured (`docs/performance.md`, Weak strata): 0.3 % takes 15 to 19 %
-/// fewer rays on the halls and spheres and moves their pictures' distance
-/// from the original algorithm by 0.01 %; the closed-box energy balance
-/// moves from −0.43 % to −0.48 % (a lumped term misses what its stratum
-/// sends from behind the centroid's side of the receiver's plane), and at
-/// 1 % to −0.59 %. A receiver inside the stratum's bounding sphere never
-/// takes it as one term: there the far term is furthest off (a facet
-/// touching the floor), always the same way, and a solve of many weak
-/// steps (overshooting makes them) added it up to 3.2 % at a sphere's
-/// contact, converged, against `--no-clustering` (1.1 % since).
-pub const WEAK_STRATUM_SHARE: f64 = 3e-3;
-
-/// The fewest strata a clustered step shoots from (unless its cells are
-/// fewer).
-pub const MIN_STRATA: usize = 8;
-
 /// Shared-ray keys per stratum node ([`facets::Memo`]): one per normal
 /// bin a far term may cast from, and one for the node's representative.
 const RAY_SLOTS: u32 = 7;
-
-/// Vertices of one polygon a worker takes at once in a gather pass
-/// ([`par_runs`]): a small facet's three or four.
-const PAR_RUN: usize = 4;
-
-/// Vertices from which the check charges of a gather
-/// ([`gather_passes`]) are made in parallel.
-const PARALLEL_CHARGES: usize = 8_192;
 
 /// The shared-ray key slot of a ray from the node's representative.
 const REPRESENTATIVE_SLOT: u32 = RAY_SLOTS - 1;
@@ -193,16 +130,6 @@ const REPRESENTATIVE_SLOT: u32 = RAY_SLOTS - 1;
 /// Not a shared-ray slot: a ray the vertex asks alone, by the full
 /// search (from a point of a near cell other than its sample).
 const OWN_RAY_SLOT: u32 = u32::MAX;
-
-/// The share of the ambient term ([`Progressive::ambient`]) times its
-/// reflectance that a point may expect to receive later, and so send ahead
-/// when it shoots ([`SolverOptions::overshoot`], [`Expectation`]). The
-/// ambient term counts every bounce still to come as if spread evenly;
-/// measured as the only expectation on the 15-, 30- and 60-table halls and
-/// the 32-segment spheres (`docs/performance.md`), half of it took the
-/// fewest rays (0.35 and 0.65 within a few per cent, 1 and 2 10 to 30 %
-/// more, some steps sending light back).
-const OVERSHOOT_SHARE: f64 = 0.5;
 
 /// What a step expects each point to receive later (overshooting, [`Shot`]):
 /// a point that has received `r` so far expects `min(gain · r, ρ ·
@@ -218,7 +145,7 @@ const OVERSHOOT_SHARE: f64 = 0.5;
 struct Expectation {
     /// `R · U / S` (see above), `>= 0`.
     gain: f64,
-    /// [`OVERSHOOT_SHARE`] times the ambient term, clamped at 0 per
+    /// [`OVERSHOOT_SHARE`](crate::solver::tuning::OVERSHOOT_SHARE) times the ambient term, clamped at 0 per
     /// channel, in the scene's emission units.
     ambient: Rgb,
 }
@@ -230,33 +157,6 @@ impl Expectation {
         ambient: Rgb::BLACK,
     };
 }
-
-/// Default fraction of the initial unshot power at which solving stops.
-pub const DEFAULT_THRESHOLD: f64 = 1e-3;
-
-/// Default settling tolerance ([`SolverOptions::settle`]): past the
-/// threshold, a point still holding more than 2 % of its radiosity to
-/// send is shot. The error this leaves in a pocket is about half of it:
-/// on the spheres of 32 segments, against the clustered solve at 10⁻⁶,
-/// worst polygon 1.05 %, against 0.60 % at 1 % and 2.2 % at 4 %; against
-/// the brute-force solve at 10⁻⁶, seven facets 2.0 to 2.4 % off
-/// (`docs/accuracy.md`, "Settling").
-pub const DEFAULT_SETTLE: f64 = 0.02;
-
-/// Points darker than this fraction of the mean radiosity over the
-/// reflecting area count as this bright for settling
-/// ([`SolverOptions::settle`]): a point in a contact shadow holding
-/// light of no consequence does not keep the solve going.
-pub const SETTLE_FLOOR: f64 = 0.01;
-
-/// Default cap on shooter sample points (see [`ShooterSamples::AtMost`]).
-/// With the near field the unoccluded form factors of unit squares (exact
-/// 0.19982 parallel, 0.20004 perpendicular) are within 0.06 % at 16, 64 or
-/// 256 points; what the count buys is visibility: each point casts one
-/// shadow ray, so penumbrae are sampled by as many rays. 64 resolves a
-/// room's shadows without visible banding and keeps a step on a
-/// 14,000-vertex mesh under a million rays; 256 quadruples the rays.
-pub const DEFAULT_SHOOTER_SAMPLES: u32 = 64;
 
 /// How form factors are estimated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -303,7 +203,7 @@ pub struct SolverOptions {
     /// Settling tolerance, in `[0, 1)`: once the unshot power is below the
     /// threshold, go on shooting while some point of a reflecting polygon
     /// still has more than this fraction of its radiosity to send (points
-    /// darker than [`SETTLE_FLOOR`] of the mean count as that bright),
+    /// darker than [`SETTLE_FLOOR`](crate::solver::tuning::SETTLE_FLOOR) of the mean count as that bright),
     /// from the cluster holding the most such light. A pocket (the gap
     /// under a lamp, a sphere's underside over the floor) holds little
     /// power but trades it back and forth; the threshold alone leaves it
@@ -311,26 +211,11 @@ pub struct SolverOptions {
     pub settle: f64,
     /// Stop after this many steps at most.
     pub max_steps: Option<u64>,
-    /// Use the exact point-to-cell form factor for receivers close to a
-    /// grid sample (see [`formfactor`]); off gives the plain disc sum.
-    pub near_field: bool,
-    /// Cull shadow rays with shafts between shooter and receiver (same
-    /// result bits; off tests every ray against the whole scene's BVH).
-    pub shaft_culling: bool,
+    /// Which heuristics the solve uses ([`Approximations`]: all by
+    /// default; [`Approximations::EXACT`] is the brute-force twin).
+    pub approximations: Approximations,
     /// Where unshot radiosity is kept.
     pub unshot: UnshotScheme,
-    /// Let nearby small polygons shoot together ([`cluster`]); off, every
-    /// polygon shoots alone (the brute-force twin). Only the Wallace
-    /// estimate on a grid ([`ShooterSamples::AtMost`]) clusters: the
-    /// other settings exist to reproduce the original algorithm.
-    pub clustering: bool,
-    /// Let a clustered step interpolate receiving grids from their coarse
-    /// vertices where [`receivers::accept`] allows, and take a near
-    /// stratum whose light is weak at a vertex as one term
-    /// ([`WEAK_STRATUM_SHARE`]); off, every receiving vertex is evaluated
-    /// exactly, every near stratum descended into (the twin it is
-    /// compared with).
-    pub receiver_interpolation: bool,
     /// Pixels across a hemicube's top face, for
     /// [`FormFactorMethod::Hemicube`] (ignored by the other methods).
     pub hemicube_res: hemicube::HemicubeRes,
@@ -339,13 +224,6 @@ pub struct SolverOptions {
     /// The finished step is bit-identical to one in a piece; `None` (the
     /// default) runs every step in one piece.
     pub part_budget: Option<std::time::Duration>,
-    /// Overshoot (Feda and Purgathofer 1992): a step also sends out the
-    /// light each point of its shooters is expected to receive later
-    /// (`Expectation`), leaving their unshot radiosity negative until
-    /// that light arrives; what the shrinking expectation no longer covers
-    /// is shot as negative light. Fewer steps to the same residual; off,
-    /// unshot radiosity never goes below zero (the original algorithm).
-    pub overshoot: bool,
 }
 
 /// Where unshot radiosity is kept between shooting steps.
@@ -371,13 +249,9 @@ impl Default for SolverOptions {
             threshold: DEFAULT_THRESHOLD,
             settle: DEFAULT_SETTLE,
             max_steps: None,
-            near_field: true,
-            shaft_culling: true,
+            approximations: Approximations::DEFAULT,
             unshot: UnshotScheme::Vertex,
-            clustering: true,
-            receiver_interpolation: true,
             hemicube_res: hemicube::HemicubeRes::default(),
-            overshoot: true,
             part_budget: None,
         }
     }
@@ -397,7 +271,7 @@ pub struct StepReport {
     /// The power it shot: `A_i · mean(Δb_i)` with the overshoot, in
     /// radiosity × area units (for a sky facet, weighted as
     /// [`Progressive::unshot_power`] says); negative for a step that shot
-    /// negative light ([`SolverOptions::overshoot`]).
+    /// negative light ([`Approximations::overshoot`]).
     pub shot_power: f64,
     /// Unshot power left after the step, as a fraction of the initial
     /// (for a part of a step not finished, what the last finished step
@@ -500,7 +374,7 @@ pub enum StopReason {
 ///
 /// Invariants (checked by [`Progressive::validate`]): every radiosity is
 /// finite and non-negative, every unshot value finite (negative only with
-/// [`SolverOptions::overshoot`]); one radiosity per mesh vertex
+/// [`Approximations::overshoot`]); one radiosity per mesh vertex
 /// and one unshot value per polygon or per mesh vertex, by
 /// [`SolverOptions::unshot`].
 pub struct Progressive<'a> {
@@ -549,7 +423,7 @@ pub struct Progressive<'a> {
     small: Vec<bool>,
     /// The small facets whose vertices share their shadow rays.
     facets: Facets,
-    /// Per polygon: a sky facet's probe samples ([`probes`]), empty for
+    /// Per polygon: a sky facet's probe samples ([`accel::probes`]), empty for
     /// every other polygon and when probing is off.
     probes: Vec<Vec<u32>>,
     /// Per polygon: where it is far enough to be probed when it shoots
@@ -572,13 +446,13 @@ pub struct Progressive<'a> {
     tile_candidates: Vec<Vec<u32>>,
     /// Scratch: the shooter's sample positions (polygon shooter) or its
     /// strata's bounds, two corners a stratum (cluster shooter), in groups
-    /// of [`SHOOTER_GROUP`] samples for tile shafts.
+    /// of [`SHOOTER_GROUP`](crate::solver::tuning::SHOOTER_GROUP) samples for tile shafts.
     group_points: Vec<glam::Vec3>,
     /// The clusters that shoot together (every polygon alone without
     /// clustering).
     clusters: Clusters,
     /// True when the solve shoots by clusters and strata
-    /// ([`SolverOptions::clustering`] with a grid of samples).
+    /// ([`Approximations::clusters`] with a grid of samples).
     clustered: bool,
     /// Scratch for a cluster step: the shooting cells, their samples and
     /// strata.
@@ -624,15 +498,15 @@ pub struct Progressive<'a> {
     /// The unshot fraction after the last finished step (1 before the
     /// first), which a part of a step not finished reports.
     last_fraction: f64,
-    /// The hemicube's tables and scratch, with
-    /// [`FormFactorMethod::Hemicube`].
-    hemicube: Option<hemicube::Shooting>,
 }
 
 impl<'a> Progressive<'a> {
     /// Starts a solve: every vertex at `b = e`, every polygon's unshot
     /// radiosity at `Δb = e`. `mesh` and `visibility` must be built from
-    /// `scene`.
+    /// `scene`. It shoots by rays (Wallace's or the centre estimate);
+    /// with [`FormFactorMethod::Hemicube`] its sample set is the
+    /// hemicube's but it still shoots by rays: [`build`] makes the
+    /// hemicube method ([`hemicube::HemicubeMethod`]), which steps it.
     pub fn new(
         scene: &Scene,
         mesh: impl Into<MeshRef<'a>>,
@@ -670,7 +544,8 @@ impl<'a> Progressive<'a> {
             .map(|p| emission[p.index()])
             .collect();
         let covered = crate::mesh::covered::covered_vertices(scene, mesh);
-        let subcells = SubCells::build_all(scene, mesh, &samples, options.near_field);
+        let subcells =
+            SubCells::build_all(scene, mesh, &samples, options.approximations.near_field);
         let unshot = UnshotField::new(
             options.unshot,
             mesh,
@@ -684,7 +559,7 @@ impl<'a> Progressive<'a> {
         let culling_groups = Clusters::build(scene, mesh, &emission);
         let clustered = matches!(
             (
-                options.clustering,
+                options.approximations.clusters,
                 options.form_factor,
                 options.shooter_samples
             ),
@@ -696,17 +571,18 @@ impl<'a> Progressive<'a> {
             Clusters::singletons(scene)
         };
         let (tiles, tile_of) = setup::tiles(mesh);
-        // Shared facet rays and sky probes go with the other receiver
-        // approximations.
-        let approximate = clustered && options.receiver_interpolation;
+        // The receiver heuristics act only in a solve that clusters; the
+        // crowded-cell guard only where receivers are interpolated.
+        let approx = &options.approximations;
         let coarse: Vec<Option<CoarseGrid>> = mesh
             .polygons
             .iter()
             .map(|pm| CoarseGrid::detect(mesh, pm))
             .collect();
-        let crowded = setup::crowded(mesh, visibility, &coarse, approximate);
-        let sky_probes = setup::sky_probes(mesh, &samples, approximate);
-        let far_shooters = setup::far_shooters(mesh, &samples, approximate);
+        let guarded = clustered && approx.receiver_interpolation && approx.crowded_cells;
+        let crowded = setup::crowded(mesh, visibility, &coarse, guarded);
+        let sky_probes = setup::sky_probes(mesh, &samples, clustered && approx.sky_probes);
+        let far_shooters = setup::far_shooters(mesh, &samples, clustered && approx.far_shooters);
         let mut solver = Progressive {
             mesh: mesh_ref.clone(),
             visibility,
@@ -745,7 +621,7 @@ impl<'a> Progressive<'a> {
             coarse,
             crowded,
             coarse_delta: vec![Rgb::BLACK; mesh.vertex_count()],
-            facets: Facets::new(mesh, approximate),
+            facets: Facets::new(mesh, clustered && approx.facet_rays),
             probes: sky_probes,
             far_shooters,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
@@ -760,8 +636,6 @@ impl<'a> Progressive<'a> {
             underway: None,
             fault: None,
             last_fraction: 1.0,
-            hemicube: (options.form_factor == FormFactorMethod::Hemicube)
-                .then(|| hemicube::Shooting::new(scene, mesh, options.hemicube_res)),
         };
         solver.initial_unshot_power = solver.unshot_power();
         solver
@@ -822,7 +696,7 @@ impl<'a> Progressive<'a> {
     /// [`Progressive::ambient`]), at least 0 per channel, written into
     /// `out` (resized to the vertex count). The ambient term is negative
     /// while overshooting has sent more light ahead than is left to shoot
-    /// ([`SolverOptions::overshoot`]). The solution itself is not changed.
+    /// ([`Approximations::overshoot`]). The solution itself is not changed.
     pub fn radiosity_with_ambient(&self, out: &mut Vec<Rgb>) {
         let ambient = self.ambient();
         out.clear();
@@ -838,7 +712,7 @@ impl<'a> Progressive<'a> {
     /// sum over vertices of `mean(|Δb_l|) · vertex area`, per channel), in
     /// radiosity × area units: how far the solution is from converged,
     /// counting light still to be sent and light sent ahead by overshooting
-    /// ([`SolverOptions::overshoot`]) alike. A sky's facets count together
+    /// ([`Approximations::overshoot`]) alike. A sky's facets count together
     /// as at most `S · A_scene` (its radiosity times the area of every
     /// other polygon), the most it can bring to the scene, not its own far
     /// larger power (see `sky_power_weights`).
@@ -944,32 +818,6 @@ impl<'a> Progressive<'a> {
         &self.facets
     }
 
-    /// This solver with every receiving vertex asking its own shadow rays
-    /// (no [`facets`] sharing), all else alike: the twin the sharing is
-    /// tested against.
-    #[cfg(test)]
-    pub(crate) fn without_shared_rays(mut self) -> Self {
-        self.facets = Facets::default();
-        self
-    }
-
-    /// This solver with every sky direction asked of every vertex (no
-    /// [`probes`]), all else alike: the twin probing is tested against.
-    #[cfg(test)]
-    pub(crate) fn without_sky_probes(mut self) -> Self {
-        self.probes.iter_mut().for_each(Vec::clear);
-        self
-    }
-
-    /// This solver with every sample of a far shooter asked of every
-    /// vertex (no [`far_shooters`] probes), all else alike: the twin
-    /// probing is tested against.
-    #[cfg(test)]
-    pub(crate) fn without_far_probes(mut self) -> Self {
-        self.far_shooters.iter_mut().for_each(|f| *f = None);
-        self
-    }
-
     /// The clusters the solve shoots from (each polygon alone without
     /// clustering).
     pub fn clusters(&self) -> &Clusters {
@@ -1013,7 +861,7 @@ impl<'a> Progressive<'a> {
             })
             .collect();
         let visibility = self.visibility;
-        let near_field = self.options.near_field;
+        let near_field = self.options.approximations.near_field;
         let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
             .into_par_iter()
             .with_min_len(64)

@@ -75,7 +75,7 @@ pub(super) fn sky_probes(
         .zip(samples)
         .map(|(pm, own)| {
             if pm.sky && approximate {
-                probes::spread(own, probes::SKY_PROBES)
+                probes::spread(own, crate::solver::tuning::SKY_PROBES)
             } else {
                 Vec::new()
             }

@@ -17,6 +17,7 @@ use crate::color::Rgb;
 use crate::mesh::covered::covered_vertices;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, PolygonMesh};
+use crate::solver::tuning::MAX_SPEND_SCALE;
 use rayon::prelude::*;
 
 /// Unshot radiosity `Δb` (in the scene's emission units) and how it is laid
@@ -604,13 +605,6 @@ fn polygon_received(pm: &PolygonMesh, mean_weight: &[f64], received: impl Fn(usi
     }
     sum
 }
-
-/// The largest factor by which [`send_what_is_spent`] scales a channel
-/// of a shooter's samples (or its inverse, the smallest). Beyond it the
-/// samples' reading is no estimate of the polygon's power (a field of
-/// both signs summing to nearly nothing, under overshooting), and is
-/// left as it is.
-const MAX_SPEND_SCALE: f64 = 4.0;
 
 /// Scales, per channel, the radiosity `values` that a shooter's `samples`
 /// send (one each, in the samples' order) so that they send `spent`

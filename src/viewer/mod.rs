@@ -7,11 +7,11 @@
 //! with the same [`Rasterizer`] and tone mapping the batch command uses, so
 //! what `w` writes is exactly what is on screen. The window never waits
 //! for a step, and a long step comes in parts of about
-//! [`WINDOW_PART_BUDGET`](crate::solver::step::parts::WINDOW_PART_BUDGET) of
+//! [`WINDOW_PART_BUDGET`](crate::solver::tuning::WINDOW_PART_BUDGET) of
 //! solving, each published with the receivers it finished
 //! ([`crate::solver::step::parts`]), so the picture moves while a large scene's
 //! step runs; quitting cancels the part under way
-//! ([`Progressive::step_cancellable`](crate::solver::Progressive::step_cancellable)).
+//! ([`Method::step_cancellable`](crate::solver::Method::step_cancellable)).
 //!
 //! With adaptive subdivision the worker refines the mesh once a solve
 //! converges and solves again on the refined mesh; meanwhile the window
@@ -306,7 +306,7 @@ fn solve_in_background<'p>(
     // Long steps come in parts, so the picture moves at least every
     // tenth of a second or so of solving.
     let mut options = SessionOptions::for_run(config, true);
-    options.solver.part_budget = Some(crate::solver::step::parts::WINDOW_PART_BUDGET);
+    options.solver.part_budget = Some(crate::solver::tuning::WINDOW_PART_BUDGET);
     let mut session = Session::from_prepared(prepared, options);
     let levels = session.max_refinements();
     if let Ok(mut p) = progress.lock() {

@@ -8,7 +8,7 @@ use glam::Vec3;
 use radiosity::color::Rgb;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::{Camera, CameraSource, Material, MaterialId, Polygon, Scene, SourcePos};
-use radiosity::solver::{Progressive, SolverOptions};
+use radiosity::solver::SolverOptions;
 use radiosity::visibility::Visibility;
 
 /// A polygon of material `material` through `vertices` (scene units,
@@ -166,26 +166,30 @@ pub struct Solved {
     pub radiosity: Vec<Rgb>,
     /// Shooting steps taken.
     pub steps: u64,
+    /// Shadow rays cast.
+    pub rays: u64,
     /// Unshot power before the first step (the emitted power).
     pub initial_power: f64,
     /// Net unshot power left at the end.
     pub unshot_power: f64,
 }
 
-/// Solves `s` on `mesh` until the solver is done (or a step finds nothing
-/// to shoot), checking the solver's invariants at the end.
+/// Solves `s` on `mesh` with the method `options` choose
+/// ([`radiosity::solver::build`]) until it is done (or a step finds
+/// nothing to do), checking the method's invariants at the end.
 pub fn solve_on(s: &Scene, mesh: Mesh, options: SolverOptions) -> Solved {
     let vis = Visibility::new(s);
-    let mut solver = Progressive::new(s, &mesh, &vis, options);
+    let mut solver = radiosity::solver::build(s, &mesh, &vis, options);
     while !solver.is_done() && solver.step().is_some() {}
     solver.validate().expect("the solver's invariants hold");
-    let (radiosity, steps) = (solver.radiosity().to_vec(), solver.steps());
+    let (radiosity, steps, rays) = (solver.radiosity().to_vec(), solver.steps(), solver.rays());
     let (initial_power, unshot_power) = (solver.initial_unshot_power(), solver.net_unshot_power());
     drop(solver);
     Solved {
         mesh,
         radiosity,
         steps,
+        rays,
         initial_power,
         unshot_power,
     }

@@ -23,7 +23,7 @@ fn config(args: &[&str]) -> RunConfig {
 fn no_arguments_give_the_library_defaults_and_the_window() {
     let i = invocation(&[]).unwrap();
     // Also keeps the literal default of --shooter-samples equal to
-    // solver::DEFAULT_SHOOTER_SAMPLES.
+    // crate::solver::tuning::DEFAULT_SHOOTER_SAMPLES.
     assert_eq!(
         i.config,
         RunConfig {
@@ -109,13 +109,20 @@ fn every_option_reaches_the_config() {
             threshold: 0.01,
             settle: 0.05,
             max_steps: Some(7),
-            near_field: false,
-            shaft_culling: false,
+            approximations: crate::solver::Approximations::DEFAULT.without(&[
+                Heuristic::NearField,
+                Heuristic::ShaftCulling,
+                Heuristic::Clusters,
+                Heuristic::ReceiverInterpolation,
+                Heuristic::WeakStrata,
+                Heuristic::CrowdedCells,
+                Heuristic::FacetRays,
+                Heuristic::SkyProbes,
+                Heuristic::FarShooters,
+                Heuristic::Overshoot,
+            ]),
             unshot: UnshotScheme::Vertex,
-            clustering: false,
-            receiver_interpolation: false,
             hemicube_res: crate::solver::hemicube::HemicubeRes::default(),
-            overshoot: false,
             part_budget: None,
         }
     );

@@ -18,7 +18,7 @@
 //! framing are the scene's own), the picture, the mesh exports and
 //! adaptive refinement. Each is meshed as one element (its radiosity is
 //! its emission, it receives nothing), and it shoots from a grid of its own
-//! (see `solver::kernel::formfactor::SKY_FACET_SAMPLES`).
+//! (see `crate::solver::tuning::SKY_FACET_SAMPLES`).
 
 use crate::color::Rgb;
 use crate::scene::{Material, MaterialId, Polygon, PolygonError, Scene, SourcePos, Surface};

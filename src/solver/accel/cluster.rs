@@ -25,7 +25,7 @@
 //! power. For each receiving vertex, each stratum is taken as one far
 //! term when [`Stratum::seen_from`] proves it safe: every cell in front of
 //! the receiver's plane, the box's centre by [`PLANE_DEPTH_RATIO`] of
-//! its half depth along the receiver's normal ([`TOP_DEPTH_RATIO`] for a
+//! its half depth along the receiver's normal ([`TOP_DEPTH_RATIO`](crate::solver::tuning::TOP_DEPTH_RATIO) for a
 //! node above the cut, which a weak step, starting at the tree's root,
 //! may take whole), and facing the receiver
 //! (its normal cone widened by the angle its bounding sphere subtends),
@@ -47,80 +47,10 @@
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::{PolygonId, Scene};
+use crate::solver::tuning::{
+    CLUSTER_EXTENT, PLANE_DEPTH_RATIO, RESTING_NEAR_FACTOR, RESTING_TOLERANCE, STRATUM_NEAR_RATIO,
+};
 use glam::Vec3;
-
-/// A cluster is at most this fraction of the scene's extent (the diagonal
-/// of its bounds) across. Larger clusters mean fewer steps but more
-/// receivers in their near field and fewer strata per object. Measured
-/// (solve seconds, two cores): the hall of 1,000 polygons took 25.6 s at a
-/// quarter and 30.9 s at a half; two spheres of 16 segments in the Cornell
-/// box 7.1 s at both, 10.9 s at an eighth; the picture within 0.07 % of
-/// the unclustered solve in every case.
-pub const CLUSTER_EXTENT: f32 = 0.25;
-
-/// A receiver within this many stratum diameters of a stratum's bounding
-/// box descends to the stratum's halves rather than taking one far term.
-/// One cluster's shot from a tiled unit square to a parallel and a
-/// perpendicular square (test `a_cluster_shot_matches_lambert`): worst
-/// vertex error 0.64 % of the peak at 1.5, 0.43 % at 2, 0.24 % at 3; the
-/// nearer, the fewer rays.
-pub const STRATUM_NEAR_RATIO: f32 = 2.0;
-
-/// A stratum is in front of a receiver's plane, for one far term, when
-/// its bounding box's centre lies at least this many of the box's half
-/// depths along the receiver's normal in front of it: the box lies in
-/// front, and the receiver's cosine varies over it by at most 1/this of
-/// its value at the centre either way, however wide the box is across the
-/// normal (a run of floor cells seen from the ceiling).
-///
-/// At 1.5 (the cosine within ±67 %) the floor under a sphere resting on
-/// it came out dark: there the receiver's cosine is small and varies
-/// much over a stratum of the sphere's lower rings, which the far term
-/// misses, and light goes back and forth between the two surfaces, each
-/// bounce bringing the error back. On the 32-segment spheres the facets
-/// at the contact were 2.15 % off the unclustered solve (2.40 %
-/// converged to 10⁻⁶); at 3 the worst polygon anywhere is 1.25 % (1.14 %
-/// converged), for 4 % more rays there and 1.3 % more on the 150-table
-/// hall. 2 and 2.5 left the contact as it was; 4 gave 0.73 % converged
-/// for 6 % more rays (`docs/accuracy.md`, "The plane test near a sphere's
-/// contact").
-pub const PLANE_DEPTH_RATIO: f32 = 3.0;
-
-/// [`PLANE_DEPTH_RATIO`] for a node above a weak step's cut of strata.
-/// A weak step (less power than a full one) starts at the strata tree's
-/// root and takes any node that passes the far test as one term, so its
-/// terms may be larger than any stratum a full step takes: half a ball
-/// resting on the floor rather than a patch of it. Overshooting makes
-/// most late steps weak, and their errors come back at every bounce in
-/// the gap under a ball.
-///
-/// Measured on the Cornell box with two spheres of 64 segments
-/// (`docs/accuracy.md`, "Nodes above a weak step's cut"). At 3, against
-/// the unclustered solve converged to 10⁻⁵, 8 facets of a ball's lowest
-/// rings were over 2 % too bright (worst 2.84 %); at 6, none (worst
-/// 1.63 %, and 1.06 % converged), for 0.6 to 1.0 % more rays on every
-/// hall and the spheres. Against the unclustered solve at the default
-/// threshold: 42 facets over 2 % at 3; at 4, 5, 6 and 8 the worst
-/// polygon 1.21, 1.08, 0.91 and 0.86 %. Asking 6 of every node of a
-/// weak step left 1.25 % for 7 % more rays, and of every node of every
-/// step 1.26 % for 9 % more: the nodes above the cut are the ones that
-/// need it. 8 costs twice the rays of 6 on the larger halls.
-pub const TOP_DEPTH_RATIO: f32 = 6.0;
-
-/// A stratum whose box rests on a receiver's plane (no part behind it,
-/// but too deep for [`PLANE_DEPTH_RATIO`]: a chair seen from the floor
-/// it stands on) is in front of it from this many times the near
-/// distance ([`STRATUM_NEAR_RATIO`] diameters). No cell is behind, so the
-/// far term's cosine at the power-weighted centroid is the cells' mean
-/// height over the plane, exactly; what the extra distance buys is the
-/// spread of their distances, which here weighs with heights from zero.
-/// Measured on the 30-table hall: 5.7 % fewer rays, the picture as far
-/// from the unclustered solve as without it (0.355 %).
-pub const RESTING_NEAR_FACTOR: f32 = 2.0;
-
-/// How far below the receiver's plane a resting box's bottom may reach,
-/// as a fraction of its half depth (rounding of a floor's height).
-const RESTING_TOLERANCE: f32 = 1e-3;
 
 /// A partition of the scene's polygons into clusters.
 ///
@@ -406,7 +336,7 @@ impl Stratum {
     }
 
     /// [`Stratum::seen_from`] with the plane test asking `depth_ratio`
-    /// half depths instead of [`PLANE_DEPTH_RATIO`] ([`TOP_DEPTH_RATIO`]
+    /// half depths instead of [`PLANE_DEPTH_RATIO`] ([`TOP_DEPTH_RATIO`](crate::solver::tuning::TOP_DEPTH_RATIO)
     /// above a weak step's cut).
     #[inline]
     pub fn seen_from_at(&self, x: Vec3, nx: Vec3, depth_ratio: f32) -> Seen {
@@ -720,6 +650,7 @@ fn mean_normal_of(narrow: Vec3, wide: glam::DVec3, weight: f64) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::tuning::TOP_DEPTH_RATIO;
 
     fn cell(power: f64) -> Cell {
         Cell {

@@ -8,7 +8,7 @@
 //! of about six facets: a step cast about six nearly identical rays from
 //! each shooter sample to each point (three per triangle), and on the
 //! 100,000-triangle sphere box those rays were most of the time. A facet
-//! at most [`SCALE_RATIO`] of the mesh's element size across (the longest
+//! at most [`FACET_SCALE_RATIO`] of the mesh's element size across (the longest
 //! element edge of the mesh, at most `lenmax`) is finer than the mesh
 //! was asked to resolve: one ray from each shooter sample to the facet's
 //! middle ([`Facets::point`]: the mean of its vertices' inset sample
@@ -22,12 +22,12 @@
 //! the middle's rays made such faces of the 15-table hall up to 28 %
 //! brighter than the reference.
 //!
-//! A sample nearer the facet than [`NEAR_RATIO`] of its diameter is
+//! A sample nearer the facet than [`FACET_NEAR_RATIO`] of its diameter is
 //! asked per vertex, as before: there the rays to the vertices part too
 //! widely for one to stand for the others (a chair leg where it meets the
 //! floor that shoots). So is a sample whose cell some vertex of the facet
 //! takes the exact point-to-cell form factor of
-//! ([`crate::solver::kernel::formfactor::EXACT_RATIO`]): such a vertex is close to a cell
+//! ([`crate::solver::tuning::EXACT_RATIO`]): such a vertex is close to a cell
 //! large beside it and takes much of its light from it, by one ray that
 //! must end at the vertex itself. Measured on the 64-segment spheres: the
 //! tiny facets around a sphere's pole, where it touches the floor, lie
@@ -43,22 +43,14 @@
 //! the runs depend on work stealing (on the 100,000-triangle box, 4
 //! steps cast 12,319,995 to 12,320,055 rays over runs with the same
 //! picture bytes). On with clusters and hierarchical receivers
-//! ([`crate::solver::SolverOptions::receiver_interpolation`]); `--exact-receivers`
+//! ([`crate::solver::Approximations::receiver_interpolation`]); `--exact-receivers`
 //! and `--no-clustering` ask every ray per vertex.
 
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
-use crate::solver::SHAFT_MIN_VERTICES;
+use crate::solver::tuning::{FACET_NEAR_RATIO, FACET_SCALE_RATIO, SHAFT_MIN_VERTICES};
 use crate::visibility::Visibility;
 use glam::Vec3;
-
-/// A shooter sample nearer a facet's middle than this many of the facet's
-/// diameters is asked per vertex rather than shared.
-pub const NEAR_RATIO: f32 = 4.0;
-
-/// A facet shares its rays when it is at most this fraction of the mesh's
-/// element size across (its longest element edge).
-pub const SCALE_RATIO: f32 = 0.5;
 
 /// Per polygon, the point its shared rays end at, when it is small enough
 /// to share them.
@@ -72,7 +64,7 @@ pub struct Facets {
 impl Facets {
     /// The facets of `mesh` that share rays: polygons with fewer than
     /// [`SHAFT_MIN_VERTICES`] element vertices and at most
-    /// [`SCALE_RATIO`] of the longest element edge across, none of them a
+    /// [`FACET_SCALE_RATIO`] of the longest element edge across, none of them a
     /// sky facet (it receives nothing). Empty (every polygon per vertex)
     /// when `on` is false.
     pub fn new(mesh: &Mesh, on: bool) -> Self {
@@ -87,7 +79,7 @@ impl Facets {
                 })
             })
             .fold(0.0f32, f32::max);
-        let largest = SCALE_RATIO * element_size;
+        let largest = FACET_SCALE_RATIO * element_size;
         let points = mesh
             .polygons
             .iter()
@@ -125,7 +117,7 @@ impl Facets {
     #[inline]
     pub fn point(&self, j: usize, from: Vec3, exact_r2: f32) -> Option<Vec3> {
         let (middle, diameter) = self.points.get(j).copied().flatten()?;
-        let reach = (NEAR_RATIO * diameter).max(exact_r2.sqrt() + diameter);
+        let reach = (FACET_NEAR_RATIO * diameter).max(exact_r2.sqrt() + diameter);
         (from.distance_squared(middle) > reach * reach).then_some(middle)
     }
 
@@ -245,7 +237,7 @@ mod tests {
         );
         assert!(facets.point(0, far, 0.0).is_none());
         assert!(facets.point(2, far, 0.0).is_none());
-        // Within NEAR_RATIO diameters: per vertex.
+        // Within FACET_NEAR_RATIO diameters: per vertex.
         assert!(facets.point(1, Vec3::new(1.1, 0.5, 1.0), 0.0).is_none());
         // A cell large enough that the facet lies within its exact zone:
         // per vertex, though the cell's sample is far.

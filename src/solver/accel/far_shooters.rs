@@ -37,26 +37,8 @@
 
 use super::probes;
 use crate::solver::kernel::formfactor::ShooterSample;
+use crate::solver::tuning::{FAR_PROBES, FAR_SHOOTER_RATIO};
 use glam::Vec3;
-
-/// A receiving vertex at least this many shooter diameters from the
-/// shooter's middle probes it first ([`FarShooter`]). At 12, the probes'
-/// rays are at most a twelfth of the height of a table top (0.75 units)
-/// apart where they pass its edge: about 0.06 units, a quarter of an
-/// element of the halls' 0.25 units.
-///
-/// At 6 the probes missed parts of chairs: against the unclustered solve,
-/// both converged to 10⁻⁵, eight chair-leg faces of the 60-table hall were
-/// 2.0 to 2.5 % too bright (0.69 % with no probes at all); at 12 none is
-/// over 2 % (worst 1.12 % at the default threshold), for 4 % more rays
-/// there and 1.5 % more time on the 150-table hall
-/// (`docs/accuracy.md`, "Far lamps probed from twelve diameters").
-pub const FAR_SHOOTER_RATIO: f32 = 12.0;
-
-/// How many of a far shooter's samples a vertex asks first; all of them
-/// must face the vertex ([`probes::verdict`] with its
-/// [`probes::MIN_PROBES`]) and agree.
-pub const FAR_PROBES: usize = probes::MIN_PROBES;
 
 /// Where a shooter is far, and the samples that probe it there.
 ///

@@ -2,13 +2,13 @@
 //! the facet's directions, spread over it, and when they all agree (all
 //! open, all blocked) takes that answer for every direction of the facet.
 //!
-//! A sky facet shoots from [`crate::solver::kernel::formfactor::SKY_FACET_SAMPLES`]
+//! A sky facet shoots from [`crate::solver::tuning::SKY_FACET_SAMPLES`]
 //! directions so that a window's or an overhang's edge draws a smooth
 //! penumbra, and a step cast a ray along each of them from every
 //! receiving vertex that faces them: 125 rays per vertex per step on a
 //! real export under `--sky`. Yet most vertices see a facet's whole patch
 //! of sky, or none of it; only those near a shadow's edge see part. So a
-//! vertex first asks [`SKY_PROBES`] of the facet's directions, chosen
+//! vertex first asks [`SKY_PROBES`](crate::solver::tuning::SKY_PROBES) of the facet's directions, chosen
 //! once per facet to cover it evenly ([`spread`]); when every probe it
 //! faces agrees, and it faces at least [`MIN_PROBES`] of them, that is
 //! the visibility of the whole facet from it ([`verdict`]), and the form
@@ -24,14 +24,8 @@
 //! only on its own rays, so the bits do not depend on the thread count.
 
 use crate::solver::kernel::formfactor::ShooterSample;
+use crate::solver::tuning::MIN_PROBES;
 use glam::Vec3;
-
-/// How many of a sky facet's directions a receiving vertex asks first.
-pub const SKY_PROBES: usize = 16;
-
-/// A verdict needs at least this many probes in front of the receiver: a
-/// facet near its horizon is seen through too few to judge.
-pub const MIN_PROBES: usize = 4;
 
 /// `n` of `samples` spread evenly over them (indices, increasing):
 /// farthest-point sampling from the sample nearest their centroid, each
@@ -115,6 +109,7 @@ pub fn verdict(
 mod tests {
     use super::*;
     use crate::solver::formfactor::ShooterSample;
+    use crate::solver::tuning::SKY_PROBES;
 
     fn grid(n: usize) -> Vec<ShooterSample> {
         (0..n * n)

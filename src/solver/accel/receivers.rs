@@ -14,7 +14,7 @@
 //! vertices exactly first; then a cell whose corners predict its check
 //! vertex (bilinearly, in grid coordinates, as the elements are
 //! parametrised) within [`CHECK_TOLERANCE`] of the exact value, or within
-//! [`WEAK_SHARE`] of the radiosity the check vertex already holds, has its
+//! [`RECEIVER_WEAK_SHARE`] of the radiosity the check vertex already holds, has its
 //! other vertices interpolated; any other cell is evaluated exactly at
 //! every vertex ([`accept`]). An accepted cell is interpolated through
 //! all five of its exact values ([`interpolate`]): the corners' bilinear
@@ -22,7 +22,7 @@
 //! bilinear blend alone is low wherever the light is highest inside the
 //! cell, as on every wall of a closed room, and lost 0.5 % of a closed
 //! box's light. A cell near the shooter (closer to its
-//! bounds than [`NEAR_RATIO`] of the cell's diagonal) is always exact:
+//! bounds than [`RECEIVER_NEAR_RATIO`] of the cell's diagonal) is always exact:
 //! there the field bends within a cell in ways one check cannot see.
 //!
 //! The second rule is the power oracle of Hanrahan, Salzman and
@@ -46,39 +46,11 @@
 
 use crate::color::Rgb;
 use crate::mesh::{Mesh, PolygonMesh};
+use crate::solver::tuning::{
+    CHECK_TOLERANCE, CROWD_RATIO, RECEIVER_ERROR_BUDGET, RECEIVER_NEAR_RATIO, RECEIVER_STRIDE,
+    RECEIVER_WEAK_SHARE,
+};
 use glam::Vec3;
-
-/// Every this-many rows and columns of a receiving grid (and its last row
-/// and column) are evaluated exactly; the vertices between are
-/// interpolated where [`accept`] allows. With 4, a large wall evaluates
-/// about one vertex in eight (16 coarse vertices and a check per 25).
-pub const RECEIVER_STRIDE: u32 = 4;
-
-/// A cell is interpolated when its corners predict its check vertex to
-/// this fraction of the exact value ... Chosen with [`WEAK_SHARE`] on the
-/// 30-table hall and the 32-segment spheres against `--exact-receivers`:
-/// 2 % and 0.05 % gave pictures within 0.21 % and 0.09 %, 5 % and 0.2 %
-/// within 0.60 % and 0.20 % for little more speed.
-pub const CHECK_TOLERANCE: f64 = 0.02;
-
-/// ... or to this fraction of the radiosity the check vertex already holds,
-/// within [`ERROR_BUDGET`].
-pub const WEAK_SHARE: f64 = 0.001;
-
-/// The most interpolation error the weak rule of [`accept`] may leave at a
-/// check vertex over a whole solve, as a fraction of its radiosity.
-pub const ERROR_BUDGET: f64 = 0.005;
-
-/// A coarse cell is evaluated exactly at every vertex, in every step,
-/// when another polygon reaches into the space in front of it up to this
-/// many of its diagonals away ([`crowded_cells`]): a chair's legs on a
-/// floor cell, a lamp hung just under a ceiling. Such a polygon casts a
-/// shadow or closes a pocket smaller than the cell, which its five
-/// exact points may all miss: interpolated, the floor around a chair leg
-/// was bright where the leg hides it, the leg's foot 2.5 % too bright
-/// on the 30-table hall, and the ceiling above McGuire's lamp lit by
-/// light that cannot reach it, the lamp's back 2.8 % too bright.
-pub const CROWD_RATIO: f32 = 0.25;
 
 /// Per mesh vertex, true where it is the first corner of a crowded cell
 /// of a receiving grid ([`CROWD_RATIO`]); `crowds(polygon, corners,
@@ -105,10 +77,6 @@ pub fn crowded_cells(
     }
     crowded
 }
-
-/// A coarse cell nearer the shooter's bounds than this many of its
-/// diagonals is evaluated exactly ([`far_from`]).
-pub const NEAR_RATIO: f32 = 1.0;
 
 /// The regular grid of a polygon's mesh: its first `(nu + 1)(nv + 1)`
 /// vertices are the grid points `(a, b)`, `a` running fastest, as
@@ -293,8 +261,8 @@ impl CoarseGrid {
 /// blend of the corners must predict the check vertex
 ///
 /// - within [`CHECK_TOLERANCE`] of its exact value (free), or
-/// - within [`WEAK_SHARE`] of what it holds, with the error charged to the
-///   check vertex, whose charges may not exceed [`ERROR_BUDGET`] of what
+/// - within [`RECEIVER_WEAK_SHARE`] of what it holds, with the error charged to the
+///   check vertex, whose charges may not exceed [`RECEIVER_ERROR_BUDGET`] of what
 ///   it holds: however many weak steps are smoothed, the error they leave
 ///   at the check vertex stays within that budget.
 ///
@@ -312,7 +280,7 @@ pub fn accept(
         let err = (p - e).abs();
         if err <= CHECK_TOLERANCE * e.max(p) {
             Some(0.0)
-        } else if err <= WEAK_SHARE * h && s + err <= ERROR_BUDGET * h {
+        } else if err <= RECEIVER_WEAK_SHARE * h && s + err <= RECEIVER_ERROR_BUDGET * h {
             Some(err)
         } else {
             None
@@ -327,7 +295,7 @@ pub fn accept(
 
 /// Whether a coarse cell with corners at `corners` (scene units) is far
 /// enough from the shooter's bounds `(min, max)` to be interpolated: at
-/// least [`NEAR_RATIO`] of its diagonal away. Near the shooter (a wall
+/// least [`RECEIVER_NEAR_RATIO`] of its diagonal away. Near the shooter (a wall
 /// meeting the shooting floor, a seat above the floor) the field bends
 /// sharply within a cell, and the check vertex in its middle does not see
 /// how.
@@ -338,7 +306,7 @@ pub fn far_from(corners: [Vec3; 4], shooter: (Vec3, Vec3)) -> bool {
             (lo.min(c), hi.max(c))
         });
     let gap = (shooter.0 - hi).max(lo - shooter.1).max(Vec3::ZERO);
-    gap.length() >= NEAR_RATIO * (hi - lo).length()
+    gap.length() >= RECEIVER_NEAR_RATIO * (hi - lo).length()
 }
 
 /// The value of an accepted cell at a vertex: the bilinear blend of the
@@ -508,7 +476,7 @@ mod tests {
         let cost = accept(weak, Rgb::splat(0.0104), mid, held, none).expect("weak");
         assert!((cost.r - 0.0004).abs() < 1e-12);
         // ... but not once the charges reach the budget.
-        let spent = Rgb::splat(ERROR_BUDGET - 0.0002);
+        let spent = Rgb::splat(RECEIVER_ERROR_BUDGET - 0.0002);
         assert_eq!(accept(weak, Rgb::splat(0.0104), mid, held, spent), None);
         // A dark channel held is not a licence for the others.
         let red = Rgb::new(1.0, 0.0, 0.0);

@@ -11,7 +11,7 @@
 //! contact 30 to 40 % dark, and by different amounts, as they shoot in
 //! different orders.
 //!
-//! A cell that stands for more than [`ELEMENTS_PER_CELL`] elements and
+//! A cell that stands for more than [`SUBCELL_ELEMENTS_PER_CELL`] elements and
 //! has something close over it (`Over`: a sphere's bottom, a block's
 //! foot, a lamp under the ceiling) is cut into 4 × 4 sub-cells (a triangle
 //! into 16 congruent triangles), and each sub-cell again into 4 × 4 leaves.
@@ -54,7 +54,11 @@ use crate::mesh::Mesh;
 use crate::scene::{Polygon, Scene};
 use crate::solver::kernel::formfactor::{
     cell_diameter2, lane_terms, point_to_polygon, quadrature, triangle_area, Quadrature,
-    ShooterSample, EXACT_RATIO, NEAR_FIELD_RATIO,
+    ShooterSample,
+};
+use crate::solver::tuning::{
+    EXACT_RATIO, NEAR_FIELD_RATIO, SUBCELL_CLOSE, SUBCELL_EDGE_MARGIN, SUBCELL_ELEMENTS_PER_CELL,
+    SUBCELL_LEAF_RATIO, SUBCELL_REACH,
 };
 use glam::Vec3;
 use rayon::prelude::*;
@@ -71,26 +75,8 @@ pub const SUBCELLS: usize = SIDE * SIDE;
 /// within [`EXACT_RATIO`] of a sub-cell's diameters takes it as its leaves.
 pub const LEAVES: usize = SIDE * SIDE;
 
-/// A receiver within this many of a sub-cell's diameters takes the sub-cell as
-/// its leaves (the distance within which a sub-cell takes Lambert's exact
-/// form factor).
-pub const LEAF_RATIO: f32 = EXACT_RATIO;
-
 /// Values per split cell: one per sub-cell and one per leaf.
 pub const PER_CELL: usize = SUBCELLS * (1 + LEAVES);
-
-/// A cell is split when it stands for more than this many of its
-/// polygon's elements (by area): finer than that, its centre's reading is
-/// already what its elements hold.
-pub const ELEMENTS_PER_CELL: f64 = 4.0;
-
-/// A receiver farther than this factor of the cell's exact radius
-/// ([`ShooterSample::exact_r2`], itself 1.5 cell diameters), 2 cell
-/// diameters, is more than 6 of a sub-cell's diameters from every sub-cell, and
-/// takes their point terms, four at a time; nearer, each sub-cell is taken by
-/// the rules of a cell (Lambert's exact form factor within 1.5 of its
-/// diameters, its quadrature within 6, its point term beyond).
-pub const FAR_SCALE: f32 = 2.0 / 1.5;
 
 /// "Not split" in [`SubCells::first`] and in a step's [`Split::first`].
 pub const NONE: u32 = u32::MAX;
@@ -134,7 +120,7 @@ pub struct SubCells {
 
 impl SubCells {
     /// Every polygon's sub-cells: those of its cells that stand for more than
-    /// [`ELEMENTS_PER_CELL`] of its elements and have something close over
+    /// [`SUBCELL_ELEMENTS_PER_CELL`] of its elements and have something close over
     /// them (`Over`). None without the near field (`near_field` false), nor
     /// for samples without a cell, whose form factors have no cell to cut.
     pub fn build_all(
@@ -153,7 +139,7 @@ impl SubCells {
                     near_field
                         && s.cell.is_some()
                         && s.near_r2 > 0.0
-                        && s.area > ELEMENTS_PER_CELL * element_area
+                        && s.area > SUBCELL_ELEMENTS_PER_CELL * element_area
                 };
                 if !samples[i].iter().any(large) {
                     return SubCells::build(&samples[i], |_| false);
@@ -228,9 +214,9 @@ impl SubCells {
 }
 
 /// Where something stands over a shooter's cell: a mesh vertex of another
-/// polygon in front of the shooter's plane by less than [`CLOSE`] cell
-/// diameters, within [`REACH`] diameters of the cell's centre, and over
-/// the shooter's inside, farther than [`EDGE_MARGIN`] diameters from its
+/// polygon in front of the shooter's plane by less than [`SUBCELL_CLOSE`] cell
+/// diameters, within [`SUBCELL_REACH`] diameters of the cell's centre, and over
+/// the shooter's inside, farther than [`SUBCELL_EDGE_MARGIN`] diameters from its
 /// edges.
 ///
 /// That is where light pools narrower than a cell: under a sphere resting
@@ -243,18 +229,6 @@ struct Over {
     /// Per polygon: bounds of its mesh vertices, in scene units.
     bounds: Vec<(Vec3, Vec3)>,
 }
-
-/// How close over a shooter's plane, in cell diameters, a point must
-/// stand to count (`Over`).
-pub const CLOSE: f32 = 0.5;
-
-/// How near a cell's centre, in cell diameters, a point must stand to
-/// count (`Over`).
-pub const REACH: f32 = 1.0;
-
-/// How far inside a shooter's edges, in cell diameters, a point must
-/// stand over it to count as over its inside (`Over`).
-pub const EDGE_MARGIN: f32 = 0.01;
 
 impl Over {
     fn new(mesh: &Mesh) -> Over {
@@ -282,15 +256,15 @@ impl Over {
         inward: &[(Vec3, Vec3)],
         s: &ShooterSample,
     ) -> bool {
-        let diameter = (s.exact_r2.sqrt() / crate::solver::kernel::formfactor::EXACT_RATIO)
-            .max(f32::MIN_POSITIVE);
-        let r2 = (REACH * diameter).powi(2);
-        let (margin, ahead) = (EDGE_MARGIN * diameter, 1e-4 * diameter);
+        let diameter =
+            (s.exact_r2.sqrt() / crate::solver::tuning::EXACT_RATIO).max(f32::MIN_POSITIVE);
+        let r2 = (SUBCELL_REACH * diameter).powi(2);
+        let (margin, ahead) = (SUBCELL_EDGE_MARGIN * diameter, 1e-4 * diameter);
         let c = s.position;
         let over = |p: Vec3| {
             let height = n.dot(p - c);
             height > ahead
-                && height < CLOSE * diameter
+                && height < SUBCELL_CLOSE * diameter
                 && p.distance_squared(c) < r2
                 && inward.iter().all(|&(a, w)| w.dot(p - a) > margin)
         };
@@ -470,7 +444,7 @@ where
     /// `Σ value · F` over the sub-cells from `first` seen from `x` (unit normal
     /// `nx`), the shooter's unit normal being `ns`, and `Σ F` alone (whether
     /// anything is seen). `far` says the receiver is more than
-    /// [`FAR_SCALE`] of the cell's exact radius away.
+    /// [`SUBCELL_FAR_SCALE`](crate::solver::tuning::SUBCELL_FAR_SCALE) of the cell's exact radius away.
     #[inline]
     pub fn sum(&self, first: usize, x: Vec3, nx: Vec3, ns: Vec3, far: bool) -> (W, f64) {
         let mut sum = W::default();
@@ -497,7 +471,9 @@ where
             // A receiver this close sees the light vary across the sub-cell
             // (where a sphere touches the floor it falls to nothing under
             // the contact): each leaf sends its own.
-            if x.distance_squared(c.position) < LEAF_RATIO * LEAF_RATIO * c.diameter2 {
+            if x.distance_squared(c.position)
+                < SUBCELL_LEAF_RATIO * SUBCELL_LEAF_RATIO * c.diameter2
+            {
                 let leaves = (first + p) * LEAVES..(first + p + 1) * LEAVES;
                 for (leaf, &value) in self.leaves[leaves.clone()]
                     .iter()
@@ -737,7 +713,7 @@ mod tests {
     /// Cells are split where something stands over them (a cube on the
     /// floor), not in the room's far corner, where only the walls meet the
     /// floor, nor on the wall a tenth of the room from the cube (more
-    /// than [`CLOSE`] of its cells' diameter), nor on the ceiling.
+    /// than [`SUBCELL_CLOSE`] of its cells' diameter), nor on the ceiling.
     #[test]
     fn cells_are_split_where_something_stands_over_them() {
         use crate::solver::formfactor::{shooter_samples, SampleSet};

@@ -15,7 +15,7 @@
 //! in any length unit, since `a_k / r²` is dimensionless: the scene's unit
 //! enters only through `e` ([`crate::scene::Scene::set_luminaire`]). For a
 //! cosine distribution `I / Φ = cosθ / π` and this is Lambert's term. A
-//! receiver within [`super::formfactor::NEAR_FIELD_RATIO`] cell diameters
+//! receiver within [`crate::solver::tuning::NEAR_FIELD_RATIO`] cell diameters
 //! of a sample sums the term over the cell's quadrature points instead.
 //! Visibility is the same one ray per sample as for any shooter.
 

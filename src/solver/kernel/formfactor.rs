@@ -43,23 +43,10 @@
 
 use crate::mesh::{area_centroid, drop_collinear, Mesh, PolygonMesh};
 use crate::scene::{Polygon, Shape};
-use crate::solver::accel::subcells::{Split, FAR_SCALE};
+use crate::solver::accel::subcells::Split;
+use crate::solver::tuning::{EXACT_RATIO, NEAR_FIELD_RATIO, SKY_FACET_SAMPLES, SUBCELL_FAR_SCALE};
 use glam::{DVec3, Vec3, Vec4};
 use std::f64::consts::PI;
-
-/// A receiver within this many cell diameters of a grid sample gets the
-/// cell's quadrature (or, closer, the exact) form factor instead of the
-/// point term. Measured on a unit square of 8 × 8 cells (worst error over
-/// 2,000 random receivers / over a perpendicular wall): 3 diameters give
-/// 0.8 % / 0.8 %, 4 give 0.6 % / 0.6 %, 6 give 0.27 % / 0.33 %. The extra
-/// terms cost arithmetic only, never a ray.
-pub const NEAR_FIELD_RATIO: f32 = 6.0;
-
-/// A receiver within this many cell diameters of a grid sample gets the
-/// exact point-to-cell form factor: close enough that a quadrature's points
-/// are no longer far compared with their spacing (1 and 2 diameters gave
-/// the same errors as 1.5).
-pub const EXACT_RATIO: f32 = 1.5;
 
 /// A point of a shooting polygon and the area it stands for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -226,24 +213,6 @@ pub enum SampleSet {
     /// with the far-field point term (see `sky_samples`).
     Sky(u32),
 }
-
-/// Points a sky facet ([`crate::scene::Surface::sky`]) shoots from,
-/// whatever `--shooter-samples` and `--form-factor` say: a facet is one
-/// element, yet it subtends a large solid angle, and its points are the
-/// directions sky light comes from. With the 80 facets of
-/// [`crate::scene::SKY_SUBDIVISIONS`] this makes 20,480 directions.
-///
-/// Measured on the floor under a 1 × 1 skylight 2 units up (the solver's
-/// `sky_light_through_a_skylight_*` tests, lenmax 0.05), as the largest
-/// departure of a vertex from the mean of its neighbours (roughness) and
-/// from Lambert's exact value, both relative to the peak: a regular grid
-/// of 16 a facet gave 12 % and 9 % (rows of directions enter through the
-/// window's edge at once); jittered, 16 gave 8.4 % and 11 %, 64 gave 3.8 %
-/// and 5.7 %, 144 gave 2.4 % and under 4 %, 256 gives 1.5 % and 2.6 %
-/// (exact profile: 0.1 %). Rays grow with the count: an open courtyard of
-/// 7,353 vertices solves in 0.5 s at 16, 2.2 s at 64, 3.5 s at 144 and
-/// 4.3 s at 256 on two cores.
-pub const SKY_FACET_SAMPLES: u32 = 256;
 
 impl SampleSet {
     /// The set `polygon` shoots from when the solve asks for `set`: its
@@ -489,7 +458,7 @@ where
         }
         if let (Some(split), Some(cell), true) = (split, s.cell, near_field) {
             if let Some(first) = split.of(k) {
-                let far = r2 >= s.exact_r2 * FAR_SCALE * FAR_SCALE;
+                let far = r2 >= s.exact_r2 * SUBCELL_FAR_SCALE * SUBCELL_FAR_SCALE;
                 let (value, seen) = split.sum(first, x, nx, ns, far);
                 if seen <= 0.0 {
                     continue;

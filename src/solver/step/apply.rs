@@ -2,7 +2,7 @@
 //! step's report.
 //!
 //! Heuristics acting here: **overshooting** (a shooter is left holding
-//! minus what it sent ahead, [`crate::solver::SolverOptions::overshoot`];
+//! minus what it sent ahead, [`crate::solver::Approximations::overshoot`];
 //! negative light takes radiosity back, never below black).
 
 use super::{StepPhase, Underway};
@@ -30,7 +30,7 @@ impl<'a> Progressive<'a> {
             }
             u.spent = true;
         }
-        let culling = self.options.shaft_culling;
+        let culling = self.options.approximations.shaft_culling;
         let mesh: &Mesh = &self.mesh;
         for j in polygons {
             if !self.receives[j] {

@@ -4,21 +4,22 @@
 //! power due shoots next, its member with the most shooting for it.
 //! Heuristics acting here:
 //! - **emitters first**: an emitter that has not shot its light yet
-//!   ([`crate::solver::PENDING_EMISSION`]) shoots before any reflector;
+//!   ([`crate::solver::tuning::PENDING_EMISSION`]) shoots before any reflector;
 //! - **overshooting**: what each point expects to receive later
 //!   (`Expectation`, `OVERSHOOT_SHARE`),
 //!   sent ahead, and the negative part shot once the expectation no
 //!   longer covers it;
 //! - **settling**: past the threshold, the cluster holding the most light
 //!   of points not yet settled ([`crate::solver::SolverOptions::settle`],
-//!   [`crate::solver::SETTLE_FLOOR`]);
+//!   [`crate::solver::tuning::SETTLE_FLOOR`]);
 //! - **sky power weights**: a sky facet's power counts as the light it
 //!   can bring (`sky_power_weights`).
 
 use crate::color::Rgb;
 use crate::scene::PolygonId;
+use crate::solver::tuning::{OVERSHOOT_SHARE, PENDING_EMISSION, SETTLE_FLOOR};
 use crate::solver::unshot::Shot;
-use crate::solver::{Expectation, Progressive, OVERSHOOT_SHARE, PENDING_EMISSION, SETTLE_FLOOR};
+use crate::solver::{Expectation, Progressive};
 
 impl<'a> Progressive<'a> {
     /// The power polygon `j` sends out in a step that sends `shot`
@@ -51,9 +52,9 @@ impl<'a> Progressive<'a> {
     }
 
     /// What the next step expects every point to receive later
-    /// ([`Expectation`]); nothing without [`SolverOptions::overshoot`].
+    /// ([`Expectation`]); nothing without [`Approximations::overshoot`].
     pub(in crate::solver) fn expectation(&self) -> Expectation {
-        if !self.options.overshoot {
+        if !self.options.approximations.overshoot {
             return Expectation::NONE;
         }
         let ambient = self.ambient().max(Rgb::BLACK) * OVERSHOOT_SHARE;
@@ -129,20 +130,22 @@ impl<'a> Progressive<'a> {
         expected: Expectation,
     ) -> Option<(usize, f64, bool)> {
         // Past the threshold, what is left to shoot is what has not settled.
-        if self.options.settle > 0.0 && self.unshot_fraction() <= self.options.threshold {
+        if self.settling() && self.unshot_fraction() <= self.options.threshold {
             if let Some(chosen) = self.choose_unsettled(expected) {
                 return Some(chosen);
             }
         }
-        if let Some(chosen) = self.choose_pending_emitter() {
-            return Some(chosen);
+        if self.options.approximations.emitters_first {
+            if let Some(chosen) = self.choose_pending_emitter() {
+                return Some(chosen);
+            }
         }
         let mut positive = vec![0.0f64; self.clusters.len()];
         let mut negative = vec![0.0f64; self.clusters.len()];
         for i in 0..self.mesh.polygons.len() {
             let c = self.clusters.of(PolygonId(i as u32));
             positive[c] += self.polygon_due(i, false, expected);
-            if self.options.overshoot {
+            if self.options.approximations.overshoot {
                 negative[c] += self.polygon_due(i, true, expected);
             }
         }
@@ -184,9 +187,15 @@ impl<'a> Progressive<'a> {
         best
     }
 
+    /// Whether the solve settles past the threshold
+    /// ([`Approximations::settling`] with a tolerance above 0).
+    fn settling(&self) -> bool {
+        self.options.approximations.settling && self.options.settle > 0.0
+    }
+
     /// Whether some point has not settled ([`SolverOptions::settle`]).
     pub(in crate::solver) fn unsettled(&self) -> bool {
-        self.options.settle > 0.0 && self.choose_unsettled(self.expectation()).is_some()
+        self.settling() && self.choose_unsettled(self.expectation()).is_some()
     }
 
     /// The radiosity below which a point counts as that bright for
@@ -226,7 +235,7 @@ impl<'a> Progressive<'a> {
         let tolerance = self.options.settle;
         // Per cluster, for each sign: (unsettled power, power due).
         let mut sums = vec![[(0.0f64, 0.0f64); 2]; self.clusters.len()];
-        let signs: &[bool] = if self.options.overshoot {
+        let signs: &[bool] = if self.options.approximations.overshoot {
             &[false, true]
         } else {
             &[false]

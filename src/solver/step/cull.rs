@@ -5,20 +5,21 @@
 //! - **receiver marking**: a polygon receives only when some vertex of it
 //!   is in front of the shooter and some sample in front of it (a
 //!   cluster's step marks every reflecting polygon);
-//! - **shaft culling** ([`crate::solver::SolverOptions::shaft_culling`]):
+//! - **shaft culling** ([`crate::solver::Approximations::shaft_culling`]):
 //!   the polygons in each receiver's shaft to the shooter (a cluster's
 //!   bounds), then in each thin shaft between a tile of
-//!   [`crate::solver::TILE_VERTICES`] receiving vertices and a group of
-//!   [`crate::solver::SHOOTER_GROUP`] samples or strata, searched by
-//!   culling group; small receivers ([`crate::solver::SHAFT_MIN_VERTICES`])
-//!   and crowded shafts ([`crate::solver::REFINE_MAX`]) ask the BVH
+//!   [`crate::solver::tuning::TILE_VERTICES`] receiving vertices and a group of
+//!   [`crate::solver::tuning::SHOOTER_GROUP`] samples or strata, searched by
+//!   culling group; small receivers ([`crate::solver::tuning::SHAFT_MIN_VERTICES`])
+//!   and crowded shafts ([`crate::solver::tuning::REFINE_MAX`]) ask the BVH
 //!   instead.
 
 use super::{How, Underway};
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
 use crate::solver::accel::cluster::Clusters;
-use crate::solver::{Progressive, REFINE_MAX, SHOOTER_GROUP};
+use crate::solver::tuning::{REFINE_MAX, SHOOTER_GROUP};
+use crate::solver::Progressive;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -89,7 +90,7 @@ impl<'a> Progressive<'a> {
     /// the cluster's bounds), then in each thin shaft between a receiver
     /// tile and a group of shooter samples (or strata).
     pub(in crate::solver) fn cull_chunk(&mut self, u: &Underway, polygons: Range<usize>) {
-        if !self.options.shaft_culling {
+        if !self.options.approximations.shaft_culling {
             return;
         }
         match u.how {

@@ -1,5 +1,5 @@
-//! Phase 4 of a step: the gather of a polygon shooting alone, the
-//! hemicube's, and the two passes every gather runs.
+//! Phase 4 of a step: the gather of a polygon shooting alone, and the
+//! two passes every gather runs.
 //!
 //! Every receiving vertex sums `ρ_j · Σ_k Δb_k · F(l → sample k)`, in
 //! parallel, each vertex independent of the others. Heuristics acting
@@ -10,7 +10,7 @@
 //!   shooter ([`crate::solver::accel::receivers`], `Interpolating`);
 //! - **shadow-ray choice**: no ray in an empty shaft, a short candidate
 //!   list tested one by one, else the BVH ([`ShadowQuery`],
-//!   [`crate::solver::LINEAR_CANDIDATES`]);
+//!   [`crate::solver::tuning::LINEAR_CANDIDATES`]);
 //! - **shared facet rays** ([`crate::solver::accel::facets`]);
 //! - **sky probes** and **far shooters**: a few rays first, their answer
 //!   for all when they agree ([`crate::solver::accel::probes`],
@@ -18,7 +18,7 @@
 //! - **sub-cells**: a split cell near the receiver sends as its sub-cells
 //!   ([`crate::solver::accel::subcells`]);
 //! - the **near field** of the form factor
-//!   ([`crate::solver::SolverOptions::near_field`]).
+//!   ([`crate::solver::Approximations::near_field`]).
 
 use super::{How, Underway};
 use crate::color::Rgb;
@@ -30,10 +30,10 @@ use crate::solver::accel::facets::Scratch;
 use crate::solver::accel::receivers::CoarseGrid;
 use crate::solver::accel::{probes, receivers, subcells};
 use crate::solver::kernel::distribution;
-use crate::solver::unshot::Shot;
-use crate::solver::{
-    Progressive, LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
+use crate::solver::tuning::{
+    LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
 };
+use crate::solver::Progressive;
 use crate::visibility::{LastBlocker, ShadowQuery, Visibility};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -146,7 +146,9 @@ impl<'a> Progressive<'a> {
             };
             // Reflected light may be interpolated across receiving grids;
             // an emitter's shot, which draws the sharpest shadows, never is.
-            let on = p.clustered && p.options.receiver_interpolation && p.emission[i].is_black();
+            let on = p.clustered
+                && p.options.approximations.receiver_interpolation
+                && p.emission[i].is_black();
             let cells = p.interpolating(on, p.clusters.of(shooter));
             gather_passes(sums, mesh, &cells, cancel, exact, Work { vertices, stage })
         })
@@ -191,40 +193,6 @@ impl<'a> Progressive<'a> {
             held: &self.radiosity,
         }
     }
-
-    /// Phase 4 by hemicubes ([`hemicube::Shooting::gather`]): `Δrad` of
-    /// every receiving vertex into `self.delta`, from what `shot` sends
-    /// (read into `self.shot`), from at most `hemicubes` hemicubes
-    /// ([`Progressive::hemicube_points`]).
-    pub(in crate::solver) fn gather_hemicube(
-        &mut self,
-        shooter: PolygonId,
-        shot: Shot,
-        hemicubes: usize,
-        cancel: &AtomicBool,
-    ) -> Option<Gathered> {
-        let i = shooter.index();
-        let power = self.unshot.sent_power(&self.mesh, i, shot, &self.radiosity);
-        let merged = self.hemicube_points(shooter, hemicubes);
-        let (samples, shot) = match &merged {
-            Some((samples, shot)) => (&samples[..], &shot[..]),
-            None => (&self.samples[i][..], &self.shot[..]),
-        };
-        let hemicube = self.hemicube.as_mut()?;
-        let pairs = hemicube.gather(
-            &self.mesh,
-            i,
-            self.directional[i].as_ref(),
-            samples,
-            shot,
-            power,
-            &self.receives,
-            &self.reflectance,
-            &mut self.delta,
-            cancel,
-        )?;
-        Some(Gathered { pairs, rays: 0 })
-    }
 }
 
 /// What both gathers (a polygon's, a cluster's) read of the step: the
@@ -237,9 +205,9 @@ pub(in crate::solver) struct GatherContext<'g> {
     pub(in crate::solver) facets: &'g Facets,
     /// Per polygon: front reflectance.
     pub(in crate::solver) reflectance: &'g [Rgb],
-    /// [`crate::solver::SolverOptions::near_field`].
+    /// [`crate::solver::Approximations::near_field`].
     pub(in crate::solver) near_field: bool,
-    /// [`crate::solver::SolverOptions::shaft_culling`].
+    /// [`crate::solver::Approximations::shaft_culling`].
     culling: bool,
     /// Per polygon: too small for a shaft of its own.
     small: &'g [bool],
@@ -263,8 +231,8 @@ impl<'g> GatherContext<'g> {
             visibility: p.visibility,
             facets: &p.facets,
             reflectance: &p.reflectance,
-            near_field: p.options.near_field,
-            culling: p.options.shaft_culling,
+            near_field: p.options.approximations.near_field,
+            culling: p.options.approximations.shaft_culling,
             small: &p.small,
             candidates: &p.candidates,
             tile_candidates: &p.tile_candidates,

@@ -7,7 +7,7 @@
 //!   way, one term and one ray per normal bin
 //!   ([`crate::solver::accel::cluster::Seen::FarBinned`]);
 //! - **weak strata**: a near stratum whose light is too weak here to
-//!   matter is one term all the same ([`crate::solver::WEAK_STRATUM_SHARE`]);
+//!   matter is one term all the same ([`crate::solver::tuning::WEAK_STRATUM_SHARE`]);
 //! - **single cells** near by, with the rules of a polygon's shot and
 //!   **sub-cells** ([`crate::solver::accel::subcells`]);
 //! - **receiver interpolation**, **shadow-ray choice** and **shared facet
@@ -16,15 +16,12 @@
 use super::gather::{gather_passes, GatherContext, Gathered, Stage, Work};
 use crate::color::Rgb;
 use crate::scene::PolygonId;
-use crate::solver::accel::cluster;
 use crate::solver::accel::cluster::{Cell, Clusters, Seen, Strata, Stratum};
 use crate::solver::accel::facets::Scratch;
 use crate::solver::accel::subcells::{self, SubCells};
 use crate::solver::kernel::formfactor::{weighted_point_to_samples, ShooterSample};
-use crate::solver::{
-    Progressive, LINEAR_CANDIDATES, OWN_RAY_SLOT, RAY_SLOTS, REPRESENTATIVE_SLOT, SHOOTER_GROUP,
-    WEAK_STRATUM_SHARE,
-};
+use crate::solver::tuning::{LINEAR_CANDIDATES, SHOOTER_GROUP, WEAK_STRATUM_SHARE};
+use crate::solver::{Progressive, OWN_RAY_SLOT, RAY_SLOTS, REPRESENTATIVE_SLOT};
 use crate::visibility::{LastBlocker, ShadowQuery};
 use glam::Vec3;
 use std::ops::Range;
@@ -65,7 +62,7 @@ impl<'a> Progressive<'a> {
                 subcells: &p.subcells,
                 strata: &p.strata,
                 held: &p.radiosity,
-                lump_share: if p.options.receiver_interpolation {
+                lump_share: if p.options.approximations.weak_strata {
                     WEAK_STRATUM_SHARE
                 } else {
                     0.0
@@ -74,7 +71,7 @@ impl<'a> Progressive<'a> {
             // The exact `Δrad` at receiving vertex `l` of polygon `j`, with
             // the pairs and rays it took.
             let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| shot.vertex(l, j, scratch);
-            let cells = p.interpolating(p.options.receiver_interpolation, cluster);
+            let cells = p.interpolating(p.options.approximations.receiver_interpolation, cluster);
             gather_passes(
                 sums,
                 g.mesh,
@@ -175,9 +172,9 @@ impl ClusterShot<'_> {
             // Above a weak step's cut, nodes larger than any
             // stratum must lie deeper in front of the receiver.
             let depth_ratio = if si == NONE {
-                cluster::TOP_DEPTH_RATIO
+                crate::solver::tuning::TOP_DEPTH_RATIO
             } else {
-                cluster::PLANE_DEPTH_RATIO
+                crate::solver::tuning::PLANE_DEPTH_RATIO
             };
             let seen = node.seen_from_at(x, nx, depth_ratio);
             if seen == Seen::Behind {

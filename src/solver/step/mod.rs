@@ -4,15 +4,18 @@
 //!    sends;
 //! 2. [`read`]: read what its samples (or a cluster's strata) carry;
 //! 3. [`cull`]: mark the receivers and cull their shadow-ray candidates;
-//! 4. [`gather`] (a polygon's or a hemicube's) and [`gather_cluster`]:
-//!    every receiving vertex's `Δrad`;
+//! 4. [`gather`] (a polygon's) and [`gather_cluster`]: every receiving
+//!    vertex's `Δrad`;
 //! 5. [`apply`]: add it to the receivers and report the step.
 //!
 //! Phases 3 to 5 run over the receivers in chunks, and with a part budget
 //! a step returns between chunks ([`parts`]). This module begins a step
-//! (phases 1 and 2) and runs it.
+//! (phases 1 and 2) and runs it. Another method may compose these phases
+//! with its own: the hemicube ([`crate::solver::methods::hemicube`])
+//! takes phases 1, 3 and 5 and reads and gathers by rendering.
 
 use crate::scene::PolygonId;
+use crate::solver::unshot::Shot;
 use crate::solver::{Expectation, Progressive, SolverError, StepReport};
 use gather::Gathered;
 use std::sync::atomic::AtomicBool;
@@ -43,11 +46,11 @@ pub(in crate::solver) struct Underway {
     /// first receivers applied).
     pub(in crate::solver) spent: bool,
     /// Counts so far.
-    gathered: Gathered,
+    pub(in crate::solver) gathered: Gathered,
     receivers: u64,
     clear: u64,
     /// Parts reported so far, the one running included.
-    part: u32,
+    pub(in crate::solver) part: u32,
     /// The unshot fraction the last finished step left.
     fraction_before: f64,
 }
@@ -94,12 +97,20 @@ thread_local! {
     pub(crate) static POISON_READ_AT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
-/// What [`Progressive::begin_step`] did.
-pub(in crate::solver) enum Begun {
-    /// The whole step (a hemicube step).
-    Done(StepReport),
-    /// The shooter is read and its receivers marked.
-    Underway(Underway),
+/// A step chosen (phase 1) and not yet begun: its shooter and what it
+/// sends. A method shoots it its own way ([`Progressive::begin_chosen`]
+/// for progressive shooting; the hemicube renders it,
+/// [`crate::solver::methods::hemicube`]).
+pub(in crate::solver) struct Chosen {
+    /// The step so far: shooter, cluster, signed power and expected light
+    /// chosen, shooting [`How::Alone`] in one part, nothing gathered.
+    pub(in crate::solver) underway: Underway,
+    /// Strata or hemicubes the step may use ([`Progressive::step_roots`]).
+    pub(in crate::solver) roots: usize,
+    /// Whether the step shoots negative light.
+    pub(in crate::solver) negative: bool,
+    /// What each point of the shooter sends.
+    pub(in crate::solver) shot: Shot,
 }
 
 impl<'a> Progressive<'a> {
@@ -126,10 +137,8 @@ impl<'a> Progressive<'a> {
         // (building its strata) against its budget.
         let start = std::time::Instant::now();
         if self.underway.is_none() {
-            match self.begin_step(cancel)? {
-                Begun::Done(report) => return Some(report),
-                Begun::Underway(u) => self.underway = Some(u),
-            }
+            let chosen = self.choose_step()?;
+            self.underway = Some(self.begin_chosen(chosen)?);
         }
         self.continue_step(start, cancel)
     }
@@ -153,7 +162,7 @@ impl<'a> Progressive<'a> {
 
     /// Whether what the shooter of step `u` sends, as read in phase 2,
     /// is finite: its samples' readings or its cluster's strata.
-    fn read_is_finite(&self, u: &Underway) -> bool {
+    pub(in crate::solver) fn read_is_finite(&self, u: &Underway) -> bool {
         match u.how {
             How::Alone => self.shot.iter().all(|s| s.is_finite()),
             How::Cluster { .. } => self.strata.nodes.iter().all(|n| {
@@ -169,7 +178,7 @@ impl<'a> Progressive<'a> {
     /// Test hook ([`POISON_READ_AT`]): makes step `u`'s reading NaN when
     /// it is the step asked for.
     #[cfg(test)]
-    fn poison_read(&mut self, u: &Underway) {
+    pub(in crate::solver) fn poison_read(&mut self, u: &Underway) {
         if POISON_READ_AT.get() != self.steps + 1 {
             return;
         }
@@ -187,28 +196,16 @@ impl<'a> Progressive<'a> {
         self.underway.is_some()
     }
 
-    /// Phases 1 and 2 of a step, and with hemicubes the whole step:
-    /// chooses the shooter, reads what it sends and marks its receivers.
-    /// `None` when nothing is due or, for a hemicube step, once `cancel`
-    /// is set.
-    pub(in crate::solver) fn begin_step(&mut self, cancel: &AtomicBool) -> Option<Begun> {
+    /// Phase 1 of a step: chooses the shooter and what it sends; `None`
+    /// when nothing is due. Changes nothing.
+    pub(in crate::solver) fn choose_step(&self) -> Option<Chosen> {
         let expected = self.expectation();
         let (cluster, shot_power, negative) = self.choose_shooter(expected)?;
         let shooter = self.strongest_member(cluster, negative, expected);
         let roots = self.step_roots(shot_power);
-        // Emitters, every polygon without clustering and every polygon of
-        // a scene where nothing clusters (a room of large walls, where
-        // strata would only add work) keep their own samples; a polygon
-        // whose light is weak shoots through strata, as a cluster of one.
-        let alone = self.clusters.members(cluster).len() == 1
-            && (!self.clustered
-                || self.clusters.grouped() == 0
-                || !self.emission[shooter.index()].is_black()
-                || roots >= self.samples[shooter.index()].len());
-        let by_hemicube = self.hemicube.is_some() && !self.mesh.polygons[shooter.index()].sky;
         let shot = self.polygon_shot(shooter.index(), negative, expected);
         let signed = if negative { -shot_power } else { shot_power };
-        let mut underway = Underway {
+        let underway = Underway {
             cluster,
             shooter,
             shot_power: signed,
@@ -222,32 +219,34 @@ impl<'a> Progressive<'a> {
             part: 0,
             fraction_before: self.last_fraction,
         };
-        if by_hemicube {
-            // A hemicube step renders all its receivers at once: one part.
-            self.read_shooter(shooter, shot);
-            self.mark_receivers(shooter.index());
-            let hemicubes = if self.options.clustering {
-                roots
-            } else {
-                usize::MAX
-            };
-            #[cfg(test)]
-            self.poison_read(&underway);
-            if !self.read_is_finite(&underway) {
-                self.fail(self.steps + 1, &underway, StepPhase::Read);
-                return None;
-            }
-            let gathered = self.gather_hemicube(shooter, shot, hemicubes, cancel)?;
-            let polygons = 0..self.mesh.polygons.len();
-            if !self.gathered_is_finite(polygons.clone()) {
-                self.fail(self.steps + 1, &underway, StepPhase::Gather);
-                return None;
-            }
-            self.apply_chunk(&mut underway, polygons);
-            underway.gathered = gathered;
-            underway.part = 1;
-            return Some(Begun::Done(self.finish_step(&underway)));
-        }
+        Some(Chosen {
+            underway,
+            roots,
+            negative,
+            shot,
+        })
+    }
+
+    /// Phase 2 of a progressive step: reads what the chosen shooter sends
+    /// (its samples, or a cluster's strata) and marks its receivers;
+    /// [`Progressive::continue_step`] then gathers and applies.
+    pub(in crate::solver) fn begin_chosen(&mut self, chosen: Chosen) -> Option<Underway> {
+        let Chosen {
+            mut underway,
+            roots,
+            negative,
+            shot,
+        } = chosen;
+        let (cluster, shooter, expected) = (underway.cluster, underway.shooter, underway.expected);
+        // Emitters, every polygon without clustering and every polygon of
+        // a scene where nothing clusters (a room of large walls, where
+        // strata would only add work) keep their own samples; a polygon
+        // whose light is weak shoots through strata, as a cluster of one.
+        let alone = self.clusters.members(cluster).len() == 1
+            && (!self.clustered
+                || self.clusters.grouped() == 0
+                || !self.emission[shooter.index()].is_black()
+                || roots >= self.samples[shooter.index()].len());
         let in_parts = self.options.part_budget.is_some();
         if alone {
             self.read_shooter(shooter, shot);
@@ -258,7 +257,7 @@ impl<'a> Progressive<'a> {
             // Reflected light may be interpolated across receiving grids;
             // an emitter's shot, which draws the sharpest shadows, never is.
             let interpolating = self.clustered
-                && self.options.receiver_interpolation
+                && self.options.approximations.receiver_interpolation
                 && self.emission[shooter.index()].is_black();
             let per_vertex = self.samples[shooter.index()].len();
             underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
@@ -268,7 +267,7 @@ impl<'a> Progressive<'a> {
             let from_top = roots < self.step_roots(f64::INFINITY);
             underway.how = How::Cluster { from_top };
             let per_vertex = self.strata.roots.len();
-            let interpolating = self.options.receiver_interpolation;
+            let interpolating = self.options.approximations.receiver_interpolation;
             underway.plan = parts::Plan::new(per_vertex, interpolating, in_parts);
         }
         #[cfg(test)]
@@ -277,6 +276,6 @@ impl<'a> Progressive<'a> {
             self.fail(self.steps + 1, &underway, StepPhase::Read);
             return None;
         }
-        Some(Begun::Underway(underway))
+        Some(underway)
     }
 }

@@ -27,55 +27,15 @@
 use super::gather::Stage;
 use super::{How, StepPhase, Underway};
 use crate::scene::PolygonId;
+use crate::solver::tuning::{
+    CHUNK_GROWTH, CHUNK_TARGET, CHUNK_WORK, NEAR_WEIGHT, PIECE_GROWTH, PIECE_WORK,
+};
 use crate::solver::{Progressive, StepReport};
 use std::sync::atomic::AtomicBool;
 
 use crate::mesh::PolygonMesh;
 use std::ops::Range;
 use std::time::Duration;
-
-/// Receiving vertices × shooter points (samples or strata) in one chunk of
-/// whole polygons at most: about 5 ms of gathering on two cores where a
-/// pair costs what it costs on average, 40 ms where it costs most (0.3 to
-/// 2.3 µs on the 100,000-triangle sphere box, more where receivers take
-/// a part's leaves). Chunks shrink from the time the earlier ones took
-/// (`Plan::observe`), down to [`CHUNK_WORK`] / 64; they never grow past
-/// it, as the next polygons may cost several times the last. Twice this
-/// let a part that met the dearest polygons late run to 0.12 s.
-pub const CHUNK_WORK: u64 = 1 << 14;
-
-/// How much a chunk may grow on the last one's size: slowly, as the next
-/// polygons may cost several times the last (a tessellated sphere's
-/// facets beside the shooting patch).
-const GROWTH: f64 = 1.25;
-
-/// How much a piece of a large polygon may grow on the last one's size.
-const PIECE_GROWTH: f64 = 1.5;
-
-/// Work in one piece of a large polygon at most: its vertices cost less
-/// than others, most being interpolated, but the ones near the shooter
-/// are evaluated exactly (a hall's floor under the shooting table cost
-/// 0.47 µs a pair, so a piece stays under about 30 ms). Pieces grow
-/// while the floor's far rows are cheap; four times this let the first
-/// part of a step that then reached the rows under the shooting tables
-/// run to 0.13 s on the 150-table hall's finest mesh, and twice this,
-/// once the floor's cells round chair legs were exact in every step
-/// ([`crate::solver::accel::receivers::CROWD_RATIO`]), let a piece of the 150-table
-/// hall's floor that reached them run to 0.12 s.
-pub const PIECE_WORK: u64 = 2 * CHUNK_WORK;
-
-/// The solver time a chunk aims at: a part ends within about this of its
-/// budget.
-pub const CHUNK_TARGET: Duration = Duration::from_millis(20);
-
-/// How much more a receiving vertex of the shooting cluster is counted
-/// than another: it lies among the cells it receives from, so its sum
-/// descends the strata to single cells.
-pub const NEAR_WEIGHT: u64 = 8;
-
-/// The solver time a window asks a part of a step to stay near: under
-/// the 100 ms that keeps a picture moving, with a chunk's margin.
-pub const WINDOW_PART_BUDGET: Duration = Duration::from_millis(50);
 
 /// Which pass of a receiving polygon's gather a piece runs
 /// ([`super::gather::gather_passes`]).
@@ -281,7 +241,7 @@ impl Plan {
         let (limit, growth, cap) = if piece {
             (&mut self.piece_limit, PIECE_GROWTH, PIECE_WORK)
         } else {
-            (&mut self.limit, GROWTH, CHUNK_WORK)
+            (&mut self.limit, CHUNK_GROWTH, CHUNK_WORK)
         };
         let now = *limit as f64;
         let next = if fits < now {

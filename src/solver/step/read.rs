@@ -10,20 +10,17 @@
 //!   sub-cells and leaves ([`crate::solver::accel::subcells`]);
 //! - **strata**: a cluster (or a polygon of weak light) shoots from a cut
 //!   of its strata, the fewer the weaker its light
-//!   ([`crate::solver::FULL_STRATA_SHARE`], [`crate::solver::MIN_STRATA`]);
-//! - **hemicube runs**: a weak hemicube step merges its cells into fewer
-//!   hemicubes by the same cut.
+//!   ([`crate::solver::tuning::FULL_STRATA_SHARE`], [`crate::solver::tuning::MIN_STRATA`]);
+//!   a weak hemicube step merges its cells into fewer hemicubes by the
+//!   same cut ([`crate::solver::methods::hemicube`]).
 
-use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::PolygonId;
 use crate::solver::accel::cluster::{Cell, Strata};
 use crate::solver::accel::subcells;
-use crate::solver::kernel::formfactor::ShooterSample;
+use crate::solver::tuning::{FULL_STRATA_SHARE, MIN_STRATA};
 use crate::solver::unshot::Shot;
-use crate::solver::{
-    unshot, Expectation, Progressive, ShooterSamples, FULL_STRATA_SHARE, MIN_STRATA,
-};
+use crate::solver::{unshot, Expectation, Progressive, ShooterSamples};
 
 impl<'a> Progressive<'a> {
     /// How many strata a clustered step shoots from at most, for a step
@@ -40,7 +37,7 @@ impl<'a> Progressive<'a> {
             ShooterSamples::AtMost(n) => n as usize,
             ShooterSamples::All => usize::MAX,
         };
-        if self.initial_unshot_power <= 0.0 {
+        if !self.options.approximations.strata || self.initial_unshot_power <= 0.0 {
             return cap;
         }
         let share = power / (FULL_STRATA_SHARE * self.initial_unshot_power);
@@ -129,59 +126,5 @@ impl<'a> Progressive<'a> {
         let k = roots.min(self.cells.len());
         let samples = &self.cell_samples;
         self.strata = Strata::build(&self.cells, k, |c| samples[c].bounds());
-    }
-
-    /// Where a hemicube step of `shooter` places its hemicubes when it may
-    /// use at most `hemicubes` ([`Progressive::step_roots`]: fewer the
-    /// weaker the step's light): `None` when the shooter's own samples
-    /// are few enough (one hemicube each, carrying `self.shot`). Else its
-    /// cells are merged into that many runs, the cut of their
-    /// [`Strata`] as a cluster's weak step takes it, each a hemicube at
-    /// the run's power-weighted centroid (on the polygon, which is
-    /// convex) carrying the run's area and its mean unshot radiosity: the
-    /// same power, from fewer points. A run is a coarser quadrature of
-    /// the shooter, which only receivers within a few runs' widths notice,
-    /// and a weak step carries too little light for that to show.
-    pub(in crate::solver) fn hemicube_points(
-        &self,
-        shooter: PolygonId,
-        hemicubes: usize,
-    ) -> Option<(Vec<ShooterSample>, Vec<Rgb>)> {
-        let i = shooter.index();
-        let samples = &self.samples[i];
-        if hemicubes >= samples.len() {
-            return None;
-        }
-        let normal = self.mesh.polygons[i].normal;
-        let cells: Vec<Cell> = samples
-            .iter()
-            .zip(&self.shot)
-            .enumerate()
-            .map(|(k, (sample, &unshot))| Cell {
-                polygon: shooter,
-                sample: k as u32,
-                unshot,
-                area: sample.area,
-                normal,
-                power: unshot.mean() * sample.area,
-            })
-            .filter(|c| c.power > 0.0)
-            .collect();
-        let strata = Strata::build(&cells, hemicubes, |c| {
-            samples[cells[c].sample as usize].bounds()
-        });
-        let mut points = Vec::with_capacity(strata.roots.len());
-        let mut shot = Vec::with_capacity(strata.roots.len());
-        for &r in &strata.roots {
-            let node = &strata.nodes[r as usize];
-            let run = node.cells.start as usize..node.cells.end as usize;
-            let area: f64 = cells[run].iter().map(|c| c.area).sum();
-            if area <= 0.0 {
-                continue;
-            }
-            points.push(ShooterSample::point(node.centroid, area));
-            shot.push(node.power / area);
-        }
-        Some((points, shot))
     }
 }

@@ -20,7 +20,7 @@ fn energy_balance_with_clusters() {
         0.1,
         crate::mesh::DEFAULT_INSET,
         SolverOptions {
-            clustering: false,
+            approximations: options.approximations.with(Heuristic::Clusters, false),
             ..options
         },
     );
@@ -68,7 +68,7 @@ fn clusters_match_the_brute_force_twin() {
         &s,
         mesh.clone(),
         SolverOptions {
-            clustering: false,
+            approximations: options.approximations.with(Heuristic::Clusters, false),
             ..options
         },
     );
@@ -77,7 +77,11 @@ fn clusters_match_the_brute_force_twin() {
             &s,
             mesh.clone(),
             SolverOptions {
-                receiver_interpolation: interpolate,
+                approximations: if interpolate {
+                    options.approximations
+                } else {
+                    options.approximations.without(&Heuristic::RECEIVERS)
+                },
                 ..options
             },
         );
@@ -171,7 +175,7 @@ fn a_cluster_shot_matches_lambert() {
     let vis = Visibility::new(&s);
     // Without overshoot the step sends exactly the unshot light set here.
     let options = SolverOptions {
-        overshoot: false,
+        approximations: Approximations::DEFAULT.with(Heuristic::Overshoot, false),
         ..Default::default()
     };
     let mut solver = Progressive::new(&s, &mesh, &vis, options);
@@ -216,22 +220,6 @@ fn a_cluster_shot_matches_lambert() {
     assert!(worst < 0.01 * peak, "worst error {worst} of peak {peak}");
 }
 
-/// Clustered solves give the same bits on one thread and on two.
-#[test]
-fn clustered_solves_do_not_depend_on_the_thread_count() {
-    let s = tiled_box(true, 4);
-    let options = SolverOptions {
-        max_steps: Some(25),
-        ..Default::default()
-    };
-    let run = |threads| {
-        on_threads(threads, || {
-            solve(&s, 0.15, crate::mesh::DEFAULT_INSET, options)
-        })
-    };
-    assert!(same_bits(&run(1).radiosity, &run(2).radiosity));
-}
-
 /// Hierarchical receivers: interpolating reflected light across coarse
 /// cells of the walls gives what evaluating every vertex gives (vertices
 /// within 0.5 % relative L1, every polygon's mean within 1 %, the darkest
@@ -252,7 +240,11 @@ fn interpolated_receivers_match_exact_ones() {
     let run = |interpolate: bool| {
         let options = SolverOptions {
             threshold: 1e-4,
-            receiver_interpolation: interpolate,
+            approximations: if interpolate {
+                Approximations::DEFAULT
+            } else {
+                Approximations::DEFAULT.without(&Heuristic::RECEIVERS)
+            },
             ..Default::default()
         };
         let mut solver = Progressive::new(&s, &mesh, &vis, options);
@@ -335,10 +327,11 @@ fn shared_facet_rays_match_per_vertex_rays() {
         s.polygons.len()
     );
     let run = |shared: bool| {
+        let options = SolverOptions {
+            approximations: options.approximations.with(Heuristic::FacetRays, shared),
+            ..options
+        };
         let mut solver = Progressive::new(&s, &mesh, &vis, options);
-        if !shared {
-            solver = solver.without_shared_rays();
-        }
         while !solver.is_done() && solver.step().is_some() {}
         solver.validate().unwrap();
         (solver.radiosity().to_vec(), solver.rays())

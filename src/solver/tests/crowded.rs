@@ -37,7 +37,11 @@ fn back_radiosity(s: &Scene, mesh: &Mesh, interpolate: bool) -> f64 {
     let vis = Visibility::new(s);
     let options = SolverOptions {
         threshold: 1e-6,
-        receiver_interpolation: interpolate,
+        approximations: if interpolate {
+            Approximations::DEFAULT
+        } else {
+            Approximations::DEFAULT.without(&Heuristic::RECEIVERS)
+        },
         ..Default::default()
     };
     let mut solver = Progressive::new(s, mesh, &vis, options);

@@ -42,7 +42,7 @@ fn solver<'a>(
 ) -> Progressive<'a> {
     let options = SolverOptions {
         threshold: 1e-3,
-        clustering,
+        approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
         ..Default::default()
     };
     Progressive::new(s, mesh, vis, options)

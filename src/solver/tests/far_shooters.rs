@@ -38,10 +38,11 @@ fn far_shooters_probed_match_asking_every_sample() {
     let mesh = regular_mesh(&s, 0.25);
     let vis = Visibility::new(&s);
     let lamp_shot = |probing: bool| {
-        let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
-        if !probing {
-            solver = solver.without_far_probes();
-        }
+        let options = SolverOptions {
+            approximations: Approximations::DEFAULT.with(Heuristic::FarShooters, probing),
+            ..Default::default()
+        };
+        let mut solver = Progressive::new(&s, &mesh, &vis, options);
         assert_eq!(solver.next_shooter(), Some(PolygonId(1)), "the lamp first");
         solver.step().expect("the lamp shoots");
         solver.validate().unwrap();

@@ -4,33 +4,8 @@
 
 use super::*;
 
-// Tolerances. The receiver is integrated on a 51 × 51 vertex grid with
-// the default inset; integrating the *exact* point form factor on that
-// grid gives 0.20005 for the perpendicular pair (0.005 % off), so the
-// quadrature is not what is measured. Both pairs must be within 0.5 % at
-// the default sample count.
-
-#[test]
-fn parallel_unit_squares() {
-    let f = measured_form_factor(BOTTOM, TOP, SolverOptions::default());
-    let err = (f - F_PARALLEL_UNIT_SQUARES).abs() / F_PARALLEL_UNIT_SQUARES;
-    eprintln!("parallel: F = {f}, exact {F_PARALLEL_UNIT_SQUARES}");
-    assert!(
-        err < 0.005,
-        "F = {f}, exact {F_PARALLEL_UNIT_SQUARES}, error {err}"
-    );
-}
-
-#[test]
-fn perpendicular_unit_squares() {
-    let f = measured_form_factor(BOTTOM, SIDE, SolverOptions::default());
-    let err = (f - F_PERPENDICULAR_UNIT_SQUARES).abs() / F_PERPENDICULAR_UNIT_SQUARES;
-    eprintln!("perpendicular: F = {f}, exact {F_PERPENDICULAR_UNIT_SQUARES}");
-    assert!(
-        err < 0.005,
-        "F = {f}, exact {F_PERPENDICULAR_UNIT_SQUARES}, error {err}"
-    );
-}
+// The unit squares' form factors at the default sample count are checked
+// for every method by the conformance suite (`tests/conformance.rs`).
 
 #[test]
 fn more_shooter_samples_converge_to_the_exact_value() {
@@ -39,7 +14,7 @@ fn more_shooter_samples_converge_to_the_exact_value() {
         TOP,
         SolverOptions {
             shooter_samples: ShooterSamples::AtMost(4),
-            near_field: false,
+            approximations: Approximations::DEFAULT.with(Heuristic::NearField, false),
             ..Default::default()
         },
     );
@@ -48,7 +23,7 @@ fn more_shooter_samples_converge_to_the_exact_value() {
         TOP,
         SolverOptions {
             shooter_samples: ShooterSamples::AtMost(400),
-            near_field: false,
+            approximations: Approximations::DEFAULT.with(Heuristic::NearField, false),
             ..Default::default()
         },
     );
@@ -318,7 +293,7 @@ fn a_leg_on_a_glowing_floor_at(x0: f32, y0: f32) {
             crate::mesh::DEFAULT_INSET,
             SolverOptions {
                 max_steps: Some(1),
-                clustering,
+                approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
                 ..Default::default()
             },
         );

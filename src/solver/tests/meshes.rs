@@ -150,7 +150,7 @@ fn continued_refinement_matches_a_fresh_solve() {
     // of the scene mean at worst), which is not what this checks.
     let options = SolverOptions {
         threshold: 1e-4,
-        receiver_interpolation: false,
+        approximations: Approximations::DEFAULT.without(&Heuristic::RECEIVERS),
         ..Default::default()
     };
     let continued = solve_adaptively(&s, 0.1, options);

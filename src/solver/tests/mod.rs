@@ -1,8 +1,12 @@
 //! The solver's unit tests, one file a topic, and the helpers they share
 //! (a solve to convergence, thread pools, bit-for-bit comparison).
 //!
-//! The hemicube's tests (`hemicube.rs`) are a child of
-//! [`super::hemicube`], whose private items they read.
+//! The closed-form checks every method must pass (unit squares, the
+//! uniform enclosure, energy balance, a shadow, thread counts) run over
+//! every method and unshot scheme in the conformance suite
+//! (`tests/conformance.rs`); these test what is progressive shooting's
+//! own. The hemicube's tests sit beside it
+//! ([`super::methods::hemicube`]).
 
 use super::*;
 use crate::mesh::{self, MeshOptions};
@@ -28,9 +32,6 @@ mod visibility;
 /// Exact form factor between two coaxial parallel unit squares one unit
 /// apart (Howell's catalogue, C-11).
 const F_PARALLEL_UNIT_SQUARES: f64 = 0.19982;
-/// Exact form factor between two unit squares meeting at a right angle
-/// along a full edge (Howell's catalogue, C-14).
-const F_PERPENDICULAR_UNIT_SQUARES: f64 = 0.20004;
 
 struct Solved {
     mesh: Mesh,
@@ -124,9 +125,6 @@ fn measured_form_factor(
 
 const BOTTOM: [[f32; 3]; 4] = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]];
 const TOP: [[f32; 3]; 4] = [[0., 0., 1.], [0., 1., 1.], [1., 1., 1.], [1., 0., 1.]];
-/// The unit square in the plane x = 0 sharing BOTTOM's edge along y,
-/// facing +x.
-const SIDE: [[f32; 3]; 4] = [[0., 0., 0.], [0., 1., 0.], [0., 1., 1.], [0., 0., 1.]];
 
 /// `|absorbed + unshot − emitted| / emitted` of a solve of a closed scene
 /// whose every polygon reflects.

@@ -1,4 +1,4 @@
-//! Overshooting ([`SolverOptions::overshoot`]) against its plain twin and
+//! Overshooting ([`Approximations::overshoot`]) against its plain twin and
 //! the closed forms: it must reach the same solution in fewer steps, keep
 //! the energy balance with signed unshot light, and save and resume a
 //! state holding negative unshot light bit for bit.
@@ -26,8 +26,9 @@ fn run(s: &Scene, lenmax: f32, threshold: f64, overshoot: bool, clustering: bool
         lenmax,
         SolverOptions {
             threshold,
-            overshoot,
-            clustering,
+            approximations: Approximations::DEFAULT
+                .with(Heuristic::Overshoot, overshoot)
+                .with(Heuristic::Clusters, clustering),
             ..Default::default()
         },
     )
@@ -146,7 +147,7 @@ fn overshooting_matches_the_plain_solve() {
 /// its stratum's light, and what it misses has no sign of its own. It
 /// moves with the far test's strictness: with the plane test asking 3,
 /// 4, 5, 6, 8 and 12 half depths above a weak step's cut
-/// ([`super::cluster::TOP_DEPTH_RATIO`], 6) it measured −0.090, −0.116,
+/// ([`crate::solver::tuning::TOP_DEPTH_RATIO`], 6) it measured −0.090, −0.116,
 /// −0.110, −0.107, −0.050 and +0.159 %. With the
 /// default interpolating receivers, within 0.2 % with and without
 /// overshooting (measured −0.08 % and −0.06 %; −0.50 % and −0.46 % when
@@ -169,13 +170,13 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     };
     let base = SolverOptions {
         threshold: 1e-5,
-        overshoot: false,
+        approximations: Approximations::DEFAULT.with(Heuristic::Overshoot, false),
         ..Default::default()
     };
     let alone = error(
         "unclustered",
         SolverOptions {
-            clustering: false,
+            approximations: base.approximations.with(Heuristic::Clusters, false),
             ..base
         },
     );
@@ -183,7 +184,7 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     let exact = error(
         "exact receivers",
         SolverOptions {
-            receiver_interpolation: false,
+            approximations: base.approximations.without(&Heuristic::RECEIVERS),
             ..base
         },
     );
@@ -195,7 +196,7 @@ fn overshooting_balances_energy_with_signed_unshot_light() {
     let over = error(
         "overshooting",
         SolverOptions {
-            overshoot: true,
+            approximations: base.approximations.with(Heuristic::Overshoot, true),
             ..base
         },
     );
@@ -229,7 +230,7 @@ fn negative_unshot_light_saves_and_resumes_bit_for_bit() {
         solver.unshot().iter().any(|u| u.min_channel() < 0.0),
         "negative unshot light is held"
     );
-    let bytes = checkpoint::encode(7, &solver, b"");
+    let bytes = checkpoint::encode(7, &solver.state(), b"");
     let saved = checkpoint::decode(&bytes).unwrap().state;
     let mut resumed = Progressive::new(&s, &mesh, &vis, options);
     let mut bad = saved.clone();

@@ -7,7 +7,6 @@
 use super::same_bits;
 use super::*;
 use crate::mesh::{self, MeshOptions};
-use crate::solver::step::parts;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
@@ -24,7 +23,7 @@ fn hall() -> (Scene, Mesh) {
     )
     .unwrap();
     let largest = m.polygons.iter().map(|p| p.vertex_count()).max().unwrap();
-    let per_chunk = parts::CHUNK_WORK / u64::from(DEFAULT_SHOOTER_SAMPLES);
+    let per_chunk = crate::solver::tuning::CHUNK_WORK / u64::from(DEFAULT_SHOOTER_SAMPLES);
     assert!(u64::from(largest) > per_chunk, "{largest} vertices");
     (s, m)
 }
@@ -65,7 +64,7 @@ fn a_step_in_parts_is_bit_identical_to_one_in_a_piece() {
     for base in [
         SolverOptions::default(),
         SolverOptions {
-            clustering: false,
+            approximations: Approximations::DEFAULT.with(Heuristic::Clusters, false),
             unshot: UnshotScheme::Polygon,
             ..Default::default()
         },

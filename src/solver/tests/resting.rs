@@ -1,7 +1,7 @@
 //! A tessellated ball resting on a floor, clustered against the
 //! unclustered twin: the thin gap between the two surfaces is lit only by
 //! light going back and forth between them, so an error in one cluster
-//! shot there adds up at every bounce ([`super::cluster::PLANE_DEPTH_RATIO`]).
+//! shot there adds up at every bounce ([`crate::solver::tuning::PLANE_DEPTH_RATIO`]).
 
 use super::*;
 use crate::testutil::sphere_box::uv_sphere;
@@ -83,7 +83,7 @@ fn the_gap_under_a_resting_ball_matches_the_unclustered_twin() {
     let mesh = regular_mesh(&s, LENMAX);
     let options = SolverOptions {
         threshold: THRESHOLD,
-        receiver_interpolation: false,
+        approximations: Approximations::DEFAULT.without(&Heuristic::RECEIVERS),
         ..Default::default()
     };
     let grouped = Progressive::new(&s, &mesh, &Visibility::new(&s), options)
@@ -95,7 +95,7 @@ fn the_gap_under_a_resting_ball_matches_the_unclustered_twin() {
         &s,
         &mesh,
         SolverOptions {
-            clustering: false,
+            approximations: options.approximations.with(Heuristic::Clusters, false),
             ..options
         },
     );

@@ -59,7 +59,7 @@ fn solve(s: &Scene, threshold: f64, settle: f64, clustering: bool) -> (Mesh, Vec
     let options = SolverOptions {
         threshold,
         settle,
-        clustering,
+        approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
         ..Default::default()
     };
     let mut solver = Progressive::new(s, &mesh, &vis, options);

@@ -365,10 +365,11 @@ fn sky_probes_match_asking_every_direction() {
     let mesh = crate::testutil::regular_mesh(&s, 0.1);
     let vis = Visibility::new(&s);
     let run = |probing: bool| {
-        let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
-        if !probing {
-            solver = solver.without_sky_probes();
-        }
+        let options = SolverOptions {
+            approximations: Approximations::DEFAULT.with(Heuristic::SkyProbes, probing),
+            ..Default::default()
+        };
+        let mut solver = Progressive::new(&s, &mesh, &vis, options);
         while !solver.is_done() && solver.step().is_some() {}
         solver.validate().unwrap();
         (solver.radiosity().to_vec(), solver.rays())

@@ -1,62 +1,8 @@
-//! Shadows: an occluder casts one, and shaft culling changes which rays
-//! are cast, never what they find.
+//! Shadows: shaft culling changes which rays are cast, never what they
+//! find. (That an occluder casts a shadow is checked for every method by
+//! the conformance suite, `tests/conformance.rs`.)
 
 use super::*;
-
-/// A floor vertex right below an opaque black square gets no direct
-/// light from the lamp above it, while one outside its shadow does.
-#[test]
-fn occluder_casts_a_shadow() {
-    let s = scene(
-        vec![
-            polygon(
-                0,
-                &[[-0.5, 0., 2.], [-0.5, 1., 2.], [0.5, 1., 2.], [0.5, 0., 2.]],
-            ), // lamp, faces -z
-            polygon(
-                1,
-                &[[-3., -2., 0.], [3., -2., 0.], [3., 3., 0.], [-3., 3., 0.]],
-            ), // floor, faces +z
-            polygon(
-                2,
-                &[
-                    [-1., -0.5, 1.],
-                    [1., -0.5, 1.],
-                    [1., 1.5, 1.],
-                    [-1., 1.5, 1.],
-                ],
-            ), // blocker
-        ],
-        vec![
-            grey("lamp", 1.0, 0.0),
-            grey("floor", 0.0, 0.5),
-            grey("black", 0.0, 0.0),
-        ],
-    );
-    let solved = solve(
-        &s,
-        0.25,
-        0.0,
-        SolverOptions {
-            max_steps: Some(1),
-            ..Default::default()
-        },
-    );
-    let m = &solved.mesh;
-    let vertex_at = |x: f32, y: f32| {
-        m.polygons[1]
-            .vertices
-            .clone()
-            .min_by(|&a, &b| {
-                let da = m.positions[a as usize].distance(glam::Vec3::new(x, y, 0.0));
-                let db = m.positions[b as usize].distance(glam::Vec3::new(x, y, 0.0));
-                da.total_cmp(&db)
-            })
-            .unwrap() as usize
-    };
-    assert_eq!(solved.radiosity[vertex_at(0.0, 0.5)], Rgb::BLACK);
-    assert!(solved.radiosity[vertex_at(2.5, 0.5)].r > 0.0);
-}
 
 /// Shaft culling changes which rays are cast, never what they find: the
 /// radiosities are bit for bit those of testing every ray against the BVH,
@@ -108,7 +54,8 @@ fn shaft_culling_changes_no_result_bit() {
             &mesh,
             &vis,
             SolverOptions {
-                shaft_culling,
+                approximations: Approximations::DEFAULT
+                    .with(Heuristic::ShaftCulling, shaft_culling),
                 max_steps: Some(25),
                 ..Default::default()
             },

@@ -29,28 +29,21 @@
 //! hemicubes do not line up (Cohen et al. 1988 rotate for the same
 //! reason).
 //!
-//! The solver ([`super::Progressive`]) places one hemicube at each of the
-//! shooter's grid samples (its `--shooter-samples` cells), each carrying
-//! its cell's area and unshot radiosity (a weak step merges its cells
-//! into fewer runs, one hemicube each: `Progressive::hemicube_points`),
-//! and spreads what the elements receive to their vertices
-//! ([`spread_to_vertices`]).
+//! The solver method ([`HemicubeMethod`], in `method.rs`) places one
+//! hemicube at each of the shooter's grid samples (its
+//! `--shooter-samples` cells), each carrying its cell's area and unshot
+//! radiosity (a weak step merges its cells into fewer runs, one hemicube
+//! each: `Progressive::hemicube_points`), and spreads what the elements
+//! receive to their vertices ([`spread_to_vertices`]).
 
-use super::distribution::Directional;
 use crate::mesh::Mesh;
+use crate::solver::kernel::distribution::Directional;
+use crate::solver::tuning::{DEFAULT_HEMICUBE_RES, HEMICUBE_EDGE_SLACK, HEMICUBE_NEAR_FRACTION};
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
 
-/// Default [`HemicubeRes`]: pixels across the top face. Measured
-/// (`docs/accuracy.md`, "Hemicube"): the unit squares' form factors from
-/// 64 hemicubes are within 0.03 % of the exact midpoint rule at 64
-/// pixels and 0.016 % at 128; the pictures of `rtable` and `cornell` are
-/// 3.0 % from the reference at 64, 2.4 to 2.8 % at 128 and 2.3 to 2.8 %
-/// at 256, while a solve at 128 takes 1.2 to 1.4 times as long as at 64
-/// and one at 256 1.6 to 1.7 times as long again. 128 buys most of what
-/// more pixels give; past it the error is mostly the shooter's
-/// quadrature (more cells, `--shooter-samples`, reduce it).
-pub const DEFAULT_HEMICUBE_RES: u32 = 128;
+mod method;
+pub use method::HemicubeMethod;
 
 /// Smallest resolution accepted: with fewer pixels a side face has under
 /// four rows and whole walls vanish between pixel centres.
@@ -60,18 +53,6 @@ pub const MIN_HEMICUBE_RES: u32 = 8;
 /// take 200 MB and each thread's item and depth buffers 134 MB, beyond
 /// any use (the error stops falling well before: `docs/accuracy.md`).
 pub const MAX_HEMICUBE_RES: u32 = 4096;
-
-/// A pixel's centre counts as inside a triangle when none of its
-/// barycentric weights is below minus this: a slack so that pixel
-/// centres on an edge shared by two triangles are never missed by both
-/// to rounding (a crack would let a farther element show through).
-const EDGE_SLACK: f32 = 1e-6;
-
-/// Near clipping distance of a hemicube, as a fraction of the square root
-/// of the area its shooter sample stands for: small enough that only an
-/// element passing within a hair of the eye is cut, large enough that
-/// `1/w` stays finite in `f32`.
-pub const NEAR_FRACTION: f32 = 1e-5;
 
 /// Pixels across the top face of a hemicube: an even number in
 /// [`MIN_HEMICUBE_RES`]`..=`[`MAX_HEMICUBE_RES`] (the side faces have
@@ -304,7 +285,7 @@ impl Hemicube {
     /// skip a polygon wholly outside a face. Writes `(element, F)` pairs
     /// into `out` (cleared first), sorted by element, each `F > 0`; their
     /// sum is at most 1. `near` is the near clipping distance in scene
-    /// units (see [`NEAR_FRACTION`]).
+    /// units (see [`HEMICUBE_NEAR_FRACTION`]).
     ///
     /// `weight`, when given, multiplies each pixel's delta form factor by
     /// its value at the pixel centre's direction (in the hemicube's
@@ -562,7 +543,7 @@ impl Face<'_> {
             return;
         }
         let inv_area = 1.0 / area;
-        let slack = -EDGE_SLACK;
+        let slack = -HEMICUBE_EDGE_SLACK;
         let x_min = p0[0].min(p1[0]).min(p2[0]);
         let x_max = p0[0].max(p1[0]).max(p2[0]);
         let y_min = p0[1].min(p1[1]).min(p2[1]);
@@ -662,7 +643,7 @@ pub fn luminaire_weight(directional: &Directional, frame: Frame) -> impl Fn(DVec
 
 /// What a hemicube step needs beyond the solver's own state: the delta
 /// form factors, every polygon's corners, and scratch. Built once per
-/// solve ([`super::Progressive::new`] with [`super::FormFactorMethod::Hemicube`]).
+/// solve ([`HemicubeMethod::new`]).
 #[derive(Debug)]
 pub(crate) struct Shooting {
     deltas: DeltaFormFactors,
@@ -713,7 +694,7 @@ impl Shooting {
         mesh: &Mesh,
         shooter: usize,
         directional: Option<&Directional>,
-        samples: &[super::formfactor::ShooterSample],
+        samples: &[crate::solver::kernel::formfactor::ShooterSample],
         shot: &[crate::color::Rgb],
         power: crate::color::Rgb,
         receives: &[bool],
@@ -751,7 +732,7 @@ impl Shooting {
                         }
                     }));
                     let seed = ((shooter as u64) << 32) ^ k as u64;
-                    let near = NEAR_FRACTION * (sample.area as f32).sqrt();
+                    let near = HEMICUBE_NEAR_FRACTION * (sample.area as f32).sqrt();
                     let frame = frame(normal, seed);
                     let weight = directional.map(|d| luminaire_weight(d, frame));
                     cube.form_factors(
@@ -807,5 +788,4 @@ impl Shooting {
 }
 
 #[cfg(test)]
-#[path = "tests/hemicube.rs"]
 mod tests;

@@ -275,8 +275,8 @@ fn spreading_to_vertices_keeps_the_power() {
 // The solver shooting by hemicubes.
 
 use crate::color::Rgb;
-use crate::solver::{FormFactorMethod, Progressive, SolverOptions, UnshotScheme};
-use crate::testutil::{closed_box, glowing_box, mean_radiosity};
+use crate::solver::{FormFactorMethod, Method, SolverOptions};
+use crate::testutil::glowing_box;
 use crate::visibility::Visibility;
 
 /// Hemicube solver options at the default resolution.
@@ -285,211 +285,6 @@ fn hemicube_options() -> SolverOptions {
         form_factor: FormFactorMethod::Hemicube,
         ..SolverOptions::default()
     }
-}
-
-/// A solve of `s` on a regular mesh: its mesh, radiosity per vertex,
-/// steps, initial and final unshot power.
-fn solve(
-    s: &crate::scene::Scene,
-    lenmax: f32,
-    options: SolverOptions,
-) -> (Mesh, Vec<Rgb>, u64, f64, f64) {
-    let m = crate::testutil::regular_mesh(s, lenmax);
-    let vis = Visibility::new(s);
-    let mut solver = Progressive::new(s, &m, &vis, options);
-    while !solver.is_done() && solver.step().is_some() {}
-    solver.validate().unwrap();
-    let out = (
-        solver.radiosity().to_vec(),
-        solver.steps(),
-        solver.initial_unshot_power(),
-        solver.net_unshot_power(),
-    );
-    (m, out.0, out.1, out.2, out.3)
-}
-
-/// One hemicube step from an emitting unit square (`e = 1`) to a unit
-/// square with `ρ = 0.5`: its mean radiosity is `0.5 · F(receiver →
-/// emitter)`, which for equal areas is the emitter's form factor to it.
-/// The solver's 64 cells and N = 128 are `unit_squares_from_a_grid_of_
-/// hemicubes`'s case, with the element areas and the spreading to
-/// vertices added (both exact in the mean): the same bound, 0.25 % plus
-/// 0.5 % of quadrature.
-#[test]
-fn solver_measures_unit_square_form_factors() {
-    for (receiver, exact) in [
-        (TOP, F_PARALLEL_UNIT_SQUARES),
-        (SIDE, F_PERPENDICULAR_UNIT_SQUARES),
-    ] {
-        let s = scene(
-            vec![polygon(0, &BOTTOM), polygon(1, &receiver)],
-            vec![grey("lamp", 1.0, 0.0), grey("wall", 0.0, 0.5)],
-        );
-        let options = SolverOptions {
-            max_steps: Some(1),
-            ..hemicube_options()
-        };
-        let (m, b, ..) = solve(&s, 0.02, options);
-        let f = mean_radiosity(&m, &b, 1).r / 0.5;
-        let err = (f - exact).abs() / exact;
-        eprintln!("F = {f}, exact {exact}, error {err}");
-        assert!(err < 0.0075, "F = {f}, exact {exact}");
-    }
-}
-
-/// In a closed box whose walls all have the same `e` and `ρ`, the exact
-/// solution is uniform, `B = e / (1 − ρ)`. Every hemicube's pixels all
-/// show some wall and sum to 1, and with per-vertex unshot radiosity
-/// each step hands on exactly the power it clears, so the walls' means
-/// are exact to the threshold (measured 0.01 %, bound 0.5 %). Single
-/// vertices carry the pixel outline error of the elements around them:
-/// a corner vertex holds the light of one element, which the hemicubes
-/// of the neighbouring walls see edge-on across a few pixel rows
-/// (measured 3.7 % at the worst vertex, 0.04 % for the ray-traced path;
-/// bound 5 %). The per-polygon scheme averages what a wall received
-/// with even vertex weights, which overweight the boundary vertices
-/// (they stand for half an element or less): measured 0.6 % on the
-/// walls' means, bound 1 %.
-#[test]
-fn uniform_enclosure() {
-    let (e, rho) = (1.0, 0.6);
-    let s = scene(closed_box(1.0, [0; 6]), vec![grey("wall", e, rho)]);
-    let exact = e / (1.0 - rho);
-    for unshot in [UnshotScheme::Polygon, UnshotScheme::Vertex] {
-        let options = SolverOptions {
-            unshot,
-            threshold: 1e-4,
-            ..hemicube_options()
-        };
-        let (m, b, steps, ..) = solve(&s, 0.1, options);
-        let worst = b
-            .iter()
-            .map(|b| (b.r - exact).abs() / exact)
-            .fold(0.0, f64::max);
-        let worst_wall = (0..6)
-            .map(|p| (mean_radiosity(&m, &b, p).r - exact).abs() / exact)
-            .fold(0.0, f64::max);
-        eprintln!("{unshot:?}: worst vertex {worst}, worst wall {worst_wall}");
-        let (wall_bound, vertex_bound) = match unshot {
-            UnshotScheme::Vertex => (0.005, 0.05),
-            UnshotScheme::Polygon => (0.01, 0.05),
-        };
-        assert!(worst_wall < wall_bound, "{unshot:?}: {worst_wall}");
-        assert!(worst < vertex_bound, "{unshot:?}: {worst}");
-        assert!(steps > 6);
-    }
-}
-
-/// `|absorbed + unshot − emitted| / emitted` in a closed room, where a
-/// polygon absorbs `A (1 − ρ)/ρ · (B − e)`. Every hemicube of a closed
-/// room sees walls in every pixel, and the delta form factors sum to 1:
-/// each step hands on exactly the power it clears (times ρ), so the
-/// balance is exact to rounding with per-vertex unshot radiosity (bound
-/// `1e-9`, measured `1e-15`). The per-polygon scheme averages received
-/// light with even vertex weights rather than area weights, as the
-/// ray-traced path does, and the hemicube's boundary vertices hold the
-/// light of the boundary elements alone: measured 1.6 % on this 20 × 20
-/// element grid, bound 2 %.
-#[test]
-fn energy_balance_in_a_closed_box() {
-    let s = glowing_box();
-    for (unshot, bound) in [(UnshotScheme::Vertex, 1e-9), (UnshotScheme::Polygon, 0.02)] {
-        let options = SolverOptions {
-            threshold: 1e-5,
-            unshot,
-            ..hemicube_options()
-        };
-        let (m, b, _, initial, left) = solve(&s, 0.1, options);
-        let absorbed = crate::testutil::absorbed_power(&s, &m, &b);
-        let error = (absorbed + left - initial).abs() / initial;
-        eprintln!("{unshot:?}: energy error {error}");
-        assert!(error < bound, "{unshot:?}: {error}");
-    }
-}
-
-/// In a box without its top, emitted = absorbed + escaped + unshot. What
-/// escapes is what the hemicubes' pixels through the opening carry: the
-/// power shot minus what the walls received. Summed over the steps with
-/// `Σ_elements` of received power, this is exact up to rounding for the
-/// per-vertex scheme; checked here through the closed forms instead, as
-/// the ray-traced path's test does: escaped power `Σ_x A_x B(x)
-/// F(x → opening)` with Lambert's exact `F`, whose evaluation at the
-/// vertices rather than over the elements the hemicube integrated
-/// leaves 0.5 % (the ray-traced path's bound).
-#[test]
-fn energy_balance_in_an_open_box() {
-    let mut walls = closed_box(2.0, [1, 2, 1, 0, 1, 2]);
-    let opening = walls.pop().unwrap();
-    let s = scene(
-        walls,
-        vec![
-            grey("lamp", 10.0, 0.3),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    );
-    let options = SolverOptions {
-        threshold: 1e-5,
-        ..hemicube_options()
-    };
-    let (m, b, _, emitted, left) = solve(&s, 0.1, options);
-    let areas = m.vertex_areas();
-    let (mut absorbed, mut escaped) = (0.0, 0.0);
-    for (p, polygon) in s.polygons.iter().enumerate() {
-        let material = &s.materials[polygon.material.index()];
-        let (rho, e) = (material.reflectance().r, material.emission().r);
-        let pm = &m.polygons[p];
-        for l in pm.vertices.clone() {
-            let (bl, a) = (b[l as usize].r, areas[l as usize]);
-            absorbed += a * (1.0 - rho) / rho * (bl - e);
-            let x = m.sample_positions[l as usize];
-            escaped += a * bl * point_to_polygon(x, pm.normal, &opening.vertices);
-        }
-    }
-    let error = (absorbed + escaped + left - emitted).abs() / emitted;
-    eprintln!("emitted {emitted}, absorbed {absorbed}, escaped {escaped}, error {error}");
-    assert!(escaped > 0.2 * emitted, "the opening lets light out");
-    assert!(error < 0.005, "energy error {error}");
-}
-
-/// One thread or two, the same bits: hemicubes are rendered in parallel
-/// but summed in sample order.
-#[test]
-fn thread_count_does_not_change_the_result() {
-    let mut polygons = closed_box(2.0, [1, 2, 1, 0, 1, 2]);
-    polygons.push(polygon(
-        1,
-        &[
-            [0.5, 0.5, 0.5],
-            [1.5, 0.5, 0.5],
-            [1.5, 0.5, 1.5],
-            [0.5, 0.5, 1.5],
-        ],
-    ));
-    let s = scene(
-        polygons,
-        vec![
-            grey("lamp", 10.0, 0.3),
-            grey("a", 0.0, 0.7),
-            grey("b", 0.0, 0.4),
-        ],
-    );
-    let options = SolverOptions {
-        max_steps: Some(12),
-        ..hemicube_options()
-    };
-    let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| solve(&s, 0.15, options).1)
-    };
-    let (a, b) = (run(1), run(2));
-    assert!(a
-        .iter()
-        .zip(&b)
-        .all(|(x, y)| x.to_array().map(f64::to_bits) == y.to_array().map(f64::to_bits)));
 }
 
 /// A checkpoint of a hemicube solve is refused by a solve with another
@@ -516,58 +311,6 @@ fn checkpoint_fingerprint_holds_method_and_resolution() {
     assert_eq!(print(hemi), print(hemicube_options()));
 }
 
-/// A floor vertex right below an opaque black square gets no direct light
-/// from the lamp above it, while one outside its shadow does. The blocker
-/// is 1 unit from the floor and the lamp 1 unit above it, so a floor
-/// point under the blocker's centre is an element or more inside the
-/// umbra: no pixel of any hemicube may see it.
-#[test]
-fn occluder_casts_a_shadow() {
-    let s = scene(
-        vec![
-            polygon(
-                0,
-                &[[-0.5, 0., 2.], [-0.5, 1., 2.], [0.5, 1., 2.], [0.5, 0., 2.]],
-            ),
-            polygon(
-                1,
-                &[[-3., -2., 0.], [3., -2., 0.], [3., 3., 0.], [-3., 3., 0.]],
-            ),
-            polygon(
-                2,
-                &[
-                    [-1., -0.5, 1.],
-                    [1., -0.5, 1.],
-                    [1., 1.5, 1.],
-                    [-1., 1.5, 1.],
-                ],
-            ),
-        ],
-        vec![
-            grey("lamp", 1.0, 0.0),
-            grey("floor", 0.0, 0.5),
-            grey("black", 0.0, 0.0),
-        ],
-    );
-    let options = SolverOptions {
-        max_steps: Some(1),
-        ..hemicube_options()
-    };
-    let (m, b, ..) = solve(&s, 0.25, options);
-    let vertex_at = |x: f32, y: f32| {
-        m.polygons[1]
-            .vertices
-            .clone()
-            .min_by(|&p, &q| {
-                let d = |v: u32| m.positions[v as usize].distance(Vec3::new(x, y, 0.0));
-                d(p).total_cmp(&d(q))
-            })
-            .unwrap() as usize
-    };
-    assert_eq!(b[vertex_at(0.0, 0.5)], Rgb::BLACK);
-    assert!(b[vertex_at(2.5, 0.5)].r > 0.0);
-}
-
 /// A weak step merges its shooter's cells into fewer hemicubes
 /// ([`Progressive::hemicube_points`]): at most the number asked, on the
 /// shooter, together standing for its whole area and carrying exactly
@@ -585,14 +328,18 @@ fn weak_steps_merge_cells_into_fewer_hemicubes_with_the_same_power() {
     )
     .unwrap();
     let vis = Visibility::new(&s);
-    let mut solver = Progressive::new(&s, &m, &vis, hemicube_options());
+    let mut method = HemicubeMethod::new(&s, &m, &vis, hemicube_options());
     // After the ceiling's shot every wall holds unshot light.
-    solver.step().unwrap();
+    method.step().unwrap();
+    let solver = &mut method.progressive;
     let shooter = solver.next_shooter().unwrap();
     let i = shooter.index();
     solver.read_shooter(shooter, crate::solver::unshot::Shot::PLAIN);
     let cells = solver.samples[i].len();
-    assert_eq!(cells, crate::solver::DEFAULT_SHOOTER_SAMPLES as usize);
+    assert_eq!(
+        cells,
+        crate::solver::tuning::DEFAULT_SHOOTER_SAMPLES as usize
+    );
     assert!(solver.hemicube_points(shooter, cells).is_none());
     let polygon = &s.polygons[i];
     let (lo, hi) = polygon.vertices.iter().fold(

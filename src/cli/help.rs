@@ -1,0 +1,147 @@
+//! The long help of the options whose text quotes a tuning constant,
+//! written from the constants themselves ([`crate::solver::tuning`]), so
+//! `--help` never says one number while the solver uses another.
+
+use super::args::Args;
+use crate::solver::tuning::{
+    CHECK_TOLERANCE, CLUSTER_EXTENT, EXACT_RATIO, FACET_SCALE_RATIO, FAR_PROBES, FAR_SHOOTER_RATIO,
+    NEAR_FIELD_RATIO, OVERSHOOT_SHARE, RECEIVER_STRIDE, RECEIVER_WEAK_SHARE, SKY_FACET_SAMPLES,
+    SKY_PROBES, WEAK_STRATUM_SHARE,
+};
+use clap::CommandFactory;
+
+/// The command's definition with the long help of every option that
+/// quotes a tuning constant filled in from it.
+pub fn command() -> clap::Command {
+    Args::command()
+        .mut_arg("no_near_field", |a| a.long_help(near_field()))
+        .mut_arg("no_clustering", |a| a.long_help(clustering()))
+        .mut_arg("exact_receivers", |a| a.long_help(exact_receivers()))
+        .mut_arg("no_overshoot", |a| a.long_help(overshoot()))
+}
+
+/// Parses the process's arguments with [`command`]'s help.
+pub fn parse() -> Result<Args, clap::Error> {
+    parse_from(std::env::args_os())
+}
+
+/// Parses `args` (the program's name first) with [`command`]'s help.
+pub fn parse_from<I, T>(args: I) -> Result<Args, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let matches = command().try_get_matches_from(args)?;
+    <Args as clap::FromArgMatches>::from_arg_matches(&matches)
+}
+
+/// A fraction as a percentage with as few digits as it needs (`0.02` →
+/// `2 %`, `0.003` → `0.3 %`).
+fn percent(f: f64) -> String {
+    format!("{} %", (f * 1000.0).round() / 10.0)
+}
+
+fn near_field() -> String {
+    format!(
+        "Use the disc approximation however near the receiver.\n\n\
+         Every shooter sample then uses the plain disc approximation \
+         a/(πr² + a); by default the exact point-to-cell form factor is used \
+         within {EXACT_RATIO} cell diameters, a quadrature of the cell to \
+         {NEAR_FIELD_RATIO}."
+    )
+}
+
+fn clustering() -> String {
+    format!(
+        "Shoot every polygon alone (the solver without clusters).\n\n\
+         By default nearby small polygons (a tessellated sphere, a chair) \
+         shoot their unshot power together in one step, from strata of their \
+         cells; no cluster is more than {CLUSTER_EXTENT} of the scene's \
+         diagonal across, and emitters always shoot alone. This is the \
+         brute-force twin, for comparison."
+    )
+}
+
+fn exact_receivers() -> String {
+    format!(
+        "Evaluate every receiving vertex exactly, in every step.\n\n\
+         By default, with clusters, a step of reflected light evaluates large \
+         receiving grids at every {stride}th row and column and at a check \
+         vertex in each cell between, and interpolates the cell's other \
+         vertices where the corners predict the check vertex within {check} \
+         (or {weak} of what it already holds), and a vertex takes a nearby \
+         part of the shooting cluster as one term when its light there is too \
+         weak to matter (within {stratum} of what the vertex holds). A facet \
+         under {facet} of an element across asks one shadow ray per shooter \
+         sample for all its vertices, in every step, and a vertex asks \
+         {SKY_PROBES} of a sky facet's {SKY_FACET_SAMPLES} directions first, \
+         the others only when those disagree; a vertex {FAR_SHOOTER_RATIO} or \
+         more diameters from a lamp asks {FAR_PROBES} of its samples first, the \
+         others only when those disagree. Emitters' shots are otherwise always \
+         exact. This is the exact twin, for comparison (`--without` turns off \
+         one of these at a time).",
+        stride = RECEIVER_STRIDE,
+        check = percent(CHECK_TOLERANCE),
+        weak = percent(RECEIVER_WEAK_SHARE),
+        stratum = percent(WEAK_STRATUM_SHARE),
+        facet = FACET_SCALE_RATIO,
+    )
+}
+
+fn overshoot() -> String {
+    format!(
+        "Shoot exactly the unshot light, never more.\n\n\
+         By default each point of a shooter also sends out the light it can \
+         expect to receive later (what it has received so far times the ratio \
+         of light still to come to light shot, at most {OVERSHOOT_SHARE} of its \
+         reflectance times the ambient term), which converges in fewer steps; \
+         what it sent ahead and never received is taken back by steps of \
+         negative light. This is the original algorithm, for comparison."
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What `--help` prints for `id`.
+    fn long_help(id: &str) -> String {
+        let command = command();
+        let arg = command
+            .get_arguments()
+            .find(|a| a.get_id() == id)
+            .unwrap_or_else(|| panic!("no option {id}"));
+        arg.get_long_help().expect("a long help").to_string()
+    }
+
+    #[test]
+    fn the_help_quotes_the_constants_the_solver_uses() {
+        let receivers = long_help("exact_receivers");
+        for quoted in [
+            format!("every {RECEIVER_STRIDE}th row"),
+            format!("{SKY_PROBES} of a sky facet's {SKY_FACET_SAMPLES} directions"),
+            format!("{FAR_SHOOTER_RATIO} or more diameters"),
+            format!("asks {FAR_PROBES} of its samples"),
+            format!("within {}", percent(CHECK_TOLERANCE)),
+        ] {
+            assert!(receivers.contains(&quoted), "{quoted:?} not in {receivers}");
+        }
+        assert!(long_help("no_near_field").contains(&format!("within {EXACT_RATIO} cell")));
+        assert!(long_help("no_clustering").contains(&format!("{CLUSTER_EXTENT} of the scene")));
+        assert!(long_help("no_overshoot").contains(&format!("at most {OVERSHOOT_SHARE} of")));
+    }
+
+    #[test]
+    fn percentages_keep_their_digits() {
+        assert_eq!(percent(0.02), "2 %");
+        assert_eq!(percent(0.003), "0.3 %");
+        assert_eq!(percent(0.001), "0.1 %");
+    }
+
+    #[test]
+    fn the_long_help_parses_as_the_derived_command_does() {
+        let args = parse_from(["radiosity", "scene.sc", "--exact-receivers"]).unwrap();
+        assert!(args.exact_receivers);
+        command().debug_assert();
+    }
+}

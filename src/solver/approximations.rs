@@ -1,0 +1,286 @@
+//! The solver's heuristics, one switch each, and the exact twin.
+//!
+//! Every acceleration and every rule of thumb the progressive solver uses
+//! is one field of [`Approximations`]. All are on by default
+//! ([`Approximations::DEFAULT`]); [`Approximations::EXACT`] is the
+//! brute-force twin that each is measured against: every polygon shoots
+//! alone from all its cells, in plain power order, exactly the light it
+//! holds, to every receiving vertex with its own shadow rays, each ray
+//! tested against the whole scene. Turning one switch off leaves the
+//! others as they are, so each heuristic can be checked against its twin
+//! alone (`tests/switches.rs`), and `radiosity --without NAME` does the
+//! same from the command line.
+//!
+//! Some switches act only inside another: the receiver heuristics
+//! (interpolation, weak strata, crowded cells, facet rays, sky probes, far
+//! shooters) only in a solve that clusters, and strata only with clusters.
+//! Clusters need Wallace's estimate on a grid of shooter cells
+//! ([`super::ShooterSamples::AtMost`]).
+
+/// One named switch per heuristic of the solver (`true`: in use). See the
+/// module documentation for the exact twin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Approximations {
+    /// Emitters that have not shot their own light go before any
+    /// reflector ([`super::tuning::PENDING_EMISSION`]). Off: plain power
+    /// order, the original algorithm.
+    pub emitters_first: bool,
+    /// Overshooting (Feda and Purgathofer 1992): a step also sends out the
+    /// light each point of its shooters is expected to receive later,
+    /// leaving their unshot radiosity negative until it arrives; what the
+    /// shrinking expectation no longer covers is shot as negative light
+    /// ([`super::tuning::OVERSHOOT_SHARE`]). Fewer steps to the same
+    /// residual. Off: unshot radiosity never goes below zero.
+    pub overshoot: bool,
+    /// Settling: past the threshold, go on shooting while some point still
+    /// holds more than [`super::SolverOptions::settle`] of its radiosity
+    /// unshot. Off: stop at the threshold alone.
+    pub settling: bool,
+    /// The exact point-to-cell form factor for receivers near a shooter
+    /// cell ([`super::tuning::EXACT_RATIO`],
+    /// [`super::tuning::NEAR_FIELD_RATIO`]). Off: the plain disc sum
+    /// however near (wrong near a cell: the original point-sample
+    /// estimate). The exact twin keeps it on.
+    pub near_field: bool,
+    /// Shadow rays tested only against the polygons in the shaft between
+    /// shooter and receiver. The same result bits either way; off tests
+    /// every ray against the whole scene's BVH.
+    pub shaft_culling: bool,
+    /// Nearby small polygons (a tessellated sphere, a chair) shoot their
+    /// unshot power together, from strata of their cells
+    /// ([`super::tuning::CLUSTER_EXTENT`]). Off: every polygon shoots
+    /// alone.
+    pub clusters: bool,
+    /// A step whose light is weak shoots from fewer, coarser strata
+    /// ([`super::tuning::FULL_STRATA_SHARE`], [`super::tuning::MIN_STRATA`]),
+    /// and a weak polygon shoots through strata as a cluster of one. Off:
+    /// every step shoots from as many cells as a full one.
+    pub strata: bool,
+    /// A step of reflected light evaluates large receiving grids at their
+    /// coarse vertices and a check vertex per cell, and interpolates the
+    /// rest where the check holds ([`super::accel::receivers`]). Off: every
+    /// receiving vertex is evaluated.
+    pub receiver_interpolation: bool,
+    /// A near stratum whose light is weak at a vertex is taken as one term
+    /// ([`super::tuning::WEAK_STRATUM_SHARE`]). Off: every near stratum is
+    /// descended into.
+    pub weak_strata: bool,
+    /// A receiving cell that another polygon reaches close in front of is
+    /// never interpolated ([`super::tuning::CROWD_RATIO`]). A guard of
+    /// receiver interpolation: off, crowded cells are interpolated like
+    /// any other (only to measure what the guard buys).
+    pub crowded_cells: bool,
+    /// A facet under half an element across asks one shadow ray per
+    /// shooter sample for all its vertices ([`super::accel::facets`]).
+    /// Off: each vertex asks its own.
+    pub facet_rays: bool,
+    /// A receiving vertex asks a few of a sky facet's directions first,
+    /// the rest only when they disagree ([`super::accel::probes`]). Off:
+    /// every direction.
+    pub sky_probes: bool,
+    /// A vertex far from a lamp shooting alone asks a few of its samples
+    /// first, the rest only when they disagree
+    /// ([`super::accel::far_shooters`]). Off: every sample.
+    pub far_shooters: bool,
+}
+
+/// The name of one switch of [`Approximations`], as the command line
+/// spells it (`--without clusters,overshoot`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Heuristic {
+    /// [`Approximations::emitters_first`].
+    EmittersFirst,
+    /// [`Approximations::overshoot`].
+    Overshoot,
+    /// [`Approximations::settling`].
+    Settling,
+    /// [`Approximations::near_field`].
+    NearField,
+    /// [`Approximations::shaft_culling`].
+    ShaftCulling,
+    /// [`Approximations::clusters`].
+    Clusters,
+    /// [`Approximations::strata`].
+    Strata,
+    /// [`Approximations::receiver_interpolation`].
+    ReceiverInterpolation,
+    /// [`Approximations::weak_strata`].
+    WeakStrata,
+    /// [`Approximations::crowded_cells`].
+    CrowdedCells,
+    /// [`Approximations::facet_rays`].
+    FacetRays,
+    /// [`Approximations::sky_probes`].
+    SkyProbes,
+    /// [`Approximations::far_shooters`].
+    FarShooters,
+}
+
+impl Heuristic {
+    /// Every switch, in the order of [`Approximations`]' fields.
+    pub const ALL: [Heuristic; 13] = [
+        Heuristic::EmittersFirst,
+        Heuristic::Overshoot,
+        Heuristic::Settling,
+        Heuristic::NearField,
+        Heuristic::ShaftCulling,
+        Heuristic::Clusters,
+        Heuristic::Strata,
+        Heuristic::ReceiverInterpolation,
+        Heuristic::WeakStrata,
+        Heuristic::CrowdedCells,
+        Heuristic::FacetRays,
+        Heuristic::SkyProbes,
+        Heuristic::FarShooters,
+    ];
+
+    /// The switches `--exact-receivers` turns off: every receiving vertex
+    /// evaluated with its own rays, in every step.
+    pub const RECEIVERS: [Heuristic; 6] = [
+        Heuristic::ReceiverInterpolation,
+        Heuristic::WeakStrata,
+        Heuristic::CrowdedCells,
+        Heuristic::FacetRays,
+        Heuristic::SkyProbes,
+        Heuristic::FarShooters,
+    ];
+}
+
+impl Approximations {
+    /// Every heuristic in use: what a solve runs with unless told otherwise.
+    pub const DEFAULT: Approximations = Approximations {
+        emitters_first: true,
+        overshoot: true,
+        settling: true,
+        near_field: true,
+        shaft_culling: true,
+        clusters: true,
+        strata: true,
+        receiver_interpolation: true,
+        weak_strata: true,
+        crowded_cells: true,
+        facet_rays: true,
+        sky_probes: true,
+        far_shooters: true,
+    };
+
+    /// The brute-force twin: no heuristic that trades accuracy or a
+    /// different order of shooting for speed. The near field stays (it is
+    /// the exact form factor near a cell, which the plain disc sum only
+    /// approximates) and so does settling (it only goes on where light is
+    /// left). Shaft culling is off: the same bits, every ray tested against
+    /// the whole scene.
+    pub const EXACT: Approximations = Approximations {
+        emitters_first: false,
+        overshoot: false,
+        settling: true,
+        near_field: true,
+        shaft_culling: false,
+        clusters: false,
+        strata: false,
+        receiver_interpolation: false,
+        weak_strata: false,
+        crowded_cells: false,
+        facet_rays: false,
+        sky_probes: false,
+        far_shooters: false,
+    };
+
+    /// Whether switch `h` is on.
+    pub fn get(&self, h: Heuristic) -> bool {
+        *self.field(h)
+    }
+
+    /// This value with switch `h` set to `on`, the others as they are.
+    pub fn with(mut self, h: Heuristic, on: bool) -> Approximations {
+        *self.field_mut(h) = on;
+        self
+    }
+
+    /// This value with every switch of `group` off.
+    pub fn without(self, group: &[Heuristic]) -> Approximations {
+        group.iter().fold(self, |a, &h| a.with(h, false))
+    }
+
+    /// The switches as bits, in the order of [`Heuristic::ALL`] (bit 0
+    /// first): what a checkpoint's fingerprint hashes.
+    pub fn bits(&self) -> u64 {
+        Heuristic::ALL
+            .iter()
+            .enumerate()
+            .fold(0, |b, (i, &h)| b | (u64::from(self.get(h)) << i))
+    }
+
+    fn field(&self, h: Heuristic) -> &bool {
+        match h {
+            Heuristic::EmittersFirst => &self.emitters_first,
+            Heuristic::Overshoot => &self.overshoot,
+            Heuristic::Settling => &self.settling,
+            Heuristic::NearField => &self.near_field,
+            Heuristic::ShaftCulling => &self.shaft_culling,
+            Heuristic::Clusters => &self.clusters,
+            Heuristic::Strata => &self.strata,
+            Heuristic::ReceiverInterpolation => &self.receiver_interpolation,
+            Heuristic::WeakStrata => &self.weak_strata,
+            Heuristic::CrowdedCells => &self.crowded_cells,
+            Heuristic::FacetRays => &self.facet_rays,
+            Heuristic::SkyProbes => &self.sky_probes,
+            Heuristic::FarShooters => &self.far_shooters,
+        }
+    }
+
+    fn field_mut(&mut self, h: Heuristic) -> &mut bool {
+        match h {
+            Heuristic::EmittersFirst => &mut self.emitters_first,
+            Heuristic::Overshoot => &mut self.overshoot,
+            Heuristic::Settling => &mut self.settling,
+            Heuristic::NearField => &mut self.near_field,
+            Heuristic::ShaftCulling => &mut self.shaft_culling,
+            Heuristic::Clusters => &mut self.clusters,
+            Heuristic::Strata => &mut self.strata,
+            Heuristic::ReceiverInterpolation => &mut self.receiver_interpolation,
+            Heuristic::WeakStrata => &mut self.weak_strata,
+            Heuristic::CrowdedCells => &mut self.crowded_cells,
+            Heuristic::FacetRays => &mut self.facet_rays,
+            Heuristic::SkyProbes => &mut self.sky_probes,
+            Heuristic::FarShooters => &mut self.far_shooters,
+        }
+    }
+}
+
+impl Default for Approximations {
+    fn default() -> Self {
+        Approximations::DEFAULT
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_switch_is_its_own_field() {
+        for (i, &h) in Heuristic::ALL.iter().enumerate() {
+            let off = Approximations::DEFAULT.with(h, false);
+            assert!(!off.get(h));
+            assert_eq!(
+                off.bits(),
+                Approximations::DEFAULT.bits() & !(1 << i),
+                "{h:?}"
+            );
+        }
+        assert_eq!(
+            Approximations::DEFAULT.bits(),
+            (1 << Heuristic::ALL.len()) - 1
+        );
+    }
+
+    #[test]
+    fn the_exact_twin_keeps_only_what_is_exact() {
+        let on: Vec<Heuristic> = Heuristic::ALL
+            .into_iter()
+            .filter(|&h| Approximations::EXACT.get(h))
+            .collect();
+        assert_eq!(on, [Heuristic::Settling, Heuristic::NearField]);
+    }
+}
