@@ -138,6 +138,15 @@ pub enum PolygonError {
         /// The largest distance allowed, in scene units.
         tolerance: f64,
     },
+    /// A triangle whose angle at a vertex is so small that its boundary
+    /// doubles back there: three nearly collinear vertices that still
+    /// enclose more than [`ZERO_AREA_TOLERANCE`] of area (a sliver, as
+    /// exporters write by the thousand). A triangle is never concave.
+    #[error("triangle is a sliver: its angle at vertex {vertex} is almost zero")]
+    Sliver {
+        /// The vertex of the vanishing angle, from 1.
+        vertex: usize,
+    },
     /// The polygon turns the wrong way (or folds back) at a vertex.
     #[error("polygon is not convex at vertex {vertex}")]
     NotConvex {
@@ -298,6 +307,12 @@ fn analyze(vertices: &[Vec3]) -> Result<Analysis, PolygonError> {
         // A straight-through vertex (cos ≈ 1) is allowed; one where the
         // boundary doubles back (cos ≈ -1) is a fold, not a convex corner.
         if sin < -CONVEXITY_TOLERANCE || (sin.abs() <= CONVEXITY_TOLERANCE && cos < 0.0) {
+            // A triangle of positive area turns the same way at every
+            // vertex: a fold can only be a vanishing angle, not a concave
+            // corner.
+            if n == 3 {
+                return Err(PolygonError::Sliver { vertex: i + 1 });
+            }
             return Err(PolygonError::NotConvex { vertex: i + 1 });
         }
         turning += sin.atan2(cos);
@@ -537,6 +552,18 @@ mod tests {
             ]),
             "polygon is not convex at vertex 2"
         );
+    }
+
+    /// A triangle whose tip angle vanishes (4.5e-7 radians) but whose area
+    /// is above the zero-area bound is a sliver, never "not convex".
+    #[test]
+    fn a_sliver_triangle_is_named_so() {
+        assert_eq!(
+            err(&[[0.0, 0.0, 0.0], [1000.0, 0.0, 0.0], [2000.0, 0.0009, 0.0]]),
+            "triangle is a sliver: its angle at vertex 1 is almost zero"
+        );
+        // A thin triangle with a real angle is a triangle.
+        ok(&[[0.0, 0.0, 0.0], [1000.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     }
 
     #[test]

@@ -49,7 +49,8 @@
 //!   says nothing), transmitting (`KHR_materials_transmission`) and
 //!   alpha-blended materials are treated as diffuse (one warning naming
 //!   them);
-//! - degenerate triangles (no area, a repeated vertex) are dropped;
+//! - degenerate triangles (no area, a repeated vertex, a sliver whose
+//!   angle vanishes) are dropped;
 //! - a point or line primitive is not a surface and is skipped (when
 //!   nothing else is left the file is refused, naming it);
 //! - a texture that cannot be read leaves its factor alone;

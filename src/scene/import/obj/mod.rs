@@ -661,7 +661,10 @@ enum FaceError {
 pub(super) fn is_degenerate(e: &PolygonError) -> bool {
     matches!(
         e,
-        PolygonError::ZeroArea | PolygonError::EqualVertices { .. } | PolygonError::TooSmall { .. }
+        PolygonError::ZeroArea
+            | PolygonError::EqualVertices { .. }
+            | PolygonError::TooSmall { .. }
+            | PolygonError::Sliver { .. }
     )
 }
 

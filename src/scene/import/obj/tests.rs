@@ -115,6 +115,25 @@ fn warning_lines(s: &Scene) -> Vec<String> {
     s.warnings.iter().map(|w| w.to_string()).collect()
 }
 
+/// A sliver (three nearly collinear vertices enclosing a little area, as
+/// exporters write at seams) is dropped as a degenerate face, not refused
+/// as "not convex".
+#[test]
+fn sliver_triangles_are_dropped_not_refused() {
+    let obj = "v 0 0 0\nv 1000 0 0\nv 2000 0.0009 0\nv 0 1000 0\n\
+               f 1 2 4\nf 1 2 3\n";
+    let s = parse(obj).unwrap();
+    assert_eq!(s.polygons.len(), 1);
+    assert_eq!(
+        warning_lines(&s),
+        vec![
+            "m.obj:6:1: warning: dropped 1 degenerate face(s) (no area, or a vertex \
+                 repeated); the first here: triangle is a sliver: its angle at vertex 1 is \
+                 almost zero"
+        ]
+    );
+}
+
 #[test]
 fn degenerate_faces_are_dropped_with_one_summary_warning() {
     // As 3ds Max writes them at UV seams: zero-area slivers and
