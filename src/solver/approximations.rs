@@ -188,7 +188,9 @@ impl Approximations {
 
     /// Whether switch `h` is on.
     pub fn get(&self, h: Heuristic) -> bool {
-        *self.field(h)
+        // One table of fields serves both ways: read through a copy.
+        let mut copy = *self;
+        *copy.field_mut(h)
     }
 
     /// This value with switch `h` set to `on`, the others as they are.
@@ -209,24 +211,6 @@ impl Approximations {
             .iter()
             .enumerate()
             .fold(0, |b, (i, &h)| b | (u64::from(self.get(h)) << i))
-    }
-
-    fn field(&self, h: Heuristic) -> &bool {
-        match h {
-            Heuristic::EmittersFirst => &self.emitters_first,
-            Heuristic::Overshoot => &self.overshoot,
-            Heuristic::Settling => &self.settling,
-            Heuristic::NearField => &self.near_field,
-            Heuristic::ShaftCulling => &self.shaft_culling,
-            Heuristic::Clusters => &self.clusters,
-            Heuristic::Strata => &self.strata,
-            Heuristic::ReceiverInterpolation => &self.receiver_interpolation,
-            Heuristic::WeakStrata => &self.weak_strata,
-            Heuristic::CrowdedCells => &self.crowded_cells,
-            Heuristic::FacetRays => &self.facet_rays,
-            Heuristic::SkyProbes => &self.sky_probes,
-            Heuristic::FarShooters => &self.far_shooters,
-        }
     }
 
     fn field_mut(&mut self, h: Heuristic) -> &mut bool {
