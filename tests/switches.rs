@@ -97,12 +97,16 @@ fn switches() -> Vec<Switch> {
         off(SkyProbes, RelativeL1(1e-5)),
         // 0 everywhere: the far lamp's probes agree; it casts fewer rays.
         off(FarShooters, RelativeL1(1e-5)),
-        // 2.7e-4, 4.2e-4, 2.9e-4, 6e-7, 2.5e-7.
-        Switch { name: "--exact-receivers", twin: Approximations::DEFAULT.without(&Heuristic::RECEIVERS), tolerance: RelativeL1(1.5e-3), skip: &[] },
-        // 5.7e-4, 5.9e-4, (3.5e-4), 1.3e-6, 5e-7. The brute-force twin, but
+        // 0, 1.4e-3, 2.6e-4, 9.8e-7, 0: a tile's or a facet's vertex
+        // takes its neighbour's value at the same point, a twentieth of an
+        // element from its own inset point.
+        off(SharedReceivers, RelativeL1(3e-3)),
+        // 2.7e-4, 1.6e-3, 5.1e-4, 1.2e-6, 2.5e-7.
+        Switch { name: "--exact-receivers", twin: Approximations::DEFAULT.without(&Heuristic::RECEIVERS), tolerance: RelativeL1(3.5e-3), skip: &[] },
+        // 5.7e-4, 1.6e-3, (3.5e-4), 2.3e-6, 5e-7. The brute-force twin, but
         // for shaft culling, which changes no bit (its own row) and
         // would only multiply the rays.
-        Switch { name: "Approximations::EXACT", twin: Approximations::EXACT.with(ShaftCulling, true), tolerance: RelativeL1(2e-3), skip: &["spheres"] },
+        Switch { name: "Approximations::EXACT", twin: Approximations::EXACT.with(ShaftCulling, true), tolerance: RelativeL1(3.5e-3), skip: &["spheres"] },
     ]
 }
 

@@ -147,7 +147,8 @@ pub struct Args {
     /// Each is one switch, measured against its twin: emitters-first,
     /// overshoot, settling, near-field, shaft-culling, clusters, strata,
     /// receiver-interpolation, weak-strata, crowded-cells, facet-rays,
-    /// sky-probes, far-shooters. `docs/accuracy.md` gives what each costs
+    /// sky-probes, far-shooters, shared-receivers. `docs/accuracy.md`
+    /// gives what each costs
     /// and buys.
     #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
     pub(crate) without: Vec<Heuristic>,

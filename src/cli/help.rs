@@ -5,8 +5,8 @@
 use super::args::Args;
 use crate::solver::tuning::{
     CHECK_TOLERANCE, CLUSTER_EXTENT, EXACT_RATIO, FACET_SCALE_RATIO, FAR_PROBES, FAR_SHOOTER_RATIO,
-    NEAR_FIELD_RATIO, OVERSHOOT_SHARE, RECEIVER_STRIDE, RECEIVER_WEAK_SHARE, SKY_FACET_SAMPLES,
-    SKY_PROBES, WEAK_STRATUM_SHARE,
+    NEAR_FIELD_RATIO, OVERSHOOT_SHARE, RECEIVER_STRIDE, RECEIVER_WEAK_SHARE, SHARE_CREASE_DEG,
+    SKY_FACET_SAMPLES, SKY_PROBES, WEAK_STRATUM_SHARE,
 };
 use clap::CommandFactory;
 
@@ -77,7 +77,9 @@ fn exact_receivers() -> String {
          {SKY_PROBES} of a sky facet's {SKY_FACET_SAMPLES} directions first, \
          the others only when those disagree; a vertex {FAR_SHOOTER_RATIO} or \
          more diameters from a lamp asks {FAR_PROBES} of its samples first, the \
-         others only when those disagree. Emitters' shots are otherwise always \
+         others only when those disagree. Vertices of polygons of one surface \
+         at one point (coplanar, or smooth within {SHARE_CREASE_DEG}°) take \
+         the value of the first of them. Emitters' shots are otherwise always \
          exact. This is the exact twin, for comparison (`--without` turns off \
          one of these at a time).",
         stride = RECEIVER_STRIDE,
@@ -122,6 +124,7 @@ mod tests {
             format!("{SKY_PROBES} of a sky facet's {SKY_FACET_SAMPLES} directions"),
             format!("{FAR_SHOOTER_RATIO} or more diameters"),
             format!("asks {FAR_PROBES} of its samples"),
+            format!("smooth within {SHARE_CREASE_DEG}°"),
             format!("within {}", percent(CHECK_TOLERANCE)),
         ] {
             assert!(receivers.contains(&quoted), "{quoted:?} not in {receivers}");

@@ -13,7 +13,7 @@
 //!
 //! Some switches act only inside another: the receiver heuristics
 //! (interpolation, weak strata, crowded cells, facet rays, sky probes, far
-//! shooters) only in a solve that clusters, and strata only with clusters.
+//! shooters, shared receivers) only in a solve that clusters, and strata only with clusters.
 //! Clusters need Wallace's estimate on a grid of shooter cells
 //! ([`super::ShooterSamples::AtMost`]).
 
@@ -82,6 +82,11 @@ pub struct Approximations {
     /// first, the rest only when they disagree
     /// ([`super::accel::far_shooters`]). Off: every sample.
     pub far_shooters: bool,
+    /// Vertices of one surface at one point (a triangulated wall's, a
+    /// smooth sphere's facets') receive as one, the lowest-numbered
+    /// evaluated and the others taking its `Δrad`
+    /// ([`super::accel::shared`]). Off: each is evaluated alone.
+    pub shared_receivers: bool,
 }
 
 /// The name of one switch of [`Approximations`], as the command line
@@ -114,11 +119,13 @@ pub enum Heuristic {
     SkyProbes,
     /// [`Approximations::far_shooters`].
     FarShooters,
+    /// [`Approximations::shared_receivers`].
+    SharedReceivers,
 }
 
 impl Heuristic {
     /// Every switch, in the order of [`Approximations`]' fields.
-    pub const ALL: [Heuristic; 13] = [
+    pub const ALL: [Heuristic; 14] = [
         Heuristic::EmittersFirst,
         Heuristic::Overshoot,
         Heuristic::Settling,
@@ -132,17 +139,19 @@ impl Heuristic {
         Heuristic::FacetRays,
         Heuristic::SkyProbes,
         Heuristic::FarShooters,
+        Heuristic::SharedReceivers,
     ];
 
     /// The switches `--exact-receivers` turns off: every receiving vertex
     /// evaluated with its own rays, in every step.
-    pub const RECEIVERS: [Heuristic; 6] = [
+    pub const RECEIVERS: [Heuristic; 7] = [
         Heuristic::ReceiverInterpolation,
         Heuristic::WeakStrata,
         Heuristic::CrowdedCells,
         Heuristic::FacetRays,
         Heuristic::SkyProbes,
         Heuristic::FarShooters,
+        Heuristic::SharedReceivers,
     ];
 }
 
@@ -162,6 +171,7 @@ impl Approximations {
         facet_rays: true,
         sky_probes: true,
         far_shooters: true,
+        shared_receivers: true,
     };
 
     /// The brute-force twin: no heuristic that trades accuracy or a
@@ -184,6 +194,7 @@ impl Approximations {
         facet_rays: false,
         sky_probes: false,
         far_shooters: false,
+        shared_receivers: false,
     };
 
     /// Whether switch `h` is on.
@@ -228,6 +239,7 @@ impl Approximations {
             Heuristic::FacetRays => &mut self.facet_rays,
             Heuristic::SkyProbes => &mut self.sky_probes,
             Heuristic::FarShooters => &mut self.far_shooters,
+            Heuristic::SharedReceivers => &mut self.shared_receivers,
         }
     }
 }

@@ -98,7 +98,7 @@ pub use methods::hemicube;
 use crate::solver::tuning::{
     DEFAULT_SETTLE, DEFAULT_SHOOTER_SAMPLES, DEFAULT_THRESHOLD, SHAFT_MIN_VERTICES, TILE_VERTICES,
 };
-use accel::{cluster, facets, far_shooters, receivers, subcells};
+use accel::{cluster, facets, far_shooters, receivers, shared, subcells};
 pub use ambient::first_look;
 use ambient::{ambient_term, sky_power_weights};
 pub use approximations::{Approximations, Heuristic};
@@ -423,6 +423,10 @@ pub struct Progressive<'a> {
     small: Vec<bool>,
     /// The small facets whose vertices share their shadow rays.
     facets: Facets,
+    /// Per vertex: the vertex whose `Δrad` it takes, or
+    /// [`shared::ALONE`] ([`shared`]); empty when receivers are not
+    /// shared.
+    leaders: Vec<u32>,
     /// Per polygon: a sky facet's probe samples ([`accel::probes`]), empty for
     /// every other polygon and when probing is off.
     probes: Vec<Vec<u32>>,
@@ -623,6 +627,7 @@ impl<'a> Progressive<'a> {
             coarse_delta: vec![Rgb::BLACK; mesh.vertex_count()],
             facets: Facets::new(mesh, clustered && approx.facet_rays),
             probes: sky_probes,
+            leaders: shared::leaders(scene, mesh, clustered && approx.shared_receivers),
             far_shooters,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,

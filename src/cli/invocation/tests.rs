@@ -119,6 +119,7 @@ fn every_option_reaches_the_config() {
                 Heuristic::FacetRays,
                 Heuristic::SkyProbes,
                 Heuristic::FarShooters,
+                Heuristic::SharedReceivers,
                 Heuristic::Overshoot,
             ]),
             unshot: UnshotScheme::Vertex,

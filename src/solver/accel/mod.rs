@@ -11,11 +11,13 @@
 //! - [`probes`]: a sky facet's directions probed first;
 //! - [`far_shooters`]: a far shooter's samples probed first;
 //! - [`subcells`]: shooter cells much larger than their elements, shot as
-//!   their sub-cells.
+//!   their sub-cells;
+//! - [`shared`]: vertices of one surface at one point receiving as one.
 
 pub mod cluster;
 pub mod facets;
 pub mod far_shooters;
 pub mod probes;
 pub mod receivers;
+pub mod shared;
 pub mod subcells;

@@ -53,6 +53,14 @@ impl<'a> Progressive<'a> {
                 }
             }
             self.unshot.accumulate(mesh, j, &self.delta);
+            if negative {
+                // `delta` keeps what was gathered, whatever its sign, for
+                // the whole step: a shared receiver in a later chunk takes
+                // its leader's value from it ([`crate::solver::accel::shared`]).
+                for l in pm.vertices.clone() {
+                    self.delta[l as usize] = -self.delta[l as usize];
+                }
+            }
         }
     }
 

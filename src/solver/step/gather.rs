@@ -28,7 +28,7 @@ use crate::solver::accel::cluster::Clusters;
 use crate::solver::accel::facets::Facets;
 use crate::solver::accel::facets::Scratch;
 use crate::solver::accel::receivers::CoarseGrid;
-use crate::solver::accel::{probes, receivers, subcells};
+use crate::solver::accel::{probes, receivers, shared, subcells};
 use crate::solver::kernel::distribution;
 use crate::solver::tuning::{
     LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
@@ -191,6 +191,7 @@ impl<'a> Progressive<'a> {
             shooter: self.clusters.bounds(cluster),
             positions: &self.mesh.positions,
             held: &self.radiosity,
+            leaders: &self.leaders,
         }
     }
 }
@@ -339,9 +340,29 @@ pub(in crate::solver) struct Interpolating<'s> {
     pub(in crate::solver) positions: &'s [glam::Vec3],
     /// Per vertex, the radiosity before the step.
     pub(in crate::solver) held: &'s [Rgb],
+    /// Per vertex, the vertex whose `Δrad` it takes ([`shared`]); empty
+    /// when receivers are not shared.
+    pub(in crate::solver) leaders: &'s [u32],
 }
 
 impl Interpolating<'_> {
+    /// The vertex whose first-pass `Δrad` vertex `l` of polygon `j` takes
+    /// ([`shared`]): its leader, when its polygon receives and both are
+    /// evaluated exactly in the first pass. The leader's polygon comes
+    /// first, so its first pass is done by the end of the first pass over
+    /// `l`'s chunk, however the step is cut into chunks; what decides
+    /// depends on the step alone, so the bits do not depend on the cut.
+    fn leader(&self, l: usize, j: PolygonId, poly: &[PolygonId]) -> Option<usize> {
+        let m = *self.leaders.get(l)?;
+        if m == shared::ALONE {
+            return None;
+        }
+        let m = m as usize;
+        let k = poly[m];
+        (self.receives[k.index()] && self.cell(m, k).is_none() && self.cell(l, j).is_none())
+            .then_some(m)
+    }
+
     /// The coarse cell vertex `l` of polygon `j` may be interpolated from.
     fn cell(&self, l: usize, j: PolygonId) -> Option<receivers::Interpolation> {
         if !self.on || !self.receives[j.index()] || self.clusters.of(j) == self.cluster {
@@ -409,6 +430,9 @@ where
     let start = vertices.start;
     let mut gathered = Gathered { pairs: 0, rays: 0 };
     if let Stage::All | Stage::Exact { .. } = stage {
+        // Shared receivers follow a leader gathered in the same call.
+        let poly = &mesh.vertex_polygon[..];
+        let follows = |l: usize, j: PolygonId| cells.leader(l, j, poly);
         let (pairs, rays) = par_runs(
             mesh,
             &mut delta[vertices.clone()],
@@ -418,6 +442,7 @@ where
                 if !receives[j.index()]
                     || cancel.load(Ordering::Relaxed)
                     || cells.cell(l, j).is_some()
+                    || follows(l, j).is_some()
                 {
                     *delta = Rgb::BLACK;
                     return (0, 0);
@@ -429,6 +454,16 @@ where
         );
         if cancel.load(Ordering::Relaxed) {
             return None;
+        }
+        if !cells.leaders.is_empty() {
+            for l in vertices.clone() {
+                let j = poly[l];
+                if receives[j.index()] {
+                    if let Some(m) = follows(l, j) {
+                        delta[l] = delta[m];
+                    }
+                }
+            }
         }
         gathered.add(Gathered { pairs, rays });
         if !cells.on {
