@@ -16,7 +16,8 @@
 //!   finite radiosity everywhere.
 //!
 //! A full solve of one of these takes minutes to hours (issue 42); two
-//! steps, each the light of one sky facet, are what fits in seconds.
+//! steps (today each the light of one of the sky's 80 facets) are what
+//! fits in seconds.
 
 mod common;
 
@@ -42,9 +43,9 @@ struct Model {
     /// warning gives.
     dropped: usize,
     /// Each warning the library gives on loading it and on repairing it
-    /// under `--sky 1` at the default sides, in order: the text before and
-    /// the text after the file's path (which varies with the checkout);
-    /// an operating system's wording of a missing file is not compared.
+    /// under `--sky 1` at the default sides, in order. The path it starts
+    /// with varies with the checkout, and an operating system's wording
+    /// of a missing file is not compared: see [`Expected`].
     warnings: &'static [Expected],
     /// Materials after loading: one a texture slot (an OBJ of a Cube 2
     /// engine game), the file's own (`room.glb`), or the one a glTF
@@ -59,8 +60,9 @@ struct Model {
     /// Per cent of the area of the upward-facing polygons (normal within
     /// 26° of straight up) from which a ray straight up leaves the scene.
     open_up_percent: f64,
-    /// The coarse `--lenmax` of the solve: longer than any of its
-    /// triangles, so each is one element.
+    /// The coarse `--lenmax` of the mesh and the solve: longer than any
+    /// of the file's triangles, so the mesh is as coarse as its polygons
+    /// allow.
     lenmax: &'static str,
     /// Eye, look-at point and vertical field of view (degrees) of a
     /// camera straight above the level looking down, or `None` for the
@@ -72,7 +74,8 @@ struct Model {
     min_lit: f64,
 }
 
-/// One expected warning: what its text is, with the file's path left out.
+/// One expected warning: the path of the file it names, then
+/// [`Expected::starts`], then anything, then [`Expected::ends`].
 struct Expected {
     /// The file it names, relative to `tests/models/`.
     file: &'static str,
@@ -311,7 +314,7 @@ fn glb_triangles(path: &Path) -> usize {
 // ---------------------------------------------------------------------------
 // Through the library: loading, repair, mesh.
 
-/// Whether every vertex of every polygon is finite, its normal a finite
+/// Asserts that every vertex of every polygon is finite, its normal a finite
 /// unit vector and its area positive and finite.
 fn assert_polygons_finite(s: &Scene, what: &str) {
     for (i, p) in s.polygons.iter().enumerate() {
