@@ -17,7 +17,7 @@
 //! one plane. The vertex of lowest index leads the group; in a step, a
 //! follower whose leader is evaluated exactly (its polygon receives, and
 //! neither is interpolated) takes the leader's `Δrad` instead of its own
-//! ([`super::super::step::gather::gather_passes`]). The error is that of
+//! ([`crate::solver::step::gather`]). The error is that of
 //! evaluating a point a few degrees off its own normal, or at its
 //! neighbour's inset point (a twentieth of an element away); a back copy
 //! (normal reversed), another material, a crease or a sky facet never
