@@ -69,7 +69,7 @@ pub struct RunConfig {
     /// current directory.
     pub output: Option<PathBuf>,
     /// Longest element edge in scene units; `None` for the default
-    /// ([`mesh::MeshOptions::for_scene`]).
+    /// ([`mesh::MeshOptions::within_budget`]), which `prepare` picks.
     pub lenmax: Option<f32>,
     /// Boundary inset as a fraction of an element edge.
     pub inset: f32,

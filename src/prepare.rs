@@ -6,18 +6,20 @@
 //! around it, the side of a two-sided lamp that faces a ceiling across a
 //! narrow gap silenced), say on stderr what the loader and the passes
 //! changed or ignored and whether nothing emits ([`scene::Warning`],
-//! [`Scene::nothing_emits_warning`]), check the mesh size against the
-//! element limit before allocating anything, mesh it and build the
-//! visibility BVH. What the batch run, the window and the examples all
+//! [`Scene::nothing_emits_warning`]), pick the default lenmax within the
+//! vertex budget when none is given (and say so when that made the mesh
+//! coarser, [`mesh::budget`]), check the mesh size against the element
+//! limit before allocating anything, mesh it and build the visibility BVH. What the batch run, the window and the examples all
 //! start from.
 
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
+use crate::mesh::budget::VERTEX_BUDGET;
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
 use crate::scene::repair::{self, FirstHit, RepairOptions};
 use crate::scene::{
     self, IesError, LoadError, LuminaireError, Photometry, PolygonError, Scene, SplitStats,
-    UnknownName,
+    UnknownName, Warning,
 };
 use crate::visibility::Visibility;
 use glam::Vec3;
@@ -188,21 +190,35 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         scene.warnings.push(warning);
     }
     seconds.load = t.elapsed().as_secs_f64() - bvh_seconds;
+
+    let t = Instant::now();
+    let mut mesh_options = match config.lenmax {
+        Some(lenmax) => MeshOptions {
+            lenmax,
+            ..MeshOptions::for_scene(&scene)
+        },
+        None => {
+            let (options, coarsened) = MeshOptions::within_budget(&scene, VERTEX_BUDGET);
+            if let Some(coarsened) = coarsened {
+                scene
+                    .warnings
+                    .push(Warning::file(&name, coarsened.to_string()));
+            }
+            options
+        }
+    };
+    mesh_options.inset = config.inset;
+    let options_seconds = t.elapsed().as_secs_f64();
     // Said before the solve, whatever `--quiet` says: a warning explains a
-    // picture that is not what the user expected.
+    // picture that is not what the user expected (a coarser mesh too).
     for warning in &scene.warnings {
         eprintln!("{warning}");
     }
 
     let t = Instant::now();
-    let mut mesh_options = MeshOptions::for_scene(&scene);
-    mesh_options.inset = config.inset;
-    if let Some(lenmax) = config.lenmax {
-        mesh_options.lenmax = lenmax;
-    }
     mesh::check_size(&scene, &mesh_options, config.max_elements)?;
     let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
-    seconds.mesh = t.elapsed().as_secs_f64();
+    seconds.mesh = options_seconds + t.elapsed().as_secs_f64();
 
     Ok(Prepared {
         scene,
@@ -235,6 +251,25 @@ pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::budget::VERTEX_BUDGET;
+
+    /// 125 unit squares stacked 0.001 apart, facing up: at the default
+    /// lenmax (1/80 of the diagonal √2.015376, 0.017745) 58 × 58 vertices
+    /// each, 420,500 in all, over [`VERTEX_BUDGET`]; the finest
+    /// three-digit lenmax within it is 0.0182, 56 × 56 each, 392,000 in
+    /// all (0.0181 gives 57 × 57, 406,125).
+    fn stack_of_squares(dir: &Path) -> std::path::PathBuf {
+        let mut text = String::from("material wall color 1 1 1 k_diffrefl 0.5 end\n");
+        for k in 0..125 {
+            let z = k as f64 * 0.001;
+            text += &format!(
+                "polygon wall vertex 0 0 {z} vertex 1 0 {z} vertex 1 1 {z} vertex 0 1 {z} end\n"
+            );
+        }
+        let path = dir.join("stack.sc");
+        std::fs::write(&path, text).expect("the scene is written");
+        path
+    }
 
     #[test]
     fn a_deferred_preparation_builds_the_bvh_on_first_use() {
@@ -255,5 +290,82 @@ mod tests {
         assert!(eager.visibility.get().is_some());
         assert!(eager.phase_seconds().bvh > 0.0);
         assert_eq!(eager.seconds.load, eager.phase_seconds().load);
+    }
+
+    #[test]
+    fn a_default_mesh_over_the_vertex_budget_is_coarsened_and_says_so() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = RunConfig::new(SceneSource::File(stack_of_squares(dir.path())));
+        let prepared = prepare_deferred(&config).expect("the stack prepares");
+        assert_eq!(prepared.lenmax, 0.0182);
+        assert!((prepared.mesh.vertex_count() as u64) <= VERTEX_BUDGET);
+        // The squares share no edge: the estimate is the mesh.
+        let n = (1.0 / prepared.lenmax).floor() as usize + 2;
+        assert_eq!(prepared.mesh.vertex_count(), 125 * n * n);
+        // The next finer three-digit lenmax is over the budget.
+        let finer = prepared.lenmax - 0.0001;
+        let m = (1.0 / finer).floor() as u64 + 2;
+        assert!(125 * m * m > VERTEX_BUDGET, "{finer}: {m}");
+        let said: Vec<String> = prepared
+            .scene
+            .warnings
+            .iter()
+            .map(|w| w.to_string())
+            .filter(|w| w.contains("coarsened"))
+            .collect();
+        assert_eq!(said.len(), 1, "{said:?}");
+        assert!(
+            said[0].contains(&format!(
+                "stack.sc: warning: mesh coarsened to lenmax {} (an estimated",
+                prepared.lenmax
+            )) && said[0].contains("the default 0.01775 would give 421,000"),
+            "{}",
+            said[0]
+        );
+    }
+
+    #[test]
+    fn a_given_lenmax_is_used_as_it_is_whatever_the_budget() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut config = RunConfig::new(SceneSource::File(stack_of_squares(dir.path())));
+        // Finer than the default, coarser than the budget's choice.
+        for lenmax in [0.016, 0.02] {
+            config.lenmax = Some(lenmax);
+            let prepared = prepare_deferred(&config).expect("the stack prepares");
+            assert_eq!(prepared.lenmax, lenmax);
+            let n = (1.0 / lenmax).floor() as usize + 2;
+            assert_eq!(prepared.mesh.vertex_count(), 125 * n * n);
+            assert!(prepared
+                .scene
+                .warnings
+                .iter()
+                .all(|w| !w.to_string().contains("coarsened")));
+        }
+    }
+
+    /// The budget changes nothing on the bundled scenes: their lenmax is
+    /// the diagonal's fraction, to the bit, and their meshes (14,206 to
+    /// 16,957 vertices) are a twentieth of it.
+    #[test]
+    fn every_bundled_scene_keeps_the_default_lenmax() {
+        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let mut seen = 0;
+        for entry in std::fs::read_dir(scenes).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "sc") {
+                continue;
+            }
+            let prepared = prepare_deferred(&RunConfig::new(SceneSource::File(path.clone())))
+                .expect("a bundled scene prepares");
+            let fine = MeshOptions::for_scene(&prepared.scene).lenmax;
+            assert_eq!(prepared.lenmax.to_bits(), fine.to_bits(), "{path:?}");
+            assert!(
+                (prepared.mesh.vertex_count() as u64) < VERTEX_BUDGET / 16,
+                "{path:?}: {}",
+                prepared.mesh.vertex_count()
+            );
+            seen += 1;
+        }
+        assert!(seen >= 4, "{seen} bundled scenes");
     }
 }

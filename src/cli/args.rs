@@ -51,7 +51,9 @@ pub struct Args {
 
     /// Longest element edge, in scene units.
     ///
-    /// Default: 1/80 of the scene's bounding-box diagonal.
+    /// Default: 1/80 of the scene's bounding-box diagonal, or coarser when
+    /// that mesh would have more than about 400,000 vertices (a line then
+    /// says which lenmax was chosen).
     #[arg(long, value_name = "L")]
     pub(crate) lenmax: Option<f32>,
 

@@ -37,6 +37,7 @@ use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 use std::ops::Range;
 
+pub mod budget;
 pub mod covered;
 mod handle;
 pub mod refine;
@@ -50,10 +51,11 @@ pub use handle::MeshRef;
 /// sample far above `f32` rounding yet leaves it inside its elements.
 pub const DEFAULT_INSET: f32 = 0.05;
 
-/// Default `lenmax` as a fraction of the scene's bounding-box diagonal.
-/// For `rtable` (diagonal 7.7 units) this gives elements under 0.1 units,
-/// about 14,000 vertices, converged to 0.1 % unshot in a few seconds on two
-/// cores, with smooth shadows.
+/// Default `lenmax` as a fraction of the scene's bounding-box diagonal,
+/// when its mesh is within the vertex budget ([`budget`]). For `rtable`
+/// (diagonal 7.7 units) this gives elements under 0.1 units, about 14,000
+/// vertices, converged to 0.1 % unshot in a few seconds on two cores, with
+/// smooth shadows.
 pub const DEFAULT_LENMAX_FRACTION: f32 = 1.0 / 80.0;
 
 /// Most elements a mesh may have. A mesh this large needs gigabytes for the
@@ -210,8 +212,10 @@ pub struct MeshOptions {
 }
 
 impl MeshOptions {
-    /// The default options for a scene: `lenmax` a fixed fraction
-    /// ([`DEFAULT_LENMAX_FRACTION`]) of its bounding-box diagonal.
+    /// The finest default options for a scene: `lenmax` a fixed fraction
+    /// ([`DEFAULT_LENMAX_FRACTION`]) of its bounding-box diagonal. A run
+    /// without `--lenmax` takes [`MeshOptions::within_budget`], which is
+    /// these unless their mesh is over the vertex budget.
     pub fn for_scene(scene: &Scene) -> Self {
         let extent = scene.extent();
         MeshOptions {
@@ -274,19 +278,120 @@ pub struct MeshSize {
 /// counts alone (no allocation per element), so that a driver can refuse a
 /// mesh too large for memory before building it. [`build`]'s stitching
 /// then adds the vertices polygons take from their neighbours' edges and
-/// the elements split to hold them: a few percent more.
+/// the elements split to hold them: under half a percent more vertices on
+/// the bundled scenes, up to a fifth more on game levels.
 pub fn estimate(scene: &Scene, options: &MeshOptions) -> Result<MeshSize, MeshError> {
     check_options(options)?;
-    let mut size = MeshSize {
-        elements: 0,
-        vertices: 0,
-    };
-    for p in &scene.polygons {
-        let plan = Plan::new(p, options.lenmax);
-        size.elements = size.elements.saturating_add(plan.element_count());
-        size.vertices = size.vertices.saturating_add(plan.vertex_count());
+    Ok(Sizes::of(scene).at(options.lenmax))
+}
+
+/// A scene's mesh size at any lenmax ([`estimate`]'s counts) without
+/// looking at its polygons again: what each polygon's subdivision counts
+/// come from, found once. The size only falls (or stays) as lenmax grows.
+#[derive(Clone, Debug)]
+pub struct Sizes {
+    spans: Vec<Span>,
+}
+
+impl Sizes {
+    /// The spans of every polygon of `scene`.
+    pub fn of(scene: &Scene) -> Sizes {
+        Sizes {
+            spans: scene.polygons.iter().map(|p| Plan::new(p).span).collect(),
+        }
     }
-    Ok(size)
+
+    /// The mesh size at `lenmax` (positive, scene units), as [`estimate`]
+    /// gives it.
+    pub fn at(&self, lenmax: f32) -> MeshSize {
+        self.spans.iter().fold(
+            MeshSize {
+                elements: 0,
+                vertices: 0,
+            },
+            |sum, span| {
+                let size = span.size_at(lenmax);
+                MeshSize {
+                    elements: sum.elements.saturating_add(size.elements),
+                    vertices: sum.vertices.saturating_add(size.vertices),
+                }
+            },
+        )
+    }
+
+    /// The least size any lenmax gives: one element per triangle or quad,
+    /// a fan of one element per rim edge for a larger polygon. Its vertex
+    /// count is the polygons' corners (and a fan's apex).
+    pub fn least(&self) -> MeshSize {
+        self.at(f32::INFINITY)
+    }
+
+    /// The smallest lenmax, rounded up to three significant digits, that
+    /// gives the [`Sizes::least`] mesh: a longer one changes nothing.
+    /// In scene units; [`f32::MIN_POSITIVE`] for a scene with nothing to
+    /// cut.
+    pub fn coarsest(&self) -> f32 {
+        let longest = self
+            .spans
+            .iter()
+            .map(|s| s.u.max(s.v))
+            .fold(0.0f32, f32::max);
+        if longest <= 0.0 {
+            return f32::MIN_POSITIVE;
+        }
+        // One element wherever lenmax exceeds every span (`divisions`).
+        let above = round_up(longest.next_up());
+        let least = self.least();
+        if self.at(above) == least {
+            above
+        } else {
+            longest.next_up()
+        }
+    }
+
+    /// The smallest lenmax not below `from` whose mesh passes `fits`,
+    /// rounded up to three significant digits unless it is `from` itself;
+    /// `None` when even [`Sizes::coarsest`] does not. `fits` must hold at
+    /// every lenmax above one where it holds, as a limit on the size does.
+    pub fn smallest_fitting(&self, from: f32, fits: impl Fn(MeshSize) -> bool) -> Option<f32> {
+        let fits = |lenmax: f32| fits(self.at(lenmax));
+        if fits(from) {
+            return Some(from);
+        }
+        let mut hi = self.coarsest().max(from);
+        if !fits(hi) {
+            return None;
+        }
+        let mut lo = from;
+        // Bisection in log scale; the count only falls as lenmax grows.
+        for _ in 0..60 {
+            let mid = (lo * hi).sqrt();
+            if !(mid > lo && mid < hi) {
+                break;
+            }
+            if fits(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        // Rounded for the messages that show it, still fitting.
+        let rounded = round_up(hi);
+        Some(if fits(rounded) { rounded } else { hi })
+    }
+}
+
+/// `x` rounded up to three significant digits (`13.8523` to `13.9`), a
+/// lenmax a message can show and a user can type.
+fn round_up(x: f32) -> f32 {
+    let digits = 10f64.powf((x as f64).log10().floor() - 2.0);
+    let rounded = ((x as f64 / digits).ceil() * digits) as f32;
+    // Casting back may round down below `x`.
+    if rounded >= x {
+        rounded
+    } else {
+        rounded.next_up()
+    }
 }
 
 /// Refuses, before anything is allocated, a mesh with more than
@@ -325,36 +430,8 @@ fn too_many_elements(scene: &Scene, options: &MeshOptions, max_elements: u64) ->
 /// has at most `max_elements` elements; `None` when even one element per
 /// polygon is too many.
 pub fn lenmax_to_fit(scene: &Scene, options: &MeshOptions, max_elements: u64) -> Option<f32> {
-    let fits = |lenmax: f32| {
-        let o = MeshOptions { lenmax, ..*options };
-        estimate(scene, &o).is_ok_and(|s| s.elements <= max_elements)
-    };
-    // Longer than every polygon: one element per triangle or quad, a fan
-    // per larger polygon.
-    let mut hi = (scene.extent() * 2.0)
-        .max(options.lenmax)
-        .max(f32::MIN_POSITIVE);
-    if !fits(hi) {
-        return None;
-    }
-    let mut lo = options.lenmax;
-    // Bisection in log scale; the count only falls as lenmax grows.
-    for _ in 0..60 {
-        let mid = (lo * hi).sqrt();
-        if !(mid > lo && mid < hi) {
-            break;
-        }
-        if fits(mid) {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    // Round up to three significant digits for the message, keeping a
-    // value that still fits.
-    let digits = 10f64.powf((hi as f64).log10().floor() - 2.0);
-    let rounded = ((hi as f64 / digits).ceil() * digits) as f32;
-    Some(if fits(rounded) { rounded } else { hi })
+    check_options(options).ok()?;
+    Sizes::of(scene).smallest_fitting(options.lenmax, |s| s.elements <= max_elements)
 }
 
 /// Bytes held per mesh vertex during a whole run, for
@@ -447,16 +524,12 @@ pub fn build_unstitched_with_limit(
 ) -> Result<Mesh, MeshError> {
     let max_elements = max_elements.min(MAX_ADDRESSABLE_ELEMENTS);
     check_options(options)?;
-    let plans: Vec<Plan> = scene
-        .polygons
-        .iter()
-        .map(|p| Plan::new(p, options.lenmax))
-        .collect();
+    let plans: Vec<Plan> = scene.polygons.iter().map(Plan::new).collect();
     // Saturating: absurd subdivision counts must reach the limit check,
     // not overflow on the way.
-    let elements = plans
-        .iter()
-        .fold(0u64, |sum, p| sum.saturating_add(p.element_count()));
+    let elements = plans.iter().fold(0u64, |sum, p| {
+        sum.saturating_add(p.span.size_at(options.lenmax).elements)
+    });
     if elements > max_elements {
         return Err(too_many_elements(scene, options, max_elements));
     }
@@ -479,7 +552,7 @@ pub fn build_unstitched_with_limit(
             polygon: id,
             first_vertex: v_start,
         };
-        let (nu, nv, min_edge) = plan.emit(&mut builder);
+        let (nu, nv, min_edge) = plan.emit(&mut builder, options.lenmax);
         let v_end = mesh.positions.len() as u32;
         mesh.sample_positions.extend(inset_positions(
             polygon,
@@ -507,17 +580,52 @@ pub fn build_unstitched_with_limit(
     Ok(mesh)
 }
 
-/// How one polygon will be cut: its shape after simplification and the
-/// subdivision counts.
-enum Plan {
+/// How one polygon will be cut: its shape after simplification, and what
+/// sets its subdivision counts at any lenmax.
+struct Plan {
+    cut: Cut,
+    span: Span,
+}
+
+/// The shape a polygon is cut as.
+enum Cut {
     /// Parallelogram `v0 + u (v1 − v0) + v (v3 − v0)`.
-    Parallelogram { v: [Vec3; 4], nu: u32, nv: u32 },
+    Parallelogram([Vec3; 4]),
     /// Bilinear quad.
-    Bilinear { v: [Vec3; 4], nu: u32, nv: u32 },
+    Bilinear([Vec3; 4]),
     /// A single triangle subdivided `n` times per edge.
-    Triangle { v: [Vec3; 3], n: u32 },
+    Triangle([Vec3; 3]),
     /// A fan of triangles `(apex, rim[k], rim[k+1])` around a closed rim.
-    Fan { apex: Vec3, rim: Vec<Vec3>, n: u32 },
+    Fan { apex: Vec3, rim: Vec<Vec3> },
+}
+
+/// What sets one polygon's mesh size at any lenmax: the lengths its
+/// subdivision counts come from, and how the counts become elements and
+/// vertices. Computed once per polygon ([`Sizes`]), so that the size at
+/// many lenmax values (a search for the lenmax that fits) needs no
+/// geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Span {
+    /// The length cut into `nu` parts, in scene units: the longer `u` edge
+    /// of a quad, the longest edge of a triangle or of a fan's triangles;
+    /// 0 for a sky facet, which is one element whatever the lenmax.
+    u: f32,
+    /// The length cut into `nv` parts: the longer `v` edge of a quad;
+    /// equal to `u` for triangles and fans.
+    v: f32,
+    /// How the counts become elements and vertices.
+    form: Form,
+}
+
+/// How subdivision counts become elements and vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Form {
+    /// An `nu × nv` grid of quads.
+    Grid,
+    /// A triangle cut `nu` times per edge.
+    Triangle,
+    /// A fan of this many triangles, each cut `nu` times per edge.
+    Fan(u32),
 }
 
 /// Subdivisions so that `length / n < lenmax`.
@@ -531,31 +639,53 @@ fn divisions(length: f32, lenmax: f32) -> u32 {
     }
 }
 
+impl Span {
+    /// The subdivision counts `(nu, nv)` at `lenmax`.
+    fn divisions(&self, lenmax: f32) -> (u32, u32) {
+        (divisions(self.u, lenmax), divisions(self.v, lenmax))
+    }
+
+    /// Elements and vertices of the polygon's own mesh at `lenmax`
+    /// (before [`stitch`]).
+    fn size_at(&self, lenmax: f32) -> MeshSize {
+        let (nu, nv) = self.divisions(lenmax);
+        let (nu, nv) = (nu as u64, nv as u64);
+        match self.form {
+            Form::Grid => MeshSize {
+                elements: nu * nv,
+                vertices: (nu + 1) * (nv + 1),
+            },
+            Form::Triangle => MeshSize {
+                elements: nu * nu,
+                vertices: (nu + 1) * (nu + 2) / 2,
+            },
+            // The apex, each spoke's points past the apex, and each fan
+            // triangle's points off both of its spokes.
+            Form::Fan(m) => {
+                let m = m as u64;
+                let inner = nu * nu.saturating_sub(1) / 2;
+                MeshSize {
+                    elements: m.saturating_mul(nu * nu),
+                    vertices: (m.saturating_mul(nu + inner)).saturating_add(1),
+                }
+            }
+        }
+    }
+}
+
 impl Plan {
-    fn new(polygon: &Polygon, lenmax: f32) -> Plan {
-        // A sky facet's radiosity is its emission, the same everywhere:
-        // one element carries it, whatever the scene's lenmax.
-        let lenmax = if polygon.surface.sky {
-            f32::INFINITY
-        } else {
-            lenmax
-        };
+    fn new(polygon: &Polygon) -> Plan {
         let v = &polygon.vertices;
-        match polygon.shape {
+        let (cut, u, w, form) = match polygon.shape {
             Shape::Parallelogram | Shape::Quad => {
                 let q = [v[0], v[1], v[2], v[3]];
                 if polygon.shape == Shape::Parallelogram {
-                    Plan::Parallelogram {
-                        v: q,
-                        nu: divisions(q[0].distance(q[1]), lenmax),
-                        nv: divisions(q[0].distance(q[3]), lenmax),
-                    }
+                    let (u, w) = (q[0].distance(q[1]), q[0].distance(q[3]));
+                    (Cut::Parallelogram(q), u, w, Form::Grid)
                 } else {
-                    Plan::Bilinear {
-                        v: q,
-                        nu: divisions(q[0].distance(q[1]).max(q[3].distance(q[2])), lenmax),
-                        nv: divisions(q[0].distance(q[3]).max(q[1].distance(q[2])), lenmax),
-                    }
+                    let u = q[0].distance(q[1]).max(q[3].distance(q[2]));
+                    let w = q[0].distance(q[3]).max(q[1].distance(q[2]));
+                    (Cut::Bilinear(q), u, w, Form::Grid)
                 }
             }
             Shape::Triangle => {
@@ -564,22 +694,16 @@ impl Plan {
                     .distance(t[1])
                     .max(t[1].distance(t[2]))
                     .max(t[2].distance(t[0]));
-                Plan::Triangle {
-                    v: t,
-                    n: divisions(longest, lenmax),
-                }
+                (Cut::Triangle(t), longest, longest, Form::Triangle)
             }
             Shape::Convex => {
                 let rim = drop_collinear(v);
                 if rim.len() == 3 {
-                    return Plan::new(
-                        &Polygon {
-                            vertices: rim,
-                            shape: Shape::Triangle,
-                            ..polygon.clone()
-                        },
-                        lenmax,
-                    );
+                    return Plan::new(&Polygon {
+                        vertices: rim,
+                        shape: Shape::Triangle,
+                        ..polygon.clone()
+                    });
                 }
                 let apex = area_centroid(&rim);
                 let mut longest = 0.0f32;
@@ -587,78 +711,62 @@ impl Plan {
                     let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
                     longest = longest.max(a.distance(b)).max(apex.distance(a));
                 }
-                Plan::Fan {
-                    apex,
-                    rim,
-                    n: divisions(longest, lenmax),
-                }
+                let form = Form::Fan(rim.len() as u32);
+                (Cut::Fan { apex, rim }, longest, longest, form)
             }
+        };
+        // A sky facet's radiosity is its emission, the same everywhere:
+        // one element carries it, whatever the scene's lenmax.
+        let (u, v) = if polygon.surface.sky {
+            (0.0, 0.0)
+        } else {
+            (u, w)
+        };
+        Plan {
+            cut,
+            span: Span { u, v, form },
         }
     }
 
-    fn element_count(&self) -> u64 {
-        match self {
-            Plan::Parallelogram { nu, nv, .. } | Plan::Bilinear { nu, nv, .. } => {
-                *nu as u64 * *nv as u64
-            }
-            Plan::Triangle { n, .. } => *n as u64 * *n as u64,
-            Plan::Fan { rim, n, .. } => (rim.len() as u64).saturating_mul(*n as u64 * *n as u64),
-        }
-    }
-
-    fn vertex_count(&self) -> u64 {
-        match self {
-            Plan::Parallelogram { nu, nv, .. } | Plan::Bilinear { nu, nv, .. } => {
-                (*nu as u64 + 1) * (*nv as u64 + 1)
-            }
-            Plan::Triangle { n, .. } => (*n as u64 + 1) * (*n as u64 + 2) / 2,
-            // The apex, each spoke's points past the apex, and each fan
-            // triangle's points off both of its spokes.
-            Plan::Fan { rim, n, .. } => {
-                let (m, n) = (rim.len() as u64, *n as u64);
-                let inner = n * n.saturating_sub(1) / 2;
-                (m.saturating_mul(n + inner)).saturating_add(1)
-            }
-        }
-    }
-
-    /// Emits the vertices and elements; returns `(nu, nv, min_edge)`.
-    fn emit(&self, b: &mut PolygonBuilder) -> (u32, u32, f32) {
-        match self {
-            Plan::Parallelogram { v, nu, nv } => {
+    /// Emits the vertices and elements cut at `lenmax`; returns
+    /// `(nu, nv, min_edge)`.
+    fn emit(&self, b: &mut PolygonBuilder, lenmax: f32) -> (u32, u32, f32) {
+        let (nu, nv) = self.span.divisions(lenmax);
+        match &self.cut {
+            Cut::Parallelogram(v) => {
                 let (eu, ev) = (v[1] - v[0], v[3] - v[0]);
-                b.grid(*nu, *nv, |u, w| v[0] + u * eu + w * ev);
-                let min_edge = (eu.length() / *nu as f32).min(ev.length() / *nv as f32);
-                (*nu, *nv, min_edge)
+                b.grid(nu, nv, |u, w| v[0] + u * eu + w * ev);
+                let min_edge = (eu.length() / nu as f32).min(ev.length() / nv as f32);
+                (nu, nv, min_edge)
             }
-            Plan::Bilinear { v, nu, nv } => {
+            Cut::Bilinear(v) => {
                 let bilinear = |u: f32, w: f32| {
                     (1.0 - u) * (1.0 - w) * v[0]
                         + u * (1.0 - w) * v[1]
                         + u * w * v[2]
                         + (1.0 - u) * w * v[3]
                 };
-                b.grid(*nu, *nv, bilinear);
-                let shortest_u = v[0].distance(v[1]).min(v[3].distance(v[2])) / *nu as f32;
-                let shortest_v = v[0].distance(v[3]).min(v[1].distance(v[2])) / *nv as f32;
-                (*nu, *nv, shortest_u.min(shortest_v))
+                b.grid(nu, nv, bilinear);
+                let shortest_u = v[0].distance(v[1]).min(v[3].distance(v[2])) / nu as f32;
+                let shortest_v = v[0].distance(v[3]).min(v[1].distance(v[2])) / nv as f32;
+                (nu, nv, shortest_u.min(shortest_v))
             }
-            Plan::Triangle { v, n } => {
-                b.triangle(*n, v[0], v[1], v[2]);
+            Cut::Triangle(v) => {
+                b.triangle(nu, v[0], v[1], v[2]);
                 let shortest = v[0]
                     .distance(v[1])
                     .min(v[1].distance(v[2]))
                     .min(v[2].distance(v[0]));
-                (*n, *n, shortest / *n as f32)
+                (nu, nu, shortest / nu as f32)
             }
-            Plan::Fan { apex, rim, n } => {
-                b.fan(*n, *apex, rim);
+            Cut::Fan { apex, rim } => {
+                b.fan(nu, *apex, rim);
                 let mut shortest = f32::INFINITY;
                 for k in 0..rim.len() {
                     let (a, c) = (rim[k], rim[(k + 1) % rim.len()]);
                     shortest = shortest.min(a.distance(c)).min(apex.distance(a));
                 }
-                (*n, *n, shortest / *n as f32)
+                (nu, nu, shortest / nu as f32)
             }
         }
     }

@@ -7,15 +7,18 @@
 //! [`Shape`], which picks the meshing scheme.
 //!
 //! All tolerances are relative to the polygon's *extent*, the largest
-//! distance between two of its vertices, so a scene means the same thing
-//! whatever its unit of length.
+//! distance between two of its vertices (the convexity and planarity
+//! tolerances add the rounding of its `f32` coordinates,
+//! [`COORDINATE_ROUNDING`]), so a polygon means the same thing whatever
+//! its unit of length and whatever else is in the scene.
 
 use super::error::fmt_num;
 use super::{MaterialId, Polygon, SourcePos, Surface};
 use glam::{DVec3, Vec3};
 
 /// How far a vertex may lie from the polygon's plane, as a fraction of the
-/// polygon's extent (the format's "within 1e-3 of the largest extent").
+/// polygon's extent (the format's "within 1e-3 of the largest extent"),
+/// plus [`COORDINATE_ROUNDING`].
 pub const PLANARITY_TOLERANCE: f64 = 1e-3;
 
 /// Two consecutive vertices closer than this fraction of the extent count as
@@ -28,10 +31,24 @@ pub const COINCIDENT_TOLERANCE: f64 = 1e-6;
 /// decimal still produce a tiny rounding area of order `1e-8 × extent²`.
 pub const ZERO_AREA_TOLERANCE: f64 = 1e-7;
 
-/// A turn at a vertex whose sine (relative to the normal) is above
-/// `-CONVEXITY_TOLERANCE` counts as convex. Slightly negative values come
-/// from `f32` rounding of collinear vertices, which the format allows.
+/// A vertex turns the wrong way (is concave) when the nearer of its two
+/// neighbours lies more than this fraction of the extent (plus
+/// [`COORDINATE_ROUNDING`]) on the wrong side of the line of the other
+/// edge. A little on the wrong side is `f32` rounding of collinear
+/// vertices, which the format allows. At a turn past a right angle, where
+/// the boundary doubles back, the test is on the turn's sine instead: a
+/// sine below this (the wrong way, or nearly straight back) is a fold.
 pub const CONVEXITY_TOLERANCE: f64 = 1e-6;
+
+/// How far `f32` rounding may move a vertex off the line or plane it
+/// belongs to, as a fraction of the polygon's largest coordinate magnitude:
+/// four units in the last place (each vertex of a corner is rounded by up
+/// to half of one in each coordinate). Added to the convexity and
+/// planarity tolerances, so that a polygon small against its distance from
+/// the origin, whose coordinates cannot be more precise than that, is not
+/// refused for their rounding. Relative to the polygon's own coordinates,
+/// so scaling a polygon scales its tolerances.
+pub const COORDINATE_ROUNDING: f64 = 4.0 * f32::EPSILON as f64;
 
 /// How far, in radians, the edges' total turning may differ from one full
 /// turn (`2π`) before the polygon is taken to wind around more than once.
@@ -279,7 +296,10 @@ fn analyze(vertices: &[Vec3]) -> Result<Analysis, PolygonError> {
     }
     let normal = twice_area / (2.0 * area);
 
-    let tolerance = PLANARITY_TOLERANCE * extent;
+    // What f32 coordinates this far from the origin can resolve.
+    let rounding =
+        COORDINATE_ROUNDING * v.iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
+    let tolerance = PLANARITY_TOLERANCE * extent + rounding;
     let (worst, distance) = v
         .iter()
         .map(|p| (p - centroid).dot(normal).abs())
@@ -296,17 +316,28 @@ fn analyze(vertices: &[Vec3]) -> Result<Analysis, PolygonError> {
         });
     }
 
+    let convexity_tolerance = CONVEXITY_TOLERANCE * extent + rounding;
     let mut turning = 0.0;
     for i in 0..n {
         let prev = v[(i + n - 1) % n];
         let next = v[(i + 1) % n];
-        let e1 = (v[i] - prev).normalize();
-        let e2 = (next - v[i]).normalize();
+        let (e1, e2) = (v[i] - prev, next - v[i]);
+        let shorter = e1.length().min(e2.length());
+        let (e1, e2) = (e1.normalize(), e2.normalize());
         let sin = e1.cross(e2).dot(normal);
         let cos = e1.dot(e2);
         // A straight-through vertex (cos ≈ 1) is allowed; one where the
         // boundary doubles back (cos ≈ -1) is a fold, not a convex corner.
-        if sin < -CONVEXITY_TOLERANCE || (sin.abs() <= CONVEXITY_TOLERANCE && cos < 0.0) {
+        // Past a right angle, only a turn the right way is a corner; short
+        // of one, a turn the wrong way by less than the tolerance is a
+        // straight vertex moved by rounding: the nearer neighbour lies
+        // `-sin × shorter` on the wrong side of the other edge's line.
+        let wrong = if cos < 0.0 {
+            sin <= CONVEXITY_TOLERANCE
+        } else {
+            -sin * shorter > convexity_tolerance
+        };
+        if wrong {
             // A triangle of positive area turns the same way at every
             // vertex: a fold can only be a vanishing angle, not a concave
             // corner.
@@ -578,6 +609,122 @@ mod tests {
             err(&pts),
             "polygon is not convex: its edges turn through 720 degrees, not 360 (it overlaps itself)"
         );
+    }
+
+    /// `shape` scaled by `scale`, turned by the `k`-th of a set of
+    /// rotations, moved `offset` extents from the origin and rounded to
+    /// `f32`: the same polygon at another size, orientation and place, with
+    /// the float noise of an export.
+    fn placed(shape: &[[f64; 3]], scale: f64, k: usize, offset: f64) -> Vec<Vec3> {
+        let rotation = glam::DMat3::from_rotation_z(k as f64 * 0.371)
+            * glam::DMat3::from_rotation_x(k as f64 * 0.173 + 0.1);
+        shape
+            .iter()
+            .map(|p| {
+                ((rotation * DVec3::from_array(*p) + DVec3::new(0.3, -0.6, 1.0) * offset) * scale)
+                    .as_vec3()
+            })
+            .collect()
+    }
+
+    /// The verdict without its numbers: the shape, or the error (without
+    /// the vertex of a quad whose four vertices are equally far from its
+    /// plane).
+    fn verdict(vertices: Vec<Vec3>) -> String {
+        match analyze(&vertices) {
+            Ok(a) => format!("{:?}", a.shape),
+            Err(PolygonError::NotPlanar { .. }) => "not planar".to_string(),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// A unit square, a pentagon with a straight vertex, an arrowhead
+    /// (concave at vertex 3, by a tenth of its size), a folded quad (vertex
+    /// 4 a fifth of its size off the plane), a square with a fifth vertex
+    /// a ten-thousandth of its size inside its left edge, and a pentagram.
+    fn test_shapes() -> Vec<(Vec<[f64; 3]>, &'static str)> {
+        let star: Vec<[f64; 3]> = (0..5)
+            .map(|k| {
+                let a = k as f64 * 2.0 * std::f64::consts::TAU / 5.0;
+                [a.cos(), a.sin(), 0.0]
+            })
+            .collect();
+        vec![
+            (
+                vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+                "Parallelogram",
+            ),
+            (
+                vec![[0., 0., 0.], [0.5, 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+                "Convex",
+            ),
+            (
+                vec![[0., 0., 0.], [1., 0., 0.], [0.9, 0.5, 0.], [1., 1., 0.], [0., 1., 0.]],
+                "polygon is not convex at vertex 3",
+            ),
+            (
+                vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.2]],
+                "not planar",
+            ),
+            (
+                vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [1e-4, 0.5, 0.]],
+                "polygon is not convex at vertex 5",
+            ),
+            (
+                star,
+                "polygon is not convex: its edges turn through 720 degrees, not 360 (it overlaps itself)",
+            ),
+        ]
+    }
+
+    /// The convexity and planarity tolerances follow the polygon's size:
+    /// the same polygon a ten-thousandth of a unit and a hundred thousand
+    /// units across gets the same verdict, turned any way, at the origin
+    /// or a hundred times its size away from it.
+    #[test]
+    fn verdicts_do_not_depend_on_the_polygons_size_or_place() {
+        for (shape, expected) in test_shapes() {
+            for scale in [1e-4, 1.0, 1e5] {
+                for offset in [0.0, 1.0, 10.0, 100.0] {
+                    for k in 0..50 {
+                        assert_eq!(
+                            verdict(placed(&shape, scale, k, offset)),
+                            expected,
+                            "{shape:?} × {scale:e}, {offset} away, turn {k}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// A tolerance on the sine of each turn alone refused a pentagon whose
+    /// straight vertex `f32` rounding had moved off its line, once the
+    /// pentagon was some way from the origin (4 to 8 of these 200
+    /// placements at ten sizes away, 64 to 80 at a thousand): that sine is
+    /// the rounding over the edge, and the rounding grows with the
+    /// distance from the origin, not with the polygon.
+    #[test]
+    fn a_straight_vertex_moved_by_rounding_is_convex_far_from_the_origin() {
+        let pentagon = [
+            [0., 0., 0.],
+            [0.5, 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+        ];
+        for scale in [1e-4, 1e-2, 1.0, 1e3] {
+            for offset in [10.0, 1000.0] {
+                for k in 0..200 {
+                    let vertices = placed(&pentagon, scale, k, offset);
+                    assert!(
+                        analyze(&vertices).is_ok_and(|a| a.shape == Shape::Convex),
+                        "× {scale:e}, {offset} away, turn {k}: {:?}",
+                        analyze(&vertices).err()
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -110,6 +110,83 @@ fn non_planar_and_non_convex_faces_are_triangulated() {
     assert!((s.polygons[0].area - 0.5).abs() < 1e-9);
 }
 
+/// The faces of [`non_planar_and_non_convex_faces_are_triangulated`]
+/// scaled to a ten-thousandth of a unit and to a hundred thousand units,
+/// and turned off the axes so that their coordinates carry `f32` noise,
+/// are kept or split alike: the tolerances follow each face's size.
+#[test]
+fn faces_are_kept_or_split_alike_at_any_size() {
+    // Each face, the shape it is kept as (`None`: split into triangles),
+    // and its area at scale 1 (`None`: not flat).
+    type Face<'a> = (&'a [[f64; 3]], Option<Shape>, Option<f64>);
+    let faces: [Face; 4] = [
+        (
+            &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+            Some(Shape::Parallelogram),
+            Some(1.0),
+        ),
+        // A straight corner.
+        (
+            &[
+                [0., 0., 0.],
+                [1., 0., 0.],
+                [2., 0., 0.],
+                [2., 1., 0.],
+                [0., 1., 0.],
+            ],
+            Some(Shape::Convex),
+            Some(2.0),
+        ),
+        // Folded along its diagonal.
+        (
+            &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.5], [0., 1., 0.]],
+            None,
+            None,
+        ),
+        // An L.
+        (
+            &[
+                [0., 0., 0.],
+                [2., 0., 0.],
+                [2., 1., 0.],
+                [1., 1., 0.],
+                [1., 2., 0.],
+                [0., 2., 0.],
+            ],
+            None,
+            Some(3.0),
+        ),
+    ];
+    let turn = glam::DMat3::from_rotation_z(0.3) * glam::DMat3::from_rotation_x(0.7);
+    for scale in [1e-4, 1.0, 1e5] {
+        for (face, kept, flat_area) in &faces {
+            let mut obj = String::new();
+            for p in face.iter() {
+                let q = turn * glam::DVec3::from_array(*p) * scale;
+                obj += &format!("v {:e} {:e} {:e}\n", q.x as f32, q.y as f32, q.z as f32);
+            }
+            let indices: Vec<String> = (1..=face.len()).map(|k| k.to_string()).collect();
+            obj += &format!("f {}\n", indices.join(" "));
+            let s = parse(&obj).unwrap();
+            let shapes: Vec<Shape> = s.polygons.iter().map(|p| p.shape).collect();
+            match kept {
+                Some(shape) => assert_eq!(shapes, vec![*shape], "{face:?} × {scale:e}"),
+                None => assert!(
+                    shapes.len() >= 2 && shapes.iter().all(|&s| s == Shape::Triangle),
+                    "{face:?} × {scale:e}: {shapes:?}"
+                ),
+            }
+            if let Some(flat_area) = flat_area {
+                let area: f64 = s.polygons.iter().map(|p| p.area).sum::<f64>() / (scale * scale);
+                assert!(
+                    (area - flat_area).abs() < 1e-5,
+                    "{face:?} × {scale:e}: {area}"
+                );
+            }
+        }
+    }
+}
+
 /// The warnings of a scene, as printed.
 fn warning_lines(s: &Scene) -> Vec<String> {
     s.warnings.iter().map(|w| w.to_string()).collect()
