@@ -167,7 +167,9 @@ impl Weld {
     }
 }
 
-fn find(parent: &mut [usize], mut i: usize) -> usize {
+/// The root of `i` in the union-find forest `parent` (each entry its
+/// parent, a root its own), halving the path on the way.
+pub(crate) fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
         i = parent[i];

@@ -26,6 +26,7 @@
 //!
 //! [`SHARE_CREASE_DEG`]: crate::solver::tuning::SHARE_CREASE_DEG
 
+use crate::mesh::weld::find;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solver::tuning::SHARE_CREASE_DEG;
@@ -93,14 +94,6 @@ pub fn leaders(scene: &Scene, mesh: &Mesh, on: bool) -> Vec<u32> {
         }
     }
     leader
-}
-
-fn find(parent: &mut [usize], mut i: usize) -> usize {
-    while parent[i] != i {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    i
 }
 
 #[cfg(test)]
