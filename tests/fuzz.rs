@@ -1253,6 +1253,7 @@ fn corpus(target: &Target) -> Vec<(PathBuf, Vec<u8>)> {
 }
 
 fn fuzz(target: &Target, cases: u64, seed: u64) -> Summary {
+    common::limit_address_space();
     let mut seeds = (target.seeds)();
     seeds.extend(corpus(target).into_iter().map(|(_, b)| b));
     let mut rng = Rng(seed);

@@ -168,6 +168,7 @@ fn check(text: &str) -> Result<(), String> {
 
 #[test]
 fn fuzz_ies() {
+    common::limit_address_space();
     let cases = env_u64("RADIOSITY_FUZZ_CASES", CASES);
     let seed = env_u64("RADIOSITY_FUZZ_SEED", DEFAULT_SEED);
     let seeds = seeds();

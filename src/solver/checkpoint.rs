@@ -76,12 +76,21 @@ const RGB_LEN: usize = 24;
 /// Bytes of the trailing checksum.
 const CHECKSUM_LEN: usize = 8;
 
+/// The largest magnitude a saved radiosity, unshot radiosity or charge may
+/// have, in emission units. No legal scene comes near it: emission is at
+/// most [`crate::scene::MAX_EMISSION`] (1e20) and reflectance below one in
+/// f32 (at most 1 - 6e-8), so radiosity stays below about 2e27. Refusing
+/// larger values keeps a checkpoint with a valid checksum but absurd values
+/// from overflowing the next step or the picture (f32, at most 3.4e38).
+pub const MAX_STATE_VALUE: f64 = 1e30;
+
 /// Everything a progressive solve needs to continue exactly where it was.
 ///
 /// Invariants a solver checks on restore ([`crate::solver::Method::restore`]):
 /// `radiosity` has one entry per mesh vertex, `unshot` one per polygon or
 /// per mesh vertex (by [`SolverOptions::unshot`]), every channel finite and
-/// `>= 0`.
+/// `>= 0` (unshot values may be negative) and at most [`MAX_STATE_VALUE`] in
+/// magnitude.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolverState {
     /// Radiosity per mesh vertex, in the scene's emission units.

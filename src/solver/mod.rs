@@ -353,9 +353,13 @@ pub enum SolverError {
         /// Unshot entries this solve has.
         expected_unshot: usize,
     },
-    /// A state to restore holds a non-finite value, or a negative
-    /// radiosity or charge.
-    #[error("the saved state holds a negative or non-finite value")]
+    /// A state to restore holds a non-finite value, a negative radiosity
+    /// or charge, or a value beyond [`checkpoint::MAX_STATE_VALUE`].
+    #[error(
+        "the saved state holds a negative, non-finite or impossibly large value \
+         (above {:e})",
+        checkpoint::MAX_STATE_VALUE
+    )]
     BadStateValue,
 }
 
@@ -999,9 +1003,12 @@ impl<'a> Progressive<'a> {
                 expected_unshot: self.unshot.values().len(),
             });
         }
-        let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0;
+        let limit = checkpoint::MAX_STATE_VALUE;
+        let bad = |c: &Rgb| !c.is_finite() || c.min_channel() < 0.0 || c.max_channel() > limit;
+        let bad_unshot =
+            |c: &Rgb| !c.is_finite() || c.max_channel() > limit || c.min_channel() < -limit;
         if state.radiosity.iter().chain(&state.charges).any(bad)
-            || state.unshot.iter().any(|c| !c.is_finite())
+            || state.unshot.iter().any(bad_unshot)
         {
             return Err(SolverError::BadStateValue);
         }

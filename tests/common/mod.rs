@@ -96,3 +96,42 @@ impl Rng {
         &items[self.below(items.len())]
     }
 }
+
+/// The address-space limit a fuzzing test binary runs under: a small input
+/// that makes the program allocate without bound then fails the test (an
+/// allocation failure aborts it) instead of exhausting the machine.
+pub const FUZZ_ADDRESS_SPACE: u64 = 4 << 30;
+
+/// Limits this test process's address space to [`FUZZ_ADDRESS_SPACE`]
+/// (once; a lower limit already set is kept). The limit is per process, so
+/// it covers every test of the binary that calls it: call it only from
+/// test binaries whose tests all stay far below it.
+pub fn limit_address_space() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let mut now = libc::rlimit {
+            rlim_cur: 0,
+            rlim_max: 0,
+        };
+        // SAFETY: getrlimit and setrlimit only read and write the struct
+        // passed, which lives for the call.
+        unsafe {
+            if libc::getrlimit(libc::RLIMIT_AS, &mut now) != 0 {
+                return;
+            }
+            let limit = FUZZ_ADDRESS_SPACE.min(now.rlim_max);
+            if now.rlim_cur != libc::RLIM_INFINITY && now.rlim_cur <= limit {
+                return;
+            }
+            let new = libc::rlimit {
+                rlim_cur: limit,
+                rlim_max: now.rlim_max,
+            };
+            assert_eq!(
+                libc::setrlimit(libc::RLIMIT_AS, &new),
+                0,
+                "cannot limit the address space"
+            );
+        }
+    });
+}

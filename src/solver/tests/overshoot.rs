@@ -236,6 +236,15 @@ fn negative_unshot_light_saves_and_resumes_bit_for_bit() {
     let mut bad = saved.clone();
     bad.radiosity[0] = Rgb::new(-1.0, 0.0, 0.0);
     assert_eq!(resumed.restore(bad), Err(SolverError::BadStateValue));
+    // Finite but beyond what any legal scene reaches: the next step would
+    // overflow.
+    let limit = checkpoint::MAX_STATE_VALUE;
+    for (radiosity, unshot) in [(2.0 * limit, 0.0), (0.0, 2.0 * limit), (0.0, -2.0 * limit)] {
+        let mut huge = saved.clone();
+        huge.radiosity[0].g += radiosity;
+        huge.unshot[0].b += unshot;
+        assert_eq!(resumed.restore(huge), Err(SolverError::BadStateValue));
+    }
     resumed.restore(saved).unwrap();
     for _ in 0..5 {
         solver.step();
