@@ -66,55 +66,136 @@ fn root(parent: &mut [u32], mut i: u32) -> u32 {
 
 /// One number per polygon: equal for polygons whose planes coincide (see
 /// the module docs), facing either way. The numbers are the smallest
-/// polygon index of each class, so they are deterministic.
+/// polygon index of each class, so they are deterministic. A class is a
+/// connected set of the "within tolerance" relation, which is not
+/// transitive: two planes a little more than the tolerance apart share a
+/// class when a third lies between them.
 ///
-/// Cost: one hash insertion and at most 16 look-ups per polygon (each
-/// plane is binned in cells twice the tolerance wide, and looked up in the
-/// cells its tolerance box touches).
+/// Cost: `O(n)` hash operations for `n` polygons, however many share one
+/// plane. Planes are binned in fine cells an eighth of the tolerance wide,
+/// whose members are within tolerance of each other and so one class;
+/// only cells are compared with cells (in coarse bins twice the tolerance
+/// wide), by the boxes their members span, and member pairs are looked at
+/// only for the rare two cells that are neither surely within tolerance nor
+/// surely apart. Twenty thousand tiles of one floor are one fine cell, not
+/// two hundred million pairs.
 pub fn plane_classes(scene: &Scene) -> Vec<u32> {
-    let n = scene.polygons.len();
     let extent = f64::from(scene.extent()).max(f64::MIN_POSITIVE);
-    let (cell_n, cell_d) = (
-        2.0 * PLANE_NORMAL_TOLERANCE,
-        2.0 * PLANE_OFFSET_TOLERANCE * extent,
-    );
-    let planes: Vec<(DVec3, f64)> = scene.polygons.iter().map(canonical_plane).collect();
-    let cell = |x: f64, size: f64| (x / size).floor() as i64;
-    let mut bins: HashMap<[i64; 4], Vec<u32>> = HashMap::new();
-    for (i, &(normal, d)) in planes.iter().enumerate() {
-        let key = [
-            cell(normal.x, cell_n),
-            cell(normal.y, cell_n),
-            cell(normal.z, cell_n),
-            cell(d, cell_d),
-        ];
-        bins.entry(key).or_default().push(i as u32);
-    }
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    let same = |a: (DVec3, f64), b: (DVec3, f64)| {
-        (a.0 - b.0).abs().max_element() <= PLANE_NORMAL_TOLERANCE
-            && (a.1 - b.1).abs() <= PLANE_OFFSET_TOLERANCE * extent
+    let planes: Vec<[f64; 4]> = scene
+        .polygons
+        .iter()
+        .map(|p| {
+            let (n, d) = canonical_plane(p);
+            [n.x, n.y, n.z, d]
+        })
+        .collect();
+    let tolerance = [
+        PLANE_NORMAL_TOLERANCE,
+        PLANE_NORMAL_TOLERANCE,
+        PLANE_NORMAL_TOLERANCE,
+        PLANE_OFFSET_TOLERANCE * extent,
+    ];
+    plane_components(&planes, tolerance)
+}
+
+/// The classes of [`plane_classes`] for planes given as `[nx, ny, nz, d]`:
+/// two planes are joined when they differ by at most `tolerance[k]` in
+/// every coordinate `k`. Numbered by each class's smallest index.
+fn plane_components(planes: &[[f64; 4]], tolerance: [f64; 4]) -> Vec<u32> {
+    type Key = [i64; 4];
+    let key = |p: &[f64; 4], size: [f64; 4]| -> Key {
+        std::array::from_fn(|k| (p[k] / size[k]).floor() as i64)
     };
-    for (i, &(normal, d)) in planes.iter().enumerate() {
-        // The cells within tolerance of this plane: at most two per axis.
-        let range = |x: f64, size: f64, tol: f64| (cell(x - tol, size), cell(x + tol, size));
-        let axes = [
-            range(normal.x, cell_n, PLANE_NORMAL_TOLERANCE),
-            range(normal.y, cell_n, PLANE_NORMAL_TOLERANCE),
-            range(normal.z, cell_n, PLANE_NORMAL_TOLERANCE),
-            range(d, cell_d, PLANE_OFFSET_TOLERANCE * extent),
-        ];
-        for a in axes[0].0..=axes[0].1 {
-            for b in axes[1].0..=axes[1].1 {
-                for c in axes[2].0..=axes[2].1 {
-                    for e in axes[3].0..=axes[3].1 {
-                        let Some(others) = bins.get(&[a, b, c, e]) else {
+    let within = |a: &[f64; 4], b: &[f64; 4]| (0..4).all(|k| (a[k] - b[k]).abs() <= tolerance[k]);
+    // Fine cells: two planes in one differ by less than an eighth of the
+    // tolerance in every coordinate.
+    let fine_size = tolerance.map(|t| t / 8.0);
+    let mut fine: HashMap<Key, u32> = HashMap::new();
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for (i, p) in planes.iter().enumerate() {
+        let cell = *fine.entry(key(p, fine_size)).or_insert_with(|| {
+            members.push(Vec::new());
+            (members.len() - 1) as u32
+        });
+        members[cell as usize].push(i as u32);
+    }
+    let mut parent: Vec<u32> = (0..planes.len() as u32).collect();
+    let union = |parent: &mut Vec<u32>, a: u32, b: u32| {
+        let (ra, rb) = (root(parent, a), root(parent, b));
+        parent[ra.max(rb) as usize] = ra.min(rb);
+    };
+    for cell in &members {
+        for &i in &cell[1..] {
+            union(&mut parent, cell[0], i);
+        }
+    }
+    // The box each cell's members span.
+    let spans: Vec<([f64; 4], [f64; 4])> = members
+        .iter()
+        .map(|cell| {
+            cell.iter().fold(
+                ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]),
+                |(lo, hi), &i| {
+                    let p = &planes[i as usize];
+                    (
+                        std::array::from_fn(|k| lo[k].min(p[k])),
+                        std::array::from_fn(|k| hi[k].max(p[k])),
+                    )
+                },
+            )
+        })
+        .collect();
+    // Coarse bins of cells, by their lowest corner.
+    let coarse_size = tolerance.map(|t| 2.0 * t);
+    let mut coarse: HashMap<Key, Vec<u32>> = HashMap::new();
+    for (c, (lo, _)) in spans.iter().enumerate() {
+        coarse
+            .entry(key(lo, coarse_size))
+            .or_default()
+            .push(c as u32);
+    }
+    for (a, (lo, hi)) in spans.iter().enumerate() {
+        // A cell within reach has its lowest corner within the tolerance
+        // of this cell's box, less the width of a fine cell.
+        let range: [(i64, i64); 4] = std::array::from_fn(|k| {
+            let cell = |x: f64| (x / coarse_size[k]).floor() as i64;
+            (
+                cell(lo[k] - tolerance[k] - fine_size[k]),
+                cell(hi[k] + tolerance[k]),
+            )
+        });
+        for x in range[0].0..=range[0].1 {
+            for y in range[1].0..=range[1].1 {
+                for z in range[2].0..=range[2].1 {
+                    for w in range[3].0..=range[3].1 {
+                        let Some(others) = coarse.get(&[x, y, z, w]) else {
                             continue;
                         };
-                        for &j in others {
-                            if (j as usize) < i && same(planes[i], planes[j as usize]) {
-                                let (ri, rj) = (root(&mut parent, i as u32), root(&mut parent, j));
-                                parent[ri.max(rj) as usize] = ri.min(rj);
+                        for &b in others {
+                            let b = b as usize;
+                            if b >= a {
+                                continue;
+                            }
+                            let (blo, bhi) = &spans[b];
+                            let apart =
+                                (0..4).any(|k| (blo[k] - hi[k]).max(lo[k] - bhi[k]) > tolerance[k]);
+                            if apart {
+                                continue;
+                            }
+                            let (ra, rb) = (members[a][0], members[b][0]);
+                            if root(&mut parent, ra) == root(&mut parent, rb) {
+                                continue;
+                            }
+                            let surely = (0..4)
+                                .all(|k| (hi[k] - blo[k]).max(bhi[k] - lo[k]) <= tolerance[k]);
+                            let joined = surely
+                                || members[a].iter().any(|&i| {
+                                    members[b]
+                                        .iter()
+                                        .any(|&j| within(&planes[i as usize], &planes[j as usize]))
+                                });
+                            if joined {
+                                union(&mut parent, ra, rb);
                             }
                         }
                     }
@@ -122,7 +203,9 @@ pub fn plane_classes(scene: &Scene) -> Vec<u32> {
             }
         }
     }
-    (0..n as u32).map(|i| root(&mut parent, i)).collect()
+    (0..planes.len() as u32)
+        .map(|i| root(&mut parent, i))
+        .collect()
 }
 
 /// The polygon's vertices in 2-D coordinates of a plane with unit normal
@@ -289,6 +372,24 @@ mod tests {
         )
     }
 
+    /// `n` × `n` square tiles 0.1 wide in the floor plane.
+    fn floor_tiles(n: usize) -> Vec<Polygon> {
+        (0..n * n)
+            .map(|k| {
+                let (x, z) = ((k % n) as f32 * 0.1, (k / n) as f32 * 0.1);
+                testutil::polygon(
+                    0,
+                    &[
+                        [x, 0.0, z],
+                        [x, 0.0, z + 0.1],
+                        [x + 0.1, 0.0, z + 0.1],
+                        [x + 0.1, 0.0, z],
+                    ],
+                )
+            })
+            .collect()
+    }
+
     fn scene(polygons: Vec<Polygon>) -> Scene {
         testutil::scene(
             polygons,
@@ -312,6 +413,60 @@ mod tests {
             rect(0.2, 0.4, 1e-7, 0),
         ]);
         assert_eq!(plane_classes(&s), vec![0, 1, 0, 0]);
+    }
+
+    /// The classes by brute force: every pair compared.
+    fn components_by_pairs(planes: &[[f64; 4]], tolerance: [f64; 4]) -> Vec<u32> {
+        let mut parent: Vec<u32> = (0..planes.len() as u32).collect();
+        for i in 0..planes.len() {
+            for j in 0..i {
+                if (0..4).all(|k| (planes[i][k] - planes[j][k]).abs() <= tolerance[k]) {
+                    let (ri, rj) = (root(&mut parent, i as u32), root(&mut parent, j as u32));
+                    parent[ri.max(rj) as usize] = ri.min(rj);
+                }
+            }
+        }
+        (0..planes.len() as u32)
+            .map(|i| root(&mut parent, i))
+            .collect()
+    }
+
+    #[test]
+    fn classes_are_those_of_every_pair_compared() {
+        // Planes in clusters a few tolerances wide, so that cells are
+        // joined surely, by a member pair, or not at all, and chains of
+        // planes each within tolerance of the next join across cells.
+        let tolerance = [1e-3, 1e-3, 1e-3, 1e-2];
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut unit = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for spread in [0.5, 2.0, 6.0, 30.0] {
+            let mut planes = Vec::new();
+            for cluster in 0..12 {
+                let centre = [0.0, (cluster % 3) as f64 * 0.01, 1.0, cluster as f64 * 0.05];
+                for _ in 0..40 {
+                    planes.push(std::array::from_fn(|k| {
+                        centre[k] + (unit() - 0.5) * spread * tolerance[k]
+                    }));
+                }
+            }
+            assert_eq!(
+                plane_components(&planes, tolerance),
+                components_by_pairs(&planes, tolerance),
+                "spread {spread}"
+            );
+        }
+    }
+
+    #[test]
+    fn many_tiles_of_one_floor_are_one_class() {
+        // 40,000 tiles (8e8 pairs: `benches/visibility.rs` times it).
+        let s = scene(floor_tiles(200));
+        assert!(plane_classes(&s).iter().all(|&c| c == 0));
     }
 
     #[test]
