@@ -29,7 +29,7 @@ pub use framing::{
 };
 pub use import::gltf::parse_gltf;
 pub use import::ies::{IesError, Photometry};
-pub use import::load;
+pub use import::{load, load_within};
 pub use import::obj::load_obj;
 pub use import::points::{load_points, MeasurementPoint, PointsError};
 pub use import::sc::{

@@ -1,6 +1,6 @@
 //! The OBJ and MTL readers' tests.
 
-use super::mtl::srgb_to_linear;
+use crate::scene::import::texture::srgb_to_linear;
 use super::scan::without_references;
 use super::*;
 use crate::color::Rgb;
