@@ -170,7 +170,9 @@ fn machine_default() -> u64 {
 /// The soft `Max address space` of a `/proc/self/limits` text, in bytes;
 /// `None` when unlimited or absent.
 fn address_space_limit(limits: &str) -> Option<u64> {
-    let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
     line["Max address space".len()..]
         .split_whitespace()
         .next()?
@@ -201,10 +203,9 @@ pub fn parse_bytes(text: &str) -> Result<u64, String> {
         }
         _ => (body, 1.0),
     };
-    let value: f64 = number
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{text}` is not a size: give bytes, or a number with K, M, G or T"))?;
+    let value: f64 = number.trim().parse().map_err(|_| {
+        format!("`{text}` is not a size: give bytes, or a number with K, M, G or T")
+    })?;
     let bytes = value * scale;
     if !bytes.is_finite() || bytes < 0.0 || bytes >= u64::MAX as f64 {
         return Err(format!("`{text}` is not a size in bytes"));
@@ -283,7 +284,8 @@ mod tests {
                       Max cpu time              unlimited            unlimited            seconds   \n\
                       Max address space         4096000000           unlimited            bytes     \n";
         assert_eq!(address_space_limit(limits), Some(4_096_000_000));
-        let unlimited = "Max address space         unlimited            unlimited            bytes\n";
+        let unlimited =
+            "Max address space         unlimited            unlimited            bytes\n";
         assert_eq!(address_space_limit(unlimited), None);
     }
 

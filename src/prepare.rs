@@ -154,11 +154,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
 pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let mut scene = load_scene_within(
-        &config.scene,
-        config.camera.as_deref(),
-        &config.max_memory,
-    )?;
+    let mut scene = load_scene_within(&config.scene, config.camera.as_deref(), &config.max_memory)?;
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }

@@ -8,8 +8,8 @@
 //! the front end (the threshold, exposure, element limit, checkpoint
 //! interval and thread count) are checked here.
 
-use crate::budget::MemoryBudget;
 use super::args::Args;
+use crate::budget::MemoryBudget;
 use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};

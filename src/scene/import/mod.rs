@@ -4,11 +4,11 @@
 //! ([`points`]). [`load`] picks the reader by the file's extension.
 
 pub mod gltf;
-pub mod texture;
 pub mod ies;
 pub mod obj;
 pub mod points;
 pub(super) mod sc;
+pub mod texture;
 
 use crate::budget::MemoryBudget;
 use crate::scene::{LoadError, Scene};

@@ -305,7 +305,10 @@ mod tests {
         grey.write_to(&mut Cursor::new(&mut tiff), image::ImageFormat::Tiff)
             .unwrap();
         let avg = average_bytes(&tiff, &MemoryBudget::UNLIMITED).unwrap();
-        assert!((avg.g - srgb_to_linear(188.0 / 255.0)).abs() < 1e-9, "{avg:?}");
+        assert!(
+            (avg.g - srgb_to_linear(188.0 / 255.0)).abs() < 1e-9,
+            "{avg:?}"
+        );
     }
 
     #[test]

@@ -16,8 +16,8 @@ pub(super) mod solids;
 pub(super) mod split;
 pub(super) mod trapped;
 
-use crate::color::Rgb;
 use crate::budget::{MemoryBudget, OverBudget};
+use crate::color::Rgb;
 use crate::scene::{PolygonError, Scene, Sides, SplitStats};
 use glam::Vec3;
 

@@ -66,7 +66,6 @@
 
 use crate::budget::{fmt_count, least_run_bytes, MemoryBudget, OverBudget};
 use crate::scene::{Polygon, PolygonId, Scene};
-use std::sync::atomic::{AtomicU64, Ordering};
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
@@ -74,6 +73,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::BvhBuildParams;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 /// Distance, as a fraction of the scene's extent (its bounding-box
@@ -420,7 +420,9 @@ impl Growth<'_> {
 
     /// True once some thread has gone over the budget.
     fn over(&self) -> bool {
-        !self.budget.fits(self.need(self.added.load(Ordering::Relaxed)))
+        !self
+            .budget
+            .fits(self.need(self.added.load(Ordering::Relaxed)))
     }
 }
 

@@ -7,9 +7,9 @@
 use super::scan::{lines, words};
 use super::{name_list, Tally, DEFAULT_REFLECTANCE, DIFFUSE_SHEEN_LIMIT, MAX_MTL_REFLECTANCE};
 use crate::budget::MemoryBudget;
-use crate::scene::import::texture;
 use crate::color::Rgb;
 use crate::scene::error::{fmt_num, negative_channel};
+use crate::scene::import::texture;
 use crate::scene::{Diagnostic, Material, SourcePos, Warning};
 use std::path::Path;
 
