@@ -186,8 +186,8 @@ impl Sum {
     fn rgb16_be(&mut self, data: &[u8], stride: usize) {
         let t = table16();
         for p in data.chunks_exact(2 * stride) {
-            for c in 0..3 {
-                self.rgb[c] += t[usize::from(u16::from_be_bytes([p[2 * c], p[2 * c + 1]]))];
+            for (sum, v) in self.rgb.iter_mut().zip(p.chunks_exact(2)) {
+                *sum += t[usize::from(u16::from_be_bytes([v[0], v[1]]))];
             }
         }
         self.pixels += (data.len() / (2 * stride)) as u64;
@@ -196,8 +196,8 @@ impl Sum {
     /// Float samples: linear already, clamped to `[0, 1]`.
     fn rgb32f(&mut self, data: &[f32], stride: usize) {
         for p in data.chunks_exact(stride) {
-            for c in 0..3 {
-                self.rgb[c] += f64::from(p[c]).clamp(0.0, 1.0);
+            for (sum, &v) in self.rgb.iter_mut().zip(p) {
+                *sum += f64::from(v).clamp(0.0, 1.0);
             }
         }
         self.pixels += (data.len() / stride) as u64;
