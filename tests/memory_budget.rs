@@ -42,6 +42,12 @@ fn assert_refused(o: &Output, expect: &str) {
 /// A glb whose one mesh of `triangles` small triangles is drawn by
 /// `nodes` nodes: a few hundred kB that expand to `triangles × nodes`.
 fn instancing_glb(dir: &Path, triangles: usize, nodes: usize) -> PathBuf {
+    instancing_glb_of_mode(dir, triangles, nodes, 4)
+}
+
+/// [`instancing_glb`] with the primitive's `mode` (4 triangles, 5 a
+/// strip, 6 a fan) over the same `3 × triangles` positions.
+fn instancing_glb_of_mode(dir: &Path, triangles: usize, nodes: usize, mode: u32) -> PathBuf {
     let mut bin = Vec::new();
     for t in 0..triangles {
         let (x, y) = ((t % 100) as f32 * 0.01, (t / 100) as f32 * 0.01);
@@ -61,7 +67,7 @@ fn instancing_glb(dir: &Path, triangles: usize, nodes: usize) -> PathBuf {
         "bufferViews":[{{"buffer":0,"byteLength":{len}}}],
         "accessors":[{{"bufferView":0,"componentType":5126,"count":{count},"type":"VEC3",
           "min":[0,0,0],"max":[1.01,{top},0]}}],
-        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"mode":{mode}}}]}}],
         "nodes":[{nodes}],"scenes":[{{"nodes":[{roots}]}}],"scene":0}}"#,
         len = bin.len(),
         count = triangles * 3,
@@ -154,6 +160,20 @@ fn glb_node_instancing_is_refused_before_its_triangles_are_built() {
     instancing_glb(dir.path(), 100, 10);
     let o = run(dir.path(), &["instancing.glb", "--max-memory", "1G"], None);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+#[test]
+fn strips_and_fans_count_their_triangles_over_every_instance() {
+    let dir = tempfile::tempdir().unwrap();
+    // 3,000 positions: a strip or fan of 2,998 triangles, drawn 1,000 times.
+    for mode in [5, 6] {
+        instancing_glb_of_mode(dir.path(), 1_000, 1_000, mode);
+        let o = run(dir.path(), &["instancing.glb", "--max-memory", "1G"], None);
+        assert_refused(
+            &o,
+            "(2,998,000 triangles from node instancing, 2,998 in the meshes themselves)",
+        );
+    }
 }
 
 #[test]
