@@ -3,6 +3,7 @@
 //! arguments; tests and examples build it with [`RunConfig::new`] and
 //! field updates. Values here are already validated.
 
+use crate::budget::MemoryBudget;
 use crate::color::Rgb;
 use crate::mesh::{self, refine::RefineOptions};
 use crate::render::falsecolor::{Quantity, Scale};
@@ -13,9 +14,10 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// Default for [`RunConfig::max_elements`]: [`mesh::MAX_ELEMENTS`], 20
-/// million elements. A mesh that large needs about 3.7 GB by
-/// [`mesh::memory_estimate`]; the bundled scenes at their default `lenmax` have
-/// about 15,000.
+/// million elements. A mesh that large needs about 12 GB by
+/// [`mesh::memory_estimate`], which `--max-memory` refuses on smaller
+/// machines; the bundled scenes at their default `lenmax` have about
+/// 15,000.
 pub const DEFAULT_MAX_ELEMENTS: u64 = mesh::MAX_ELEMENTS;
 
 /// Default for [`RunConfig::checkpoint_every`]: one minute, so at most a
@@ -94,6 +96,11 @@ pub struct RunConfig {
     /// Refuse meshes with more elements than this (see
     /// [`DEFAULT_MAX_ELEMENTS`]); at most [`mesh::MAX_ADDRESSABLE_ELEMENTS`].
     pub max_elements: u64,
+    /// The memory the run may take (`--max-memory`): every stage that
+    /// could grow far beyond its input checks its estimate against it
+    /// before allocating ([`crate::budget`]). Default
+    /// [`MemoryBudget::for_machine`].
+    pub max_memory: MemoryBudget,
     /// Where to save the solver state during the solve, if anywhere.
     pub checkpoint: Option<PathBuf>,
     /// How often to save the checkpoint (wall clock).
@@ -198,6 +205,7 @@ impl RunConfig {
             log: None,
             plot: None,
             max_elements: DEFAULT_MAX_ELEMENTS,
+            max_memory: MemoryBudget::for_machine(),
             checkpoint: None,
             checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
             resume: None,

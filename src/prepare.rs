@@ -12,11 +12,12 @@
 //! limit before allocating anything, mesh it and build the visibility BVH. What the batch run, the window and the examples all
 //! start from.
 
+use crate::budget::{self, MemoryBudget, OverBudget};
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::budget::VERTEX_BUDGET;
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
-use crate::scene::repair::{self, FirstHit, RepairOptions};
+use crate::scene::repair::{self, FirstHit, RepairError, RepairOptions};
 use crate::scene::{
     self, IesError, LoadError, LuminaireError, Photometry, PolygonError, Scene, SplitStats,
     UnknownName, Warning,
@@ -60,6 +61,10 @@ pub enum PrepareError {
          at distances in metres (glTF scenes are in metres; OBJ and .sc have no unit)"
     )]
     NoUnits(String),
+    /// The scene would need more memory than `--max-memory`: what the
+    /// estimate is and what makes it.
+    #[error("{0}")]
+    Memory(#[from] OverBudget),
 }
 
 /// Seconds spent in each phase of a run.
@@ -149,7 +154,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
 pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let mut scene = load_scene(&config.scene, config.camera.as_deref())?;
+    let mut scene = load_scene_within(&config.scene, config.camera.as_deref(), &config.max_memory)?;
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
@@ -172,6 +177,7 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         sides: config.sides,
         sky: config.sky,
         file: &name,
+        budget: config.max_memory,
     };
     let (mut scene, repaired) = repair::run(scene, &options, |scene| {
         let t = Instant::now();
@@ -179,7 +185,10 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         bvh_seconds = t.elapsed().as_secs_f64();
         built
     })
-    .map_err(PrepareError::Sky)?;
+    .map_err(|e| match e {
+        RepairError::Sky(e) => PrepareError::Sky(e),
+        RepairError::Memory(e) => PrepareError::Memory(e),
+    })?;
     let split = repaired.split;
     let visibility = OnceLock::new();
     if let Some(built) = repaired.rays {
@@ -216,7 +225,8 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     }
 
     let t = Instant::now();
-    mesh::check_size(&scene, &mesh_options, config.max_elements)?;
+    let size = mesh::check_size(&scene, &mesh_options, config.max_elements)?;
+    check_mesh_memory(&scene, &mesh_options, size, &config.max_memory)?;
     let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
     seconds.mesh = options_seconds + t.elapsed().as_secs_f64();
 
@@ -227,6 +237,33 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         lenmax: mesh_options.lenmax,
         seconds,
         split,
+    })
+}
+
+/// Refuses a mesh whose run would need more than `budget`
+/// ([`budget::run_bytes`]), saying its size and the lenmax that fits.
+fn check_mesh_memory(
+    scene: &Scene,
+    options: &MeshOptions,
+    size: mesh::MeshSize,
+    budget: &MemoryBudget,
+) -> Result<(), OverBudget> {
+    let polygons = scene.polygons.len() as u64;
+    let need = |s: mesh::MeshSize| budget::run_bytes(polygons, s.elements, s.vertices);
+    budget.check(need(size), || {
+        let fit = mesh::Sizes::of(scene)
+            .smallest_fitting(options.lenmax, |s| budget.fits(need(s)))
+            .map_or_else(
+                || "not even one element a polygon fits".to_string(),
+                |l| format!("use --lenmax {l} or larger"),
+            );
+        format!(
+            "{} polygons meshed at lenmax {} into {} elements on {} vertices; {fit}",
+            budget::fmt_count(polygons),
+            options.lenmax,
+            budget::fmt_count(size.elements),
+            budget::fmt_count(size.vertices),
+        )
     })
 }
 
@@ -241,9 +278,19 @@ impl FirstHit for Visibility {
 /// Loads the scene from its source, with the camera of the `.sc` file
 /// `camera` when given (see [`Scene::with_camera_from`]).
 pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    load_scene_within(source, camera, &MemoryBudget::for_machine())
+}
+
+/// [`load_scene`] within the memory budget `budget`
+/// ([`scene::load_within`]).
+pub fn load_scene_within(
+    source: &SceneSource,
+    camera: Option<&Path>,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let scene = match source {
         SceneSource::Bundled => scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?,
-        SceneSource::File(path) => scene::load(path)?,
+        SceneSource::File(path) => scene::load_within(path, budget)?,
     };
     scene.with_camera_from(camera)
 }

@@ -402,6 +402,7 @@ fn repair_and_mesh(m: &Model, loaded: Scene) {
         sides: Sides::AsLoaded,
         sky: Some(Rgb::splat(1.0)),
         file: &name,
+        budget: radiosity::budget::MemoryBudget::UNLIMITED,
     };
     let (repaired, _) = repair::run(loaded, &options, Visibility::new).unwrap();
     let warnings: Vec<String> = repaired.warnings.iter().map(|w| w.to_string()).collect();

@@ -319,10 +319,23 @@ pub struct Args {
     /// Refuse meshes with more elements than this.
     ///
     /// The mesh is refused before it is built, and the message says which
-    /// --lenmax fits. The default allows meshes of up to about 3.7 GB
-    /// (estimated; 2.7 GB measured).
+    /// --lenmax fits. The default allows meshes of up to about 12 GB
+    /// (estimated), which --max-memory may refuse first.
     #[arg(long, value_name = "N", default_value_t = config::DEFAULT_MAX_ELEMENTS)]
     pub(crate) max_elements: u64,
+
+    /// Refuse scenes whose estimated memory is over this many bytes.
+    ///
+    /// A size in bytes, or with K, M, G or T (powers of 1024): 4G, 512M.
+    /// Checked before anything large is built: the triangles of glTF
+    /// node instancing and of OBJ faces, the pieces of polygons split
+    /// along intersections, the mesh and decoded textures; the error says
+    /// the estimate and what makes it. Default: three quarters of the
+    /// machine's memory (or of the cgroup's memory.max), at most the
+    /// memory available now and half the address-space limit (ulimit
+    /// -v); 4G where these cannot be read.
+    #[arg(long, value_name = "BYTES", value_parser = parse_max_memory)]
+    pub(crate) max_memory: Option<u64>,
 
     /// Save the solver state to this file, to resume it later.
     ///
@@ -424,4 +437,18 @@ pub struct Args {
     /// Default: the largest value, rounded up to 1, 2 or 5 times a power of 10.
     #[arg(long, value_name = "V")]
     pub(crate) falsecolor_max: Option<f64>,
+}
+
+/// `--max-memory`: a size ([`crate::budget::parse_bytes`]) of at least
+/// [`crate::budget::MIN_BYTES`].
+fn parse_max_memory(text: &str) -> Result<u64, String> {
+    let bytes = crate::budget::parse_bytes(text)?;
+    if bytes < crate::budget::MIN_BYTES {
+        return Err(format!(
+            "{} is too little: a run needs at least {}",
+            crate::budget::fmt_bytes(bytes),
+            crate::budget::fmt_bytes(crate::budget::MIN_BYTES)
+        ));
+    }
+    Ok(bytes)
 }

@@ -9,6 +9,7 @@
 //! interval and thread count) are checked here.
 
 use super::args::Args;
+use crate::budget::MemoryBudget;
 use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
@@ -253,6 +254,9 @@ impl TryFrom<Args> for Invocation {
             plot: args.plot,
             progress: !args.quiet,
             max_elements: args.max_elements,
+            max_memory: args
+                .max_memory
+                .map_or_else(MemoryBudget::for_machine, MemoryBudget::new),
             checkpoint: args.checkpoint,
             checkpoint_every: Duration::from_secs_f64(
                 args.checkpoint_every.min(MAX_CHECKPOINT_EVERY_SECS),

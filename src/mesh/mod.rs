@@ -32,6 +32,7 @@
 //! factors to it vanish; moved a little inward it sees what the surface near
 //! the corner sees, so corners do not come out dark.
 
+use crate::budget::fmt_bytes;
 use crate::scene::{Polygon, PolygonId, Scene, Shape};
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;
@@ -434,18 +435,9 @@ pub fn lenmax_to_fit(scene: &Scene, options: &MeshOptions, max_elements: u64) ->
     Sizes::of(scene).smallest_fitting(options.lenmax, |s| s.elements <= max_elements)
 }
 
-/// Bytes held per mesh vertex during a whole run, for
-/// [`memory_estimate`]: positions and sample points (24, up to twice that
-/// while the arrays grow), the owning polygon (4), the solver's radiosity
-/// and step scratch (48), the rasterizer's projected vertex (about 32) and
-/// a checkpoint's copy (24). Measured peak memory stays below this estimate:
-/// 639 MB for 4.7 million vertices and elements, estimated 863 MB (see
-/// `docs/reliability.md`).
-pub const BYTES_PER_VERTEX: u64 = 160;
-
-/// Bytes held per mesh element during a run: its corners and owning
-/// polygon.
-pub const BYTES_PER_ELEMENT: u64 = 24;
+/// Bytes held per mesh vertex and per element during a run: the memory
+/// model of [`crate::budget`], which [`memory_estimate`] applies.
+pub use crate::budget::{BYTES_PER_ELEMENT, BYTES_PER_VERTEX};
 
 /// Estimated peak memory of a run with a mesh of this size, in bytes:
 /// [`BYTES_PER_VERTEX`] per vertex and [`BYTES_PER_ELEMENT`] per element.
@@ -453,18 +445,6 @@ pub fn memory_estimate(size: MeshSize) -> u64 {
     size.vertices
         .saturating_mul(BYTES_PER_VERTEX)
         .saturating_add(size.elements.saturating_mul(BYTES_PER_ELEMENT))
-}
-
-/// `bytes` as `1.5 GB`, `320 MB`, `12 kB`.
-fn fmt_bytes(bytes: u64) -> String {
-    let b = bytes as f64;
-    if b >= 1e9 {
-        format!("{:.1} GB", b / 1e9)
-    } else if b >= 1e6 {
-        format!("{:.0} MB", b / 1e6)
-    } else {
-        format!("{:.0} kB", (b / 1e3).ceil())
-    }
 }
 
 /// Builds the element mesh of every polygon of `scene`, refusing more than

@@ -29,12 +29,12 @@ pub use framing::{
 };
 pub use import::gltf::parse_gltf;
 pub use import::ies::{IesError, Photometry};
-pub use import::load;
 pub use import::obj::load_obj;
 pub use import::points::{load_points, MeasurementPoint, PointsError};
 pub use import::sc::{
     load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION,
 };
+pub use import::{load, load_within};
 pub use lighting::emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
 };

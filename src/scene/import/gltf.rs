@@ -83,7 +83,9 @@
 
 mod glb;
 
-use super::obj::{average_image, is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
+use super::obj::{is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
+use super::texture;
+use crate::budget::{fmt_count, least_run_bytes, MemoryBudget, OverBudget};
 use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
 use crate::color::Rgb;
 use crate::scene::error::{fmt_num, MAX_DIAGNOSTICS};
@@ -121,6 +123,18 @@ pub type ReadUri<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
 /// Errors name the file and the JSON path (or byte offset in a glb) of
 /// each problem, up to [`MAX_DIAGNOSTICS`].
 pub fn load_gltf(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    load_gltf_within(path, camera, &MemoryBudget::for_machine())
+}
+
+/// [`load_gltf`] within the memory budget `budget`: the triangles of
+/// every node instance are counted from the accessors before any is
+/// built, and a scene over the budget is refused; textures are decoded
+/// within it.
+pub fn load_gltf_within(
+    path: &Path,
+    camera: Option<&Path>,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path)
         .map_err(|e| Diagnostic::whole(&file, format!("cannot read file: {e}")))?;
@@ -129,13 +143,24 @@ pub fn load_gltf(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError>
         let p = dir.join(name);
         std::fs::read(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))
     };
-    parse_gltf(&bytes, &file, &read_uri)?.with_camera_from(camera)
+    parse_gltf_within(&bytes, &file, &read_uri, budget)?.with_camera_from(camera)
 }
 
 /// Parses glTF bytes (a glb, or the JSON of a `.gltf`) named `file`;
 /// `read_uri` reads the external files the JSON names. The entry point
 /// of [`load_gltf`] without the file system.
 pub fn parse_gltf(bytes: &[u8], file: &str, read_uri: &ReadUri<'_>) -> Result<Scene, LoadError> {
+    parse_gltf_within(bytes, file, read_uri, &MemoryBudget::for_machine())
+}
+
+/// [`parse_gltf`] within the memory budget `budget`, as
+/// [`load_gltf_within`].
+pub fn parse_gltf_within(
+    bytes: &[u8],
+    file: &str,
+    read_uri: &ReadUri<'_>,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let fail = |message: String| LoadError::from(Diagnostic::whole(file, message));
     let (json_bytes, blob) = if bytes.starts_with(b"glTF") {
         let glb = parse_glb(bytes).map_err(fail)?;
@@ -161,6 +186,7 @@ pub fn parse_gltf(bytes: &[u8], file: &str, read_uri: &ReadUri<'_>) -> Result<Sc
     let document = ::gltf::Document::from_json_without_validation(root);
     let mut reader = Reader::new(&document, file, blob, read_uri);
     reader.warnings = warnings;
+    reader.budget = *budget;
     reader.read()
 }
 
@@ -351,6 +377,8 @@ struct Reader<'a> {
     warnings: Vec<Warning>,
     /// Each glTF material's average texture colours, read once.
     textures: HashMap<usize, Result<Rgb, String>>,
+    /// The memory the scene may take.
+    budget: MemoryBudget,
 }
 
 /// A failure to read part of the file: the message, starting with its
@@ -396,6 +424,7 @@ impl<'a> Reader<'a> {
             diags: Vec::new(),
             warnings: Vec::new(),
             textures: HashMap::new(),
+            budget: MemoryBudget::for_machine(),
         }
     }
 
@@ -414,6 +443,8 @@ impl<'a> Reader<'a> {
                 return Err(Diagnostic::whole(file, message).into());
             }
         };
+        self.check_budget(&instances)
+            .map_err(|e| Diagnostic::whole(file, e.to_string()))?;
         let (mut materials, non_diffuse, bright) = self.materials();
         let mut gathered = Gathered::default();
         for instance in &instances {
@@ -426,6 +457,53 @@ impl<'a> Reader<'a> {
             gathered.group(instance, &mesh, first_polygon);
         }
         self.finish(gathered, materials, non_diffuse, bright)
+    }
+
+    /// Refuses a scene whose triangles, counted over every node instance
+    /// from the accessors' counts (a mesh drawn by many nodes counts once
+    /// for each), would take more than the budget ([`least_run_bytes`]):
+    /// before any triangle is built, so that a small file whose nodes
+    /// reuse large meshes ends with an error instead of gigabytes.
+    fn check_budget(&self, instances: &[Instance<'a>]) -> Result<(), OverBudget> {
+        let mut triangles = 0u64;
+        let mut once = 0u64;
+        let mut seen = std::collections::HashSet::new();
+        for instance in instances {
+            let Some(mesh) = instance.node.mesh() else {
+                continue;
+            };
+            let first = seen.insert(mesh.index());
+            for primitive in mesh.primitives() {
+                let corners = match primitive.indices() {
+                    Some(a) => a.count() as u64,
+                    None => primitive
+                        .get(&::gltf::Semantic::Positions)
+                        .map_or(0, |a| a.count() as u64),
+                };
+                use ::gltf::mesh::Mode;
+                let n = match primitive.mode() {
+                    Mode::Triangles => corners / 3,
+                    Mode::TriangleStrip | Mode::TriangleFan => corners.saturating_sub(2),
+                    _ => 0,
+                };
+                triangles = triangles.saturating_add(n);
+                if first {
+                    once = once.saturating_add(n);
+                }
+            }
+        }
+        let need = least_run_bytes(triangles, triangles.saturating_mul(3));
+        self.budget.check(need, || {
+            if triangles > once {
+                format!(
+                    "{} triangles from node instancing, {} in the meshes themselves",
+                    fmt_count(triangles),
+                    fmt_count(once)
+                )
+            } else {
+                format!("{} triangles", fmt_count(triangles))
+            }
+        })
     }
 
     /// The triangles of every primitive of `mesh` drawn by `instance`, in
@@ -817,14 +895,9 @@ impl<'a> Reader<'a> {
         if let Some(r) = self.textures.get(&index) {
             return r.clone();
         }
-        let result = self.image_bytes(index).and_then(|bytes| {
-            let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-                .with_guessed_format()
-                .map_err(|e| e.to_string())?;
-            reader.limits(texture_limits());
-            let image = reader.decode().map_err(|e| e.to_string())?;
-            average_image(&image)
-        });
+        let result = self
+            .image_bytes(index)
+            .and_then(|bytes| texture::average_bytes(&bytes, &self.budget));
         self.textures.insert(index, result.clone());
         result
     }
@@ -1146,16 +1219,6 @@ fn read_data_uri(uri: &str, read_uri: &ReadUri<'_>) -> Result<Vec<u8>, String> {
         .decode_utf8()
         .map_err(|_| format!("`{uri}` percent-decodes to something that is not UTF-8"))?;
     read_uri(&path)
-}
-
-/// Limits on a decoded texture: enough for any real texture (16k × 16k),
-/// and they stop a corrupt header from asking for gigabytes.
-fn texture_limits() -> image::Limits {
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(16_384);
-    limits.max_image_height = Some(16_384);
-    limits.max_alloc = Some(1 << 30);
-    limits
 }
 
 /// A colour for a message: `r g b` with three significant digits.

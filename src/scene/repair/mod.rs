@@ -16,6 +16,7 @@ pub(super) mod solids;
 pub(super) mod split;
 pub(super) mod trapped;
 
+use crate::budget::{MemoryBudget, OverBudget};
 use crate::color::Rgb;
 use crate::scene::{PolygonError, Scene, Sides, SplitStats};
 use glam::Vec3;
@@ -31,6 +32,23 @@ pub struct RepairOptions<'a> {
     pub sky: Option<Rgb>,
     /// The scene's name as the warnings give it.
     pub file: &'a str,
+    /// The memory the repaired scene may take: the splitting along
+    /// intersections stops when its pieces would need more
+    /// ([`Scene::split_intersections_within`]).
+    pub budget: MemoryBudget,
+}
+
+/// Why the repair passes could not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RepairError {
+    /// The `--sky` enclosure would lie beyond
+    /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE).
+    #[error("{0}")]
+    Sky(#[from] PolygonError),
+    /// Splitting along intersections would make more pieces than the
+    /// memory budget allows.
+    #[error("{0}")]
+    Memory(#[from] OverBudget),
 }
 
 /// Rays cast into the finished scene, which the trapped-sides pass needs:
@@ -59,13 +77,14 @@ pub struct RepairReport<R> {
 /// is called at most once, on the finished scene, when some face emits
 /// from both sides ([`Scene::emits_from_both_sides`]).
 ///
-/// Fails only when the `--sky` enclosure would lie beyond
-/// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE).
+/// Fails when the `--sky` enclosure would lie beyond
+/// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE), or when splitting
+/// would go over [`RepairOptions::budget`].
 pub fn run<R: FirstHit>(
     mut scene: Scene,
     options: &RepairOptions<'_>,
     build_rays: impl FnOnce(&Scene) -> R,
-) -> Result<(Scene, RepairReport<R>), PolygonError> {
+) -> Result<(Scene, RepairReport<R>), RepairError> {
     // Solids keep their outside only. Found before the cuts, which leave
     // T-junctions on a box sunk into a floor; the pieces keep the mark.
     if let Some(warning) = scene.orient_solids(options.sides, options.file) {
@@ -74,7 +93,7 @@ pub fn run<R: FirstHit>(
     // Not a quirk of the file, so no warning: geometry passing through
     // geometry is how models are built. Before the back copies, so that
     // each piece gets its own.
-    let split = scene.split_intersections();
+    let split = scene.split_intersections_within(&options.budget)?;
     let mut scene = scene.with_sides(options.sides);
     // A luminaire's back is a back copy, or made here as one: after the
     // back copies, so that it finds those of a two-sided scene.

@@ -99,12 +99,12 @@
 mod mtl;
 mod scan;
 
-pub(super) use mtl::average_image;
 use mtl::{parse_mtl, read_textures, Library, MtlMaterial};
 use scan::{
     first_word_col, line_at, repaired_text, scan_obj, smooth_surfaces, CountingReader, Scan,
 };
 
+use crate::budget::{fmt_count, least_run_bytes, MemoryBudget};
 use crate::color::Rgb;
 use crate::scene::error::{cannot_read, FILE_START, MAX_DIAGNOSTICS};
 use crate::scene::lighting::emit::GroupScan;
@@ -173,6 +173,17 @@ pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 /// and the column, and every problem found is reported (up to
 /// [`MAX_DIAGNOSTICS`]).
 pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    load_obj_within(path, camera, &MemoryBudget::for_machine())
+}
+
+/// [`load_obj`] within the memory budget `budget`: a file whose faces
+/// alone would take more is refused before they are built, and textures
+/// are decoded within it.
+pub fn load_obj_within(
+    path: &Path,
+    camera: Option<&Path>,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
     // Lossy: a stray Latin-1 byte in a comment must not refuse the model;
@@ -187,7 +198,7 @@ pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> 
             Err(e) => Err(format!("cannot read material library {display}: {e}")),
         }
     };
-    parse_obj(&text, &file, &read_mtl)?.with_camera_from(camera)
+    parse_obj_within(&text, &file, &read_mtl, budget)?.with_camera_from(camera)
 }
 
 /// Turns a `mtllib` name into the library's name for messages and its
@@ -200,8 +211,28 @@ pub type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
 /// `map_Kd` textures are still read from the file system, relative to the
 /// folder of the library's name. The camera frames the model.
 pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene, LoadError> {
+    parse_obj_within(text, file, read_mtl, &MemoryBudget::for_machine())
+}
+
+/// [`parse_obj`] within the memory budget `budget`, as
+/// [`load_obj_within`].
+pub fn parse_obj_within(
+    text: &str,
+    file: &str,
+    read_mtl: &ReadMtl<'_>,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut scan = scan_obj(text, file);
+    // Each face becomes at least one polygon of three corners, meshed at
+    // least into one element: refused here, before `tobj` and the
+    // polygons, when even that is over the budget.
+    let faces = scan.faces.iter().filter(|f| !f.is_line).count() as u64;
+    budget
+        .check(least_run_bytes(faces, faces.saturating_mul(3)), || {
+            format!("{} faces", fmt_count(faces))
+        })
+        .map_err(|e| Diagnostic::whole(file, e.to_string()))?;
     smooth_surfaces(&mut scan.faces);
     let mut diags = scan.diags.clone();
     if diags.len() >= MAX_DIAGNOSTICS {
@@ -223,6 +254,7 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
         reading.mtllib_backslashes,
         &scan,
         file,
+        budget,
     );
     let models = placed_models(
         reading.loaded,
@@ -362,10 +394,11 @@ fn reading_warnings(
     backslashes: Tally,
     scan: &Scan,
     file: &str,
+    budget: &MemoryBudget,
 ) -> Vec<Warning> {
     let mut warnings = Vec::new();
     for lib in libraries {
-        read_textures(lib);
+        read_textures(lib, budget);
         warnings.append(&mut lib.warnings);
     }
     warnings.extend(unreadable);

@@ -6,8 +6,10 @@
 
 use super::scan::{lines, words};
 use super::{name_list, Tally, DEFAULT_REFLECTANCE, DIFFUSE_SHEEN_LIMIT, MAX_MTL_REFLECTANCE};
+use crate::budget::MemoryBudget;
 use crate::color::Rgb;
 use crate::scene::error::{fmt_num, negative_channel};
+use crate::scene::import::texture;
 use crate::scene::{Diagnostic, Material, SourcePos, Warning};
 use std::path::Path;
 
@@ -308,8 +310,9 @@ fn warn_about_materials(lib: &mut Library) {
 
 /// Reads each `map_Kd` texture of `lib` (relative to the library's folder)
 /// and records its average colour; one warning for those that cannot be
-/// read (they keep their `Kd`), one for paths written with `\`.
-pub(super) fn read_textures(lib: &mut Library) {
+/// read (they keep their `Kd`), one for paths written with `\`. A texture
+/// is decoded within `budget` ([`texture`]).
+pub(super) fn read_textures(lib: &mut Library, budget: &MemoryBudget) {
     let dir = Path::new(&lib.file)
         .parent()
         .map(Path::to_path_buf)
@@ -320,7 +323,7 @@ pub(super) fn read_textures(lib: &mut Library) {
             continue;
         };
         let path = dir.join(name);
-        match average_texture(&path) {
+        match texture::average_file(&path, budget) {
             Ok(rgb) => m.texture = Some(rgb),
             Err(e) => failed.add(*pos, || {
                 format!("{} (material `{}`): {e}", path.display(), m.name)
@@ -346,46 +349,6 @@ pub(super) fn read_textures(lib: &mut Library) {
                 lib.backslashes.count
             ),
         ));
-    }
-}
-
-/// The average colour of the image at `path`, in linear values (8- and
-/// 16-bit images are sRGB-decoded first; float images are linear
-/// already), alpha ignored. Each channel is in `[0, 1]`.
-pub(crate) fn average_texture(path: &Path) -> Result<Rgb, String> {
-    let image = image::open(path).map_err(|e| e.to_string())?;
-    average_image(&image)
-}
-
-/// The average colour of `image`, as [`average_texture`] says.
-pub(in crate::scene::import) fn average_image(image: &image::DynamicImage) -> Result<Rgb, String> {
-    let linear = matches!(
-        image,
-        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-    );
-    let pixels = image.to_rgb32f();
-    let n = u64::from(pixels.width()) * u64::from(pixels.height());
-    if n == 0 {
-        return Err("the image has no pixels".to_string());
-    }
-    let mut sum = [0.0f64; 3];
-    for p in pixels.pixels() {
-        for (s, &c) in sum.iter_mut().zip(&p.0) {
-            let c = f64::from(c).clamp(0.0, 1.0);
-            *s += if linear { c } else { srgb_to_linear(c) };
-        }
-    }
-    let [r, g, b] = sum.map(|s| s / n as f64);
-    Ok(Rgb::new(r, g, b))
-}
-
-/// The sRGB transfer function undone: an encoded value in `[0, 1]` to
-/// linear light in `[0, 1]` (IEC 61966-2-1).
-pub(super) fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
 

@@ -1,9 +1,9 @@
 //! The OBJ and MTL readers' tests.
 
-use super::mtl::srgb_to_linear;
 use super::scan::without_references;
 use super::*;
 use crate::color::Rgb;
+use crate::scene::import::texture::srgb_to_linear;
 use crate::scene::Shape;
 
 const MTL: &str = "\
