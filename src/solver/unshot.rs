@@ -808,14 +808,16 @@ fn cell_sources(
             sources[k] = Some(SampleSource::Region(start, regions.len() as u32));
         }
     }
-    sources
-        .into_iter()
-        .zip(cells)
-        .map(|(source, &(p, _))| source.unwrap_or_else(|| point_source(mesh, pm, p)))
-        .collect()
+    // The cells without a region read the field at their point.
+    let bare: Vec<usize> = (0..cells.len()).filter(|&k| sources[k].is_none()).collect();
+    let read = point_sources(mesh, pm, bare.iter().map(|&k| cells[k].0));
+    for (k, source) in bare.into_iter().zip(read) {
+        sources[k] = Some(source);
+    }
+    sources.into_iter().flatten().collect()
 }
 
-/// Where each of a polygon's shooter samples reads its unshot radiosity.
+/// Where a polygon's shooter samples read their unshot radiosity.
 fn sample_sources(
     mesh: &Mesh,
     pm: &PolygonMesh,
@@ -831,18 +833,32 @@ fn sample_sources(
 }
 
 /// Where the unshot radiosity at each of `points` (on polygon `pm`) is
-/// read from ([`point_source`]).
+/// read from ([`point_source`]). Many points on a polygon of many elements
+/// are located through a grid of the element triangles, which gives the
+/// same triangles as the search of every element, in time linear in the
+/// points and triangles rather than their product (a convex face of
+/// 100,000 vertices has millions of element triangles).
 fn point_sources(
     mesh: &Mesh,
     pm: &PolygonMesh,
-    points: impl Iterator<Item = glam::Vec3>,
+    points: impl ExactSizeIterator<Item = glam::Vec3>,
 ) -> Vec<SampleSource> {
-    points.map(|p| point_source(mesh, pm, p)).collect()
+    let triangles: u64 = 2 * u64::from(pm.elements.end - pm.elements.start);
+    if (points.len() as u64) * triangles < LOCATOR_MIN_WORK {
+        return points.map(|p| point_source(mesh, pm, p)).collect();
+    }
+    let locator = Locator::new(mesh, pm);
+    points.map(|p| locator.source(mesh, pm, p)).collect()
 }
+
+/// Points times element triangles below which [`point_sources`] searches
+/// every element for each point rather than build a [`Locator`].
+const LOCATOR_MIN_WORK: u64 = 1 << 14;
 
 /// Where the unshot radiosity at point `p` (on polygon `pm`) is read
 /// from: the element triangle holding it, the one whose smallest
-/// barycentric weight is largest (>= 0 inside).
+/// barycentric weight is largest (>= 0 inside), the first in element order
+/// among equals.
 fn point_source(mesh: &Mesh, pm: &PolygonMesh, p: glam::Vec3) -> SampleSource {
     let mut best = (f32::NEG_INFINITY, SampleSource::PolygonMean);
     for e in pm.elements.clone() {
@@ -856,6 +872,114 @@ fn point_source(mesh: &Mesh, pm: &PolygonMesh, p: glam::Vec3) -> SampleSource {
         }
     }
     best.1
+}
+
+/// A polygon's element triangles binned by their bounds in its plane, to
+/// find the triangles that may hold a point without looking at the rest.
+struct Locator {
+    /// Every element triangle of the polygon, in element order.
+    triangles: Vec<[crate::mesh::VertexId; 3]>,
+    /// Triangles whose weights are all zero whatever the point
+    /// ([`barycentric`] of a degenerate triangle): candidates everywhere.
+    degenerate: Vec<u32>,
+    /// In-plane axes.
+    u: glam::Vec3,
+    v: glam::Vec3,
+    lo: glam::Vec2,
+    size: glam::Vec2,
+    n: usize,
+    /// Per bucket, the triangles whose (slightly grown) bounds meet it, in
+    /// ascending order.
+    buckets: Vec<Vec<u32>>,
+}
+
+impl Locator {
+    fn new(mesh: &Mesh, pm: &PolygonMesh) -> Locator {
+        let triangles: Vec<[crate::mesh::VertexId; 3]> = pm
+            .elements
+            .clone()
+            .flat_map(|e| mesh.elements[e as usize].triangles())
+            .collect();
+        let (u, v) = pm.normal.normalize().any_orthonormal_pair();
+        let flat = |p: glam::Vec3| glam::Vec2::new(p.dot(u), p.dot(v));
+        let boxes: Vec<(glam::Vec2, glam::Vec2)> = triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|i| flat(mesh.positions[i.index()]));
+                (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+            })
+            .collect();
+        let (lo, hi) = boxes.iter().fold(
+            (glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY),
+            |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
+        );
+        // Grown by far more than f32 rounding of the projection, so a
+        // point on a triangle's edge finds it.
+        let grow = glam::Vec2::splat(1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE));
+        let n = ((triangles.len() as f64).sqrt().ceil() as usize).clamp(1, 1024);
+        let size = ((hi - lo + 2.0 * grow) / n as f32).max(glam::Vec2::splat(f32::MIN_POSITIVE));
+        let lo = lo - grow;
+        let mut locator = Locator {
+            degenerate: Vec::new(),
+            u,
+            v,
+            lo,
+            size,
+            n,
+            buckets: vec![Vec::new(); n * n],
+            triangles: Vec::new(),
+        };
+        for (k, (t, &(a, b))) in triangles.iter().zip(&boxes).enumerate() {
+            let [pa, pb, pc] = t.map(|i| mesh.positions[i.index()]);
+            if barycentric(pa, pa, pb, pc) == [0.0; 3] {
+                locator.degenerate.push(k as u32);
+                continue;
+            }
+            let ((x0, y0), (x1, y1)) = (locator.bucket(a - grow), locator.bucket(b + grow));
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    locator.buckets[y * n + x].push(k as u32);
+                }
+            }
+        }
+        locator.triangles = triangles;
+        locator
+    }
+
+    /// The bucket holding in-plane point `p`, clamped to the grid.
+    fn bucket(&self, p: glam::Vec2) -> (usize, usize) {
+        let at = (p - self.lo) / self.size;
+        let clamp = |x: f32| (x.max(0.0) as usize).min(self.n - 1);
+        (clamp(at.x), clamp(at.y))
+    }
+
+    /// [`point_source`] of `p`: the candidates of its bucket and the
+    /// degenerate triangles hold every triangle that contains `p`, so when
+    /// one does, the best of them (largest smallest weight, then first in
+    /// element order) is the best of all; otherwise every triangle is
+    /// searched.
+    fn source(&self, mesh: &Mesh, pm: &PolygonMesh, p: glam::Vec3) -> SampleSource {
+        let (x, y) = self.bucket(glam::Vec2::new(p.dot(self.u), p.dot(self.v)));
+        let mut best: Option<(f32, u32, [f32; 3])> = None;
+        for &k in self.buckets[y * self.n + x].iter().chain(&self.degenerate) {
+            let [a, b, c] = self.triangles[k as usize].map(|v| mesh.positions[v.index()]);
+            let w = barycentric(p, a, b, c);
+            let least = w[0].min(w[1]).min(w[2]);
+            let better = match best {
+                None => true,
+                Some((l, i, _)) => least > l || (least == l && k < i),
+            };
+            if better {
+                best = Some((least, k, w));
+            }
+        }
+        match best {
+            Some((least, k, w)) if least >= 0.0 => {
+                SampleSource::Triangle(self.triangles[k as usize].map(|v| v.0), w)
+            }
+            _ => point_source(mesh, pm, p),
+        }
+    }
 }
 
 /// Barycentric weights of `p` (projected into the triangle's plane) in
@@ -877,6 +1001,42 @@ fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f
 mod tests {
     use super::Shot;
     use crate::color::Rgb;
+
+    /// The grid of a polygon's element triangles finds, for points inside,
+    /// on element edges and vertices, and outside, the same triangle and
+    /// weights as the search of every element.
+    #[test]
+    fn the_locator_finds_what_the_search_of_every_element_finds() {
+        use super::{point_source, Locator, SampleSource};
+        use crate::testutil::{grey, polygon, regular_mesh, scene, Xorshift};
+        // A 40-gon, fanned and subdivided: slivers around a centre.
+        let disc: Vec<[f32; 3]> = (0..40)
+            .map(|k| {
+                let a = -std::f32::consts::TAU * k as f32 / 40.0;
+                [a.cos(), 0.0, a.sin()]
+            })
+            .collect();
+        let s = scene(vec![polygon(0, &disc)], vec![grey("floor", 0.0, 0.5)]);
+        let mesh = regular_mesh(&s, 0.2);
+        let pm = &mesh.polygons[0];
+        let locator = Locator::new(&mesh, pm);
+        let mut rng = Xorshift(7);
+        let mut points: Vec<glam::Vec3> = mesh.positions.clone();
+        points.extend(mesh.sample_positions.iter().copied());
+        for _ in 0..2000 {
+            let (x, z) = (2.4 * rng.unit_f32() - 1.2, 2.4 * rng.unit_f32() - 1.2);
+            points.push(glam::Vec3::new(x, 1e-4 * (rng.unit_f32() - 0.5), z));
+        }
+        let mut inside = 0;
+        for p in points {
+            let found = point_source(&mesh, pm, p);
+            inside += matches!(found, SampleSource::Triangle(_, w) if w.iter().all(|&x| x >= 0.0))
+                as usize;
+            assert_eq!(locator.source(&mesh, pm, p), found, "at {p}");
+        }
+        // Most points are inside the disc, so the grid answered them.
+        assert!(inside > 1500, "{inside} points inside");
+    }
 
     /// A shot sends, per channel, its sign's part beyond what the point
     /// still expects (`gain` times what it has received, at most `cap`),
