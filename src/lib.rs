@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod camera;
+pub mod cancel;
 pub mod cli;
 pub mod color;
 pub mod config;

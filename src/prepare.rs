@@ -12,11 +12,12 @@
 //! limit before allocating anything, mesh it and build the visibility BVH. What the batch run, the window and the examples all
 //! start from.
 
+use crate::cancel::{self, Cancel, Cancelled};
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::budget::VERTEX_BUDGET;
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
-use crate::scene::repair::{self, FirstHit, RepairOptions};
+use crate::scene::repair::{self, FirstHit, RepairError, RepairOptions};
 use crate::scene::{
     self, IesError, LoadError, LuminaireError, Photometry, PolygonError, Scene, SplitStats,
     UnknownName, Warning,
@@ -60,6 +61,10 @@ pub enum PrepareError {
          at distances in metres (glTF scenes are in metres; OBJ and .sc have no unit)"
     )]
     NoUnits(String),
+    /// The cancellation token was set while preparing
+    /// ([`prepare_cancellable`]).
+    #[error("{0}")]
+    Interrupted(#[from] Cancelled),
 }
 
 /// Seconds spent in each phase of a run.
@@ -135,8 +140,17 @@ impl Prepared {
 /// [`RunConfig::max_elements`] before building it, with the lenmax that
 /// would fit.
 pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
-    let prepared = prepare_deferred(config)?;
+    prepare_cancellable(config, &Cancel::never())
+}
+
+/// [`prepare`], stopping with [`PrepareError::Interrupted`] soon after
+/// `cancel` is set: while loading, between the repair passes and per
+/// polygon split, per polygon meshed, and before and after the BVH.
+pub fn prepare_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<Prepared, PrepareError> {
+    let prepared = prepare_deferred_cancellable(config, cancel)?;
+    cancel.check()?;
     prepared.visibility();
+    cancel.check()?;
     Ok(prepared)
 }
 
@@ -147,9 +161,18 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
 /// all the same, to find the sides that face a surface across a narrow
 /// gap ([`Scene::silence_covered_sides`]).
 pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
+    prepare_deferred_cancellable(config, &Cancel::never())
+}
+
+/// [`prepare_deferred`] checking `cancel` as [`prepare_cancellable`] does.
+fn prepare_deferred_cancellable(
+    config: &RunConfig,
+    cancel: &Cancel,
+) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let mut scene = load_scene(&config.scene, config.camera.as_deref())?;
+    let mut scene = load_scene_cancellable(&config.scene, config.camera.as_deref(), cancel)?;
+    cancel.check()?;
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
@@ -173,13 +196,17 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         sky: config.sky,
         file: &name,
     };
-    let (mut scene, repaired) = repair::run(scene, &options, |scene| {
+    let built = |scene: &Scene| {
         let t = Instant::now();
         let built = Visibility::new(scene);
         bvh_seconds = t.elapsed().as_secs_f64();
         built
-    })
-    .map_err(PrepareError::Sky)?;
+    };
+    let (mut scene, repaired) =
+        repair::run_cancellable(scene, &options, built, cancel).map_err(|e| match e {
+            RepairError::Sky(e) => PrepareError::Sky(e),
+            RepairError::Interrupted(c) => PrepareError::Interrupted(c),
+        })?;
     let split = repaired.split;
     let visibility = OnceLock::new();
     if let Some(built) = repaired.rays {
@@ -217,7 +244,12 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
 
     let t = Instant::now();
     mesh::check_size(&scene, &mesh_options, config.max_elements)?;
-    let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
+    cancel.check()?;
+    let mesh = mesh::build_cancellable(&scene, &mesh_options, config.max_elements, cancel)
+        .map_err(|e| match e {
+            MeshError::Interrupted(c) => PrepareError::Interrupted(c),
+            e => PrepareError::Mesh(e),
+        })?;
     seconds.mesh = options_seconds + t.elapsed().as_secs_f64();
 
     Ok(Prepared {
@@ -246,6 +278,21 @@ pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, 
         SceneSource::File(path) => scene::load(path)?,
     };
     scene.with_camera_from(camera)
+}
+
+/// [`load_scene`], returning [`PrepareError::Interrupted`] as soon as
+/// `cancel` is set: the loaders read and parse in libraries that cannot be
+/// asked to stop, and write nothing, so the load runs on a thread that an
+/// interrupt abandons ([`cancel::abandonable`]).
+fn load_scene_cancellable(
+    source: &SceneSource,
+    camera: Option<&Path>,
+    cancel: &Cancel,
+) -> Result<Scene, PrepareError> {
+    let (source, camera) = (source.clone(), camera.map(Path::to_path_buf));
+    Ok(cancel::abandonable(cancel, move || {
+        load_scene(&source, camera.as_deref())
+    })??)
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@
 //! test holds the two together).
 
 use super::view::View;
+use crate::cancel::Cancel;
 use crate::color::Rgb;
 use crate::mesh::{Mesh, VertexId};
 use glam::{DVec2, DVec3};
@@ -195,6 +196,10 @@ pub enum RenderError {
     /// The mesh's arrays disagree (a bug in whoever built it).
     #[error("inconsistent mesh: {0}")]
     BadMesh(String),
+    /// The run's cancellation token was set while drawing
+    /// ([`Rasterizer::render_cancellable`]); the picture is incomplete.
+    #[error("{0}")]
+    Cancelled(#[from] crate::cancel::Cancelled),
 }
 
 /// The z-buffer rasterizer. It owns the colour, coverage and depth buffers
@@ -267,6 +272,19 @@ impl Rasterizer {
         radiosity: &[Rgb],
         view: &View,
     ) -> Result<&Frame, RenderError> {
+        self.render_cancellable(mesh, radiosity, view, &Cancel::never())
+    }
+
+    /// [`Rasterizer::render`], stopping with [`RenderError::Cancelled`]
+    /// soon after `cancel` is set: it is checked per run of elements set
+    /// up and per band of tiles drawn, each far below a tenth of a second.
+    pub fn render_cancellable(
+        &mut self,
+        mesh: &Mesh,
+        radiosity: &[Rgb],
+        view: &View,
+        cancel: &Cancel,
+    ) -> Result<&Frame, RenderError> {
         check_mesh(mesh, radiosity)?;
         let (width, height) = (view.width(), view.height());
         let n = self.frame.resize(width, height);
@@ -277,7 +295,8 @@ impl Rasterizer {
         let w = width as usize;
         let tiles_x = w.div_ceil(TILE_WIDTH);
         let tiles = tiles_x * (height as usize).div_ceil(TILE_HEIGHT);
-        self.setup(mesh, radiosity, view, tiles_x, tiles);
+        self.setup(mesh, radiosity, view, tiles_x, tiles, cancel);
+        cancel.check()?;
 
         let batches = &self.batches;
         let vertices = &self.vertices;
@@ -306,6 +325,9 @@ impl Rasterizer {
                     back,
                 };
                 for tx in 0..tiles_x {
+                    if cancel.is_set() {
+                        return;
+                    }
                     let tile = ty * tiles_x + tx;
                     let columns = tx * TILE_WIDTH..((tx + 1) * TILE_WIDTH).min(w);
                     // Batches in mesh order, each bin in mesh order: every
@@ -319,6 +341,7 @@ impl Rasterizer {
                     }
                 }
             });
+        cancel.check()?;
         Ok(&self.frame)
     }
 
@@ -326,7 +349,15 @@ impl Rasterizer {
     /// parallel: first every mesh vertex (camera space, which side of each
     /// clip plane, projection), then runs of elements, which keep mesh
     /// order.
-    fn setup(&mut self, mesh: &Mesh, radiosity: &[Rgb], view: &View, tiles_x: usize, tiles: usize) {
+    fn setup(
+        &mut self,
+        mesh: &Mesh,
+        radiosity: &[Rgb],
+        view: &View,
+        tiles_x: usize,
+        tiles: usize,
+        cancel: &Cancel,
+    ) {
         let setup = Setup::new(view);
         self.vertices
             .resize(mesh.positions.len(), ProjectedVertex::default());
@@ -351,6 +382,9 @@ impl Rasterizer {
             .for_each(|(k, batch)| {
                 batch.triangles.clear();
                 batch.local.clear();
+                if cancel.is_set() {
+                    return;
+                }
                 for e in k * chunk..((k + 1) * chunk).min(elements) {
                     // Checked by `check_mesh`: every index below is in range.
                     let polygon = &mesh.polygons[mesh.element_polygon[e].index()];

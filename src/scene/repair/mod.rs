@@ -16,6 +16,7 @@ pub(super) mod solids;
 pub(super) mod split;
 pub(super) mod trapped;
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::scene::{PolygonError, Scene, Sides, SplitStats};
 use glam::Vec3;
@@ -62,10 +63,39 @@ pub struct RepairReport<R> {
 /// Fails only when the `--sky` enclosure would lie beyond
 /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE).
 pub fn run<R: FirstHit>(
-    mut scene: Scene,
+    scene: Scene,
     options: &RepairOptions<'_>,
     build_rays: impl FnOnce(&Scene) -> R,
 ) -> Result<(Scene, RepairReport<R>), PolygonError> {
+    run_cancellable(scene, options, build_rays, &Cancel::never()).map_err(|e| match e {
+        RepairError::Sky(e) => e,
+        // A token nobody holds is never set.
+        RepairError::Interrupted(_) => unreachable!("a never-set token was set"),
+    })
+}
+
+/// Why [`run_cancellable`] stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RepairError {
+    /// The `--sky` enclosure would lie beyond
+    /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE).
+    #[error("{0}")]
+    Sky(#[from] PolygonError),
+    /// The cancellation token was set during the passes.
+    #[error("{0}")]
+    Interrupted(#[from] Cancelled),
+}
+
+/// [`run`], stopping with [`RepairError::Interrupted`] soon after `cancel`
+/// is set: it is checked between the passes and per polygon while
+/// splitting, the pass that can take long.
+pub fn run_cancellable<R: FirstHit>(
+    mut scene: Scene,
+    options: &RepairOptions<'_>,
+    build_rays: impl FnOnce(&Scene) -> R,
+    cancel: &Cancel,
+) -> Result<(Scene, RepairReport<R>), RepairError> {
+    cancel.check()?;
     // Solids keep their outside only. Found before the cuts, which leave
     // T-junctions on a box sunk into a floor; the pieces keep the mark.
     if let Some(warning) = scene.orient_solids(options.sides, options.file) {
@@ -74,7 +104,7 @@ pub fn run<R: FirstHit>(
     // Not a quirk of the file, so no warning: geometry passing through
     // geometry is how models are built. Before the back copies, so that
     // each piece gets its own.
-    let split = scene.split_intersections();
+    let split = scene.split_intersections_cancellable(cancel)?;
     let mut scene = scene.with_sides(options.sides);
     // A luminaire's back is a back copy, or made here as one: after the
     // back copies, so that it finds those of a two-sided scene.
@@ -89,6 +119,7 @@ pub fn run<R: FirstHit>(
     // finished geometry, sky included (silencing a side changes only a
     // material, so they stay valid and are handed back).
     let mut rays = None;
+    cancel.check()?;
     if scene.emits_from_both_sides() {
         let built = build_rays(&scene);
         let first_hit = |origin, direction| built.first_hit_distance(origin, direction);

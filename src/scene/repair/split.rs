@@ -438,9 +438,22 @@ impl Scene {
     /// Meant to run once, after loading and before `with_sides` adds back
     /// copies; a scene that already has back copies is left unchanged.
     pub fn split_intersections(&mut self) -> SplitStats {
+        let never = crate::cancel::Cancel::never();
+        // Never set, so never cancelled.
+        self.split_intersections_cancellable(&never)
+            .unwrap_or_default()
+    }
+
+    /// [`Scene::split_intersections`], stopping with
+    /// [`Cancelled`](crate::cancel::Cancelled) (the scene unchanged) soon
+    /// after `cancel` is set: each polygon checks it before it is cut.
+    pub fn split_intersections_cancellable(
+        &mut self,
+        cancel: &crate::cancel::Cancel,
+    ) -> Result<SplitStats, crate::cancel::Cancelled> {
         let n = self.polygons.len();
         if n < 2 || self.polygons.iter().any(|p| p.surface.back_of.is_some()) {
-            return SplitStats::default();
+            return Ok(SplitStats::default());
         }
         let eps = SPLIT_TOLERANCE * f64::from(self.extent());
         let vertices: Vec<Vec<DVec3>> = self
@@ -473,6 +486,9 @@ impl Scene {
         let replaced: Vec<Option<Vec<Polygon>>> = (0..n)
             .into_par_iter()
             .map(|p| {
+                if cancel.is_set() {
+                    return None;
+                }
                 let others = overlapping(&bvh, &boxes, p);
                 let cuts = cuts_of(p, &others, &vertices, &planes, eps);
                 if cuts.is_empty() {
@@ -482,10 +498,11 @@ impl Scene {
                 }
             })
             .collect();
+        cancel.check()?;
 
         let mut stats = SplitStats::default();
         if replaced.iter().all(Option::is_none) {
-            return stats;
+            return Ok(stats);
         }
         // first[i]..first[i + 1]: the new ids of old polygon i.
         let mut first = Vec::with_capacity(n + 1);
@@ -510,7 +527,7 @@ impl Scene {
                 .flat_map(|id| (first[id.index()]..first[id.index() + 1]).map(PolygonId))
                 .collect();
         }
-        stats
+        Ok(stats)
     }
 }
 
