@@ -17,7 +17,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 /// How often [`abandonable`] looks at its token while it waits: well
@@ -75,21 +75,45 @@ impl Cancel {
     }
 }
 
+/// The stack of an [`abandonable`] thread: that of a program's main thread
+/// on Linux, which the work (a recursive parser, say) ran on before.
+pub const ABANDONABLE_STACK: usize = 8 << 20;
+
 /// Runs `work` on a thread of its own and returns its result, or
 /// [`Cancelled`] as soon as `cancel` is set (checked every [`POLL`]),
 /// leaving the thread to finish unobserved. Only for work that writes
 /// nothing and whose caller stops once interrupted: an abandoned thread
 /// runs on until it ends or the process exits. A panic in `work` is
-/// resumed on the caller's thread.
+/// resumed on the caller's thread. If no thread can be started, `work`
+/// runs on the caller's, not abandonable.
 pub fn abandonable<T: Send + 'static>(
     cancel: &Cancel,
     work: impl FnOnce() -> T + Send + 'static,
 ) -> Result<T, Cancelled> {
     let (send, receive) = mpsc::channel();
-    let thread = std::thread::spawn(move || {
-        // The receiver is gone only when the caller was interrupted.
-        let _ = send.send(work());
-    });
+    // Shared so that the caller can take the work back if the thread
+    // cannot be started.
+    let slot = Arc::new(Mutex::new(Some(work)));
+    let taken = Arc::clone(&slot);
+    let spawned = std::thread::Builder::new()
+        .stack_size(ABANDONABLE_STACK)
+        .spawn(move || {
+            let work = taken.lock().ok().and_then(|mut w| w.take());
+            if let Some(work) = work {
+                // The receiver is gone only when the caller was interrupted.
+                let _ = send.send(work());
+            }
+        });
+    let thread = match spawned {
+        Ok(thread) => thread,
+        Err(_) => {
+            let work = slot.lock().ok().and_then(|mut w| w.take());
+            return match work {
+                Some(work) => Ok(work()),
+                None => Err(Cancelled),
+            };
+        }
+    };
     loop {
         match receive.recv_timeout(POLL) {
             Ok(result) => return Ok(result),

@@ -4,11 +4,11 @@
 //! module only chooses between them, so the front end has one call to make.
 
 use crate::batch::{self, RunError, RunStats};
+use crate::cancel::Cancel;
 use crate::cli::{Invocation, Mode};
 use crate::config::RunConfig;
 use crate::prepare::{self, Prepared};
 use crate::viewer::{self, ViewerError};
-use crate::cancel::Cancel;
 
 /// Runs `invocation`: `Ok(Some(stats))` when a batch run wrote its
 /// results, `Ok(None)` when the window ran and the user closed it.

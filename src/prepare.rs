@@ -143,15 +143,21 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
     prepare_cancellable(config, &Cancel::never())
 }
 
-/// [`prepare`], stopping with [`PrepareError::Interrupted`] soon after
-/// `cancel` is set: while loading, between the repair passes and per
-/// polygon split, per polygon meshed, and before and after the BVH.
+/// [`prepare`], returning [`PrepareError::Interrupted`] as soon as
+/// `cancel` is set. Preparing writes nothing, and much of it runs in code
+/// that cannot be asked to stop (the loaders' parsers, the coplanar
+/// classes, stitching, the BVH build), so it runs on a thread that the
+/// interrupt abandons ([`cancel::abandonable`]); that thread itself stops
+/// at its next check (between the phases, per polygon split, per polygon
+/// meshed) rather than finishing work nobody will use.
 pub fn prepare_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<Prepared, PrepareError> {
-    let prepared = prepare_deferred_cancellable(config, cancel)?;
-    cancel.check()?;
-    prepared.visibility();
-    cancel.check()?;
-    Ok(prepared)
+    let (config, token) = (config.clone(), cancel.clone());
+    cancel::abandonable(cancel, move || {
+        let prepared = prepare_deferred_cancellable(&config, &token)?;
+        token.check()?;
+        prepared.visibility();
+        Ok(prepared)
+    })?
 }
 
 /// [`prepare`] without building the BVH, which [`Prepared::visibility`]
@@ -171,7 +177,7 @@ fn prepare_deferred_cancellable(
 ) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let mut scene = load_scene_cancellable(&config.scene, config.camera.as_deref(), cancel)?;
+    let mut scene = load_scene(&config.scene, config.camera.as_deref())?;
     cancel.check()?;
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
@@ -278,21 +284,6 @@ pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, 
         SceneSource::File(path) => scene::load(path)?,
     };
     scene.with_camera_from(camera)
-}
-
-/// [`load_scene`], returning [`PrepareError::Interrupted`] as soon as
-/// `cancel` is set: the loaders read and parse in libraries that cannot be
-/// asked to stop, and write nothing, so the load runs on a thread that an
-/// interrupt abandons ([`cancel::abandonable`]).
-fn load_scene_cancellable(
-    source: &SceneSource,
-    camera: Option<&Path>,
-    cancel: &Cancel,
-) -> Result<Scene, PrepareError> {
-    let (source, camera) = (source.clone(), camera.map(Path::to_path_buf));
-    Ok(cancel::abandonable(cancel, move || {
-        load_scene(&source, camera.as_deref())
-    })??)
 }
 
 #[cfg(test)]

@@ -131,9 +131,13 @@ fn interrupted_message(
         }
     }
     if let Some(p) = checkpoint {
-        let and = if written.is_empty() { " but" } else { "; and" };
+        let saved = if written.is_empty() {
+            " but the checkpoint"
+        } else {
+            "; saved the checkpoint"
+        };
         message.push_str(&format!(
-            "{and} the checkpoint {}: resume with --resume {}",
+            "{saved} {}: resume with --resume {}",
             p.display(),
             p.display()
         ));
@@ -395,6 +399,9 @@ pub fn run_prepared(
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree.
     let exposure = config.exposure.resolve(frame);
+    if cancel.is_set() {
+        return Err(written.interrupted(config, totals.steps, true));
+    }
     let results = Results {
         config,
         prepared,
@@ -858,4 +865,36 @@ fn drawn(mesh: &crate::mesh::Mesh) -> (usize, usize) {
 /// For `skip_serializing_if`: the field is written only when true.
 fn is_false(b: &bool) -> bool {
     !*b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paths(names: &[&str]) -> Vec<PathBuf> {
+        names.iter().map(PathBuf::from).collect()
+    }
+
+    #[test]
+    fn the_interruption_names_what_was_written_and_what_was_not() {
+        let m = interrupted_message(12, &paths(&["a.png", "a.json"]), &paths(&["a.glb"]), None);
+        assert_eq!(
+            m,
+            "interrupted after 12 steps; wrote a.png, a.json; not written: a.glb"
+        );
+        let m = interrupted_message(3, &[], &paths(&["a.png"]), None);
+        assert_eq!(m, "interrupted after 3 steps; nothing was written");
+        let m = interrupted_message(3, &[], &paths(&["a.png"]), Some(Path::new("c.ckpt")));
+        assert_eq!(
+            m,
+            "interrupted after 3 steps; nothing was written but the checkpoint c.ckpt: \
+             resume with --resume c.ckpt"
+        );
+        let m = interrupted_message(3, &paths(&["a.png"]), &[], Some(Path::new("c.ckpt")));
+        assert_eq!(
+            m,
+            "interrupted after 3 steps; wrote a.png; saved the checkpoint c.ckpt: \
+             resume with --resume c.ckpt"
+        );
+    }
 }

@@ -167,10 +167,7 @@ pub fn write_plot_file(
 /// Writes a plot drawn by [`plot`] (or its error) to `path`, atomically:
 /// [`write_plot_file`] for a caller that draws the plot itself (on a
 /// thread it can abandon).
-pub fn write_plot_image(
-    path: &Path,
-    plotted: Result<RgbImage, String>,
-) -> Result<(), OutputError> {
+pub fn write_plot_image(path: &Path, plotted: Result<RgbImage, String>) -> Result<(), OutputError> {
     check_plot_path(path)?;
     let image = plotted.map_err(|e| OutputError::Io {
         path: path.to_path_buf(),

@@ -159,7 +159,9 @@ pub fn write_atomically_seekable(
         .map_err(|e| OutputError::io(path, e))?;
     // The last moment to abandon the file: once renamed it is written.
     if let Some(cancel) = &cancel {
-        cancel.check().map_err(|c| OutputError::io(path, io::Error::other(c)))?;
+        cancel
+            .check()
+            .map_err(|c| OutputError::io(path, io::Error::other(c)))?;
     }
     tmp.persist(path)
         .map_err(|e| OutputError::io(path, e.error))?;
@@ -217,12 +219,29 @@ impl Seek for TempWriter<'_> {
     }
 }
 
+/// The token of the enclosing [`cancelling_writes`] on this thread.
+pub(crate) fn write_cancel() -> Option<Cancel> {
+    WRITE_CANCEL.with(|c| c.borrow().clone())
+}
+
+/// `Err` (as a write abandoned by [`cancelling_writes`]) once the token of
+/// the enclosing [`cancelling_writes`] is set: for a writer to check
+/// between long passes of its own before it starts writing.
+pub(crate) fn check_cancelled(path: &Path) -> Result<(), OutputError> {
+    WRITE_CANCEL.with(|c| match &*c.borrow() {
+        Some(cancel) => cancel
+            .check()
+            .map_err(|c| OutputError::io(path, io::Error::other(c))),
+        None => Ok(()),
+    })
+}
+
 /// True when `error` is a write abandoned by [`cancelling_writes`].
 pub fn is_cancelled(error: &OutputError) -> bool {
     match error {
-        OutputError::Io { error, .. } => error
-            .get_ref()
-            .is_some_and(|inner| inner.is::<Cancelled>()),
+        OutputError::Io { error, .. } => {
+            error.get_ref().is_some_and(|inner| inner.is::<Cancelled>())
+        }
         _ => false,
     }
 }
@@ -283,7 +302,10 @@ impl Temporary {
 
     /// The open file.
     fn as_file(&self) -> &File {
-        self.file.as_ref().expect("present until persisted").as_file()
+        self.file
+            .as_ref()
+            .expect("present until persisted")
+            .as_file()
     }
 
     /// Renames the temporary to `path`.
@@ -475,6 +497,126 @@ mod tests {
         );
         assert_eq!(err.path(), path);
         assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn a_cancelled_write_leaves_the_old_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.png");
+        std::fs::write(&path, b"old").unwrap();
+        let cancel = Cancel::new();
+        let err = cancelling_writes(&cancel, || {
+            write_atomically(&path, |w| {
+                w.write_all(&[1; 1 << 16])?;
+                cancel.set();
+                // The next buffer handed to the file fails.
+                for _ in 0..16 {
+                    w.write_all(&[2; 1 << 16])?;
+                }
+                Ok(())
+            })
+        })
+        .unwrap_err();
+        assert!(is_cancelled(&err), "{err}");
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(entries(dir.path()), vec![path.clone()]);
+        assert!(live_temporaries()
+            .iter()
+            .all(|p| !p.starts_with(dir.path())));
+        // Outside the scope the same token cancels nothing.
+        write_atomically(&path, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+    }
+
+    #[test]
+    fn temporaries_are_named_after_the_writer_and_listed_while_open() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("stats.json");
+        write_atomically(&path, |_| {
+            let listed: Vec<PathBuf> = live_temporaries()
+                .iter()
+                .filter(|p| p.starts_with(dir.path()))
+                .cloned()
+                .collect();
+            assert_eq!(listed.len(), 1);
+            let name = listed[0].file_name().unwrap().to_str().unwrap().to_owned();
+            let own = format!("{TEMP_PREFIX}{}-", std::process::id());
+            assert!(name.starts_with(&own), "{name}");
+            // Our own temporary is never stale, however old.
+            assert!(!is_stale(&name, Duration::from_secs(86_400)));
+            Ok(())
+        })
+        .unwrap();
+        assert!(live_temporaries()
+            .iter()
+            .all(|p| !p.starts_with(dir.path())));
+    }
+
+    /// The id of a process that has ended.
+    fn ended_pid() -> u32 {
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        child.wait().unwrap();
+        pid
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn stale_temporaries_are_those_of_ended_writers_or_old_unnamed_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let dead = ended_pid();
+        let write = |name: &str, bytes: usize| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, vec![0u8; bytes]).unwrap();
+            path
+        };
+        let killed = write(&format!("{TEMP_PREFIX}{dead}-a1b2c3"), 1000);
+        let own = write(&format!("{TEMP_PREFIX}{}-d4e5f6", std::process::id()), 10);
+        // pid 1 always runs.
+        let running = write(&format!("{TEMP_PREFIX}1-g7h8i9"), 10);
+        let fresh_unnamed = write(&format!("{TEMP_PREFIX}xyz123"), 10);
+        let old_unnamed = write(&format!("{TEMP_PREFIX}abc456"), 500);
+        let hour_ago = SystemTime::now() - Duration::from_secs(3600);
+        File::options()
+            .write(true)
+            .open(&old_unnamed)
+            .unwrap()
+            .set_modified(hour_ago)
+            .unwrap();
+        let unrelated = write("picture.png", 10);
+        std::fs::create_dir(dir.path().join(format!("{TEMP_PREFIX}{dead}-dir"))).unwrap();
+
+        let removed = remove_stale_temporaries(dir.path());
+        let mut expected = vec![
+            StaleTemporary {
+                path: killed.clone(),
+                bytes: 1000,
+            },
+            StaleTemporary {
+                path: old_unnamed.clone(),
+                bytes: 500,
+            },
+        ];
+        expected.sort_by(|a, b| a.path.cmp(&b.path));
+        assert_eq!(removed, expected);
+        assert!(!killed.exists() && !old_unnamed.exists());
+        for kept in [own, running, fresh_unnamed, unrelated] {
+            assert!(kept.exists(), "{}", kept.display());
+        }
+        assert!(dir.path().join(format!("{TEMP_PREFIX}{dead}-dir")).is_dir());
+        // Nothing more the second time.
+        assert!(remove_stale_temporaries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn staleness_by_name_and_age() {
+        let minute = STALE_AFTER;
+        assert!(!is_stale("picture.png", minute * 100));
+        assert!(!is_stale(".radiosity", minute * 100));
+        assert!(!is_stale(".radiosity-abc", minute / 2));
+        assert!(is_stale(".radiosity-abc", minute));
+        let own = format!("{TEMP_PREFIX}{}-x", std::process::id());
+        assert!(!is_stale(&own, minute * 100));
     }
 
     #[test]

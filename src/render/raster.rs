@@ -33,7 +33,7 @@
 //! test holds the two together).
 
 use super::view::View;
-use crate::cancel::Cancel;
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::mesh::{Mesh, VertexId};
 use glam::{DVec2, DVec3};
@@ -170,16 +170,43 @@ impl Frame {
 
     /// Sets the size, keeping the buffers' contents where the length is
     /// unchanged (the rasterizer clears them in parallel); returns the
-    /// number of pixels.
-    fn resize(&mut self, width: u32, height: u32) -> usize {
+    /// number of pixels. Stops with [`Cancelled`] once `cancel` is set,
+    /// the frame then to be drawn again before use.
+    fn resize(&mut self, width: u32, height: u32, cancel: &Cancel) -> Result<usize, Cancelled> {
         let n = width as usize * height as usize;
         self.width = width;
         self.height = height;
-        self.pixels.resize(n, [0.0; 3]);
-        self.covered.resize(n, false);
-        self.back.resize(n, 0.0);
-        n
+        resize_cancellable(&mut self.pixels, n, [0.0; 3], cancel)?;
+        resize_cancellable(&mut self.covered, n, false, cancel)?;
+        resize_cancellable(&mut self.back, n, 0.0, cancel)?;
+        Ok(n)
     }
+}
+
+/// Elements a buffer grows by between two looks at the token in
+/// [`resize_cancellable`]: a few megabytes, milliseconds to fill.
+const RESIZE_CHUNK: usize = 1 << 20;
+
+/// `v.resize(n, value)`, growing [`RESIZE_CHUNK`] elements at a time and
+/// stopping with [`Cancelled`] once `cancel` is set: filling the buffers
+/// of the largest picture takes seconds on a busy machine.
+fn resize_cancellable<T: Clone>(
+    v: &mut Vec<T>,
+    n: usize,
+    value: T,
+    cancel: &Cancel,
+) -> Result<(), Cancelled> {
+    if n <= v.len() {
+        v.truncate(n);
+        return Ok(());
+    }
+    v.reserve_exact(n - v.len());
+    while v.len() < n {
+        cancel.check()?;
+        let len = (v.len() + RESIZE_CHUNK).min(n);
+        v.resize(len, value.clone());
+    }
+    Ok(())
 }
 
 /// Why a mesh and its radiosities cannot be drawn.
@@ -287,10 +314,10 @@ impl Rasterizer {
     ) -> Result<&Frame, RenderError> {
         check_mesh(mesh, radiosity)?;
         let (width, height) = (view.width(), view.height());
-        let n = self.frame.resize(width, height);
+        let n = self.frame.resize(width, height, cancel)?;
         // Cleared band by band below, in parallel.
-        self.inv_depth.resize(n, 0.0);
-        self.front.resize(n, false);
+        resize_cancellable(&mut self.inv_depth, n, 0.0, cancel)?;
+        resize_cancellable(&mut self.front, n, false, cancel)?;
 
         let w = width as usize;
         let tiles_x = w.div_ceil(TILE_WIDTH);
