@@ -4,11 +4,11 @@
 //! module only chooses between them, so the front end has one call to make.
 
 use crate::batch::{self, RunError, RunStats};
+use crate::cancel::Cancel;
 use crate::cli::{Invocation, Mode};
 use crate::config::RunConfig;
 use crate::prepare::{self, Prepared};
 use crate::viewer::{self, ViewerError};
-use std::sync::atomic::AtomicBool;
 
 /// Runs `invocation`: `Ok(Some(stats))` when a batch run wrote its
 /// results, `Ok(None)` when the window ran and the user closed it.
@@ -20,7 +20,7 @@ use std::sync::atomic::AtomicBool;
 /// keys, and a Ctrl-C in its terminal ends it the ordinary way.
 pub fn run(
     invocation: &Invocation,
-    cancel: &AtomicBool,
+    cancel: &Cancel,
     arm_cancel: impl FnOnce(),
 ) -> Result<Option<RunStats>, RunError> {
     let config = &invocation.config;
@@ -64,7 +64,7 @@ pub fn run(
 fn batch(
     config: &RunConfig,
     prepared: Option<&Prepared>,
-    cancel: &AtomicBool,
+    cancel: &Cancel,
     arm_cancel: impl FnOnce(),
 ) -> Result<Option<RunStats>, RunError> {
     arm_cancel();

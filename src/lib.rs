@@ -4,6 +4,7 @@
 pub mod batch;
 pub mod budget;
 pub mod camera;
+pub mod cancel;
 pub mod cli;
 pub mod color;
 pub mod config;

@@ -4,13 +4,14 @@
 //! usage, 130 interrupted (Ctrl-C).
 
 use radiosity::batch::{self, RunError};
+use radiosity::cancel::Cancel;
 use radiosity::cli::{Invocation, UsageError};
 use radiosity::drive;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::LazyLock;
 
-/// Set by the Ctrl-C handler; batch runs poll it.
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+/// Set by the Ctrl-C handler; every phase of a batch run checks it.
+static INTERRUPTED: LazyLock<Cancel> = LazyLock::new(Cancel::new);
 
 /// Why the program ends other than by a finished run; [`exit_code`] turns
 /// each into its message and code.
@@ -81,15 +82,18 @@ fn exit_code(stop: Stop) -> u8 {
 }
 
 /// Makes Ctrl-C (SIGINT, and SIGTERM) stop a batch run cleanly: the first
-/// sets [`INTERRUPTED`], which the run polls during every step and before
-/// every write; a second exits at once with 130. [`drive::run`] installs it
-/// for batch runs only.
+/// sets [`INTERRUPTED`], which every phase of the run checks (load, split,
+/// mesh, solve, gather, render, write); a second removes the temporaries
+/// of the files being written and exits at once with 130. [`drive::run`]
+/// installs it for batch runs only.
 fn catch_ctrl_c() {
     let installed = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+        if INTERRUPTED.is_set() {
+            radiosity::output::remove_temporaries();
             eprintln!("interrupted again: exiting now");
             std::process::exit(130);
         }
+        INTERRUPTED.set();
         eprintln!("interrupted: stopping (Ctrl-C again to exit at once)");
     });
     if let Err(e) = installed {

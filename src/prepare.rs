@@ -13,6 +13,7 @@
 //! start from.
 
 use crate::budget::{self, MemoryBudget, OverBudget};
+use crate::cancel::{self, Cancel, Cancelled};
 use crate::config::{RunConfig, SceneSource, BUNDLED_SCENE, BUNDLED_SCENE_NAME};
 use crate::mesh::budget::VERTEX_BUDGET;
 use crate::mesh::{self, Mesh, MeshError, MeshOptions};
@@ -65,6 +66,10 @@ pub enum PrepareError {
     /// estimate is and what makes it.
     #[error("{0}")]
     Memory(#[from] OverBudget),
+    /// The cancellation token was set while preparing
+    /// ([`prepare_cancellable`]).
+    #[error("{0}")]
+    Interrupted(#[from] Cancelled),
 }
 
 /// Seconds spent in each phase of a run.
@@ -140,9 +145,24 @@ impl Prepared {
 /// [`RunConfig::max_elements`] before building it, with the lenmax that
 /// would fit.
 pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
-    let prepared = prepare_deferred(config)?;
-    prepared.visibility();
-    Ok(prepared)
+    prepare_cancellable(config, &Cancel::never())
+}
+
+/// [`prepare`], returning [`PrepareError::Interrupted`] as soon as
+/// `cancel` is set. Preparing writes nothing, and much of it runs in code
+/// that cannot be asked to stop (the loaders' parsers, the coplanar
+/// classes, stitching, the BVH build), so it runs on a thread that the
+/// interrupt abandons ([`cancel::abandonable`]); that thread itself stops
+/// at its next check (between the phases, per polygon split, per polygon
+/// meshed) rather than finishing work nobody will use.
+pub fn prepare_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<Prepared, PrepareError> {
+    let (config, token) = (config.clone(), cancel.clone());
+    cancel::abandonable(cancel, move || {
+        let prepared = prepare_deferred_cancellable(&config, &token)?;
+        token.check()?;
+        prepared.visibility();
+        Ok(prepared)
+    })?
 }
 
 /// [`prepare`] without building the BVH, which [`Prepared::visibility`]
@@ -152,9 +172,18 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, PrepareError> {
 /// all the same, to find the sides that face a surface across a narrow
 /// gap ([`Scene::silence_covered_sides`]).
 pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
+    prepare_deferred_cancellable(config, &Cancel::never())
+}
+
+/// [`prepare_deferred`] checking `cancel` as [`prepare_cancellable`] does.
+fn prepare_deferred_cancellable(
+    config: &RunConfig,
+    cancel: &Cancel,
+) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
     let mut scene = load_scene_within(&config.scene, config.camera.as_deref(), &config.max_memory)?;
+    cancel.check()?;
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
     }
@@ -179,16 +208,18 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
         file: &name,
         budget: config.max_memory,
     };
-    let (mut scene, repaired) = repair::run(scene, &options, |scene| {
+    let built = |scene: &Scene| {
         let t = Instant::now();
         let built = Visibility::new(scene);
         bvh_seconds = t.elapsed().as_secs_f64();
         built
-    })
-    .map_err(|e| match e {
-        RepairError::Sky(e) => PrepareError::Sky(e),
-        RepairError::Memory(e) => PrepareError::Memory(e),
-    })?;
+    };
+    let (mut scene, repaired) =
+        repair::run_cancellable(scene, &options, built, cancel).map_err(|e| match e {
+            RepairError::Sky(e) => PrepareError::Sky(e),
+            RepairError::Memory(e) => PrepareError::Memory(e),
+            RepairError::Interrupted(c) => PrepareError::Interrupted(c),
+        })?;
     let split = repaired.split;
     let visibility = OnceLock::new();
     if let Some(built) = repaired.rays {
@@ -227,7 +258,12 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     let t = Instant::now();
     let size = mesh::check_size(&scene, &mesh_options, config.max_elements)?;
     check_mesh_memory(&scene, &mesh_options, size, &config.max_memory)?;
-    let mesh = mesh::build_with_limit(&scene, &mesh_options, config.max_elements)?;
+    cancel.check()?;
+    let mesh = mesh::build_cancellable(&scene, &mesh_options, config.max_elements, cancel)
+        .map_err(|e| match e {
+            MeshError::Interrupted(c) => PrepareError::Interrupted(c),
+            e => PrepareError::Mesh(e),
+        })?;
     seconds.mesh = options_seconds + t.elapsed().as_secs_f64();
 
     Ok(Prepared {

@@ -133,7 +133,6 @@ mod tests {
     use crate::config::SceneSource;
     use crate::solver::step::POISON_READ_AT;
     use std::path::Path;
-    use std::sync::atomic::AtomicBool;
 
     /// A quick run of the bundled Cornell box writing `out.png`, the step
     /// log, the plot and a checkpoint into `dir`.
@@ -158,7 +157,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let config = quick_run(dir.path());
         POISON_READ_AT.set(5);
-        let result = run(&config, &AtomicBool::new(false));
+        let result = run(&config, &crate::cancel::Cancel::never());
         POISON_READ_AT.set(0);
         let Err(RunError::Failed(failure)) = result else {
             panic!("the run did not fail as injected: {result:?}");
@@ -186,11 +185,11 @@ mod tests {
         resumed.output = Some(dir.path().join("resumed.png"));
         resumed.log = Some(dir.path().join("resumed.csv"));
         resumed.plot = None;
-        let resumed = run(&resumed, &AtomicBool::new(false)).unwrap();
+        let resumed = run(&resumed, &crate::cancel::Cancel::never()).unwrap();
         let fresh = tempfile::tempdir().unwrap();
         let mut whole = quick_run(fresh.path());
         whole.checkpoint = None;
-        let whole = run(&whole, &AtomicBool::new(false)).unwrap();
+        let whole = run(&whole, &crate::cancel::Cancel::never()).unwrap();
         assert_eq!(resumed.steps, whole.steps);
         assert_eq!(
             resumed.unshot_fraction.to_bits(),

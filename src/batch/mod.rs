@@ -13,10 +13,14 @@
 //! memory they need, and refuses a mesh over [`RunConfig::max_elements`]
 //! with the `lenmax` that would fit ([`crate::mesh::check_size`]).
 //!
-//! **Interruption and checkpoints.** A run checks its cancel flag during
-//! every shooting step, before rendering and before each write; once it is
-//! set, nothing more is written except the checkpoint (when asked for),
-//! and the run ends with [`RunError::Interrupted`]. With a checkpoint path
+//! **Interruption and checkpoints.** A run checks its [`Cancel`] token in
+//! every phase: loading, splitting and meshing
+//! ([`prepare_cancellable`](crate::prepare::prepare_cancellable)), every
+//! shooting step, the photometric gathers, rendering and every buffer of
+//! every file written ([`output::cancelling_writes`]). Once it is set,
+//! nothing more is written except the checkpoint (when asked for), and
+//! the run ends with [`RunError::Interrupted`], which names the files
+//! already written and those that were not. With a checkpoint path
 //! the solver state is saved every [`RunConfig::checkpoint_every`], on
 //! interruption and at the end ([`checkpoint`]); a resumed run continues
 //! to the same bits an uninterrupted one gives.
@@ -34,6 +38,7 @@ pub mod progress;
 pub use checkpoint::CheckpointError;
 pub use outputs::check_outputs;
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::config::RunConfig;
 use crate::mesh::MeshRef;
 use crate::output::convergence::{self, StepRecord};
@@ -46,7 +51,6 @@ use crate::solver::SolverError;
 use progress::Progress;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Why a run failed.
@@ -58,22 +62,18 @@ pub enum RunError {
     /// The checkpoint to resume from is unusable, or saving one failed.
     #[error("{0}")]
     Checkpoint(#[from] CheckpointError),
-    /// Ctrl-C (or the caller's flag) stopped the run; no picture or stats
-    /// were written.
-    #[error(
-        "interrupted after {steps} steps; nothing was written{}",
-        match checkpoint {
-            Some(p) => format!(
-                " but the checkpoint {}: resume with --resume {}",
-                p.display(),
-                p.display()
-            ),
-            None => String::new(),
-        }
-    )]
+    /// Ctrl-C (or the caller's token) stopped the run; the message names
+    /// the files written before it and those not written.
+    #[error("{}", interrupted_message(*steps, written, not_written, checkpoint.as_deref()))]
     Interrupted {
         /// Shooting steps completed.
         steps: u64,
+        /// The results complete in place before the interruption, in the
+        /// order they were written (the checkpoint not among them).
+        written: Vec<PathBuf>,
+        /// The results asked for that were not written (an existing file
+        /// of that name is as it was).
+        not_written: Vec<PathBuf>,
         /// The checkpoint saved on the way out, if one was asked for.
         checkpoint: Option<PathBuf>,
     },
@@ -103,6 +103,75 @@ pub enum RunError {
     /// message reads `FILE:LINE:COL: error: ...`.
     #[error("{0}")]
     Points(#[from] crate::scene::PointsError),
+}
+
+/// The message of [`RunError::Interrupted`]: `interrupted after N steps;
+/// wrote a.png, a.json; not written: a.glb`, or `nothing was written`
+/// when nothing was, then the checkpoint to resume from.
+fn interrupted_message(
+    steps: u64,
+    written: &[PathBuf],
+    not_written: &[PathBuf],
+    checkpoint: Option<&Path>,
+) -> String {
+    let list = |paths: &[PathBuf]| {
+        paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut message = format!("interrupted after {steps} steps; ");
+    if written.is_empty() {
+        message.push_str("nothing was written");
+    } else {
+        message.push_str(&format!("wrote {}", list(written)));
+        if !not_written.is_empty() {
+            message.push_str(&format!("; not written: {}", list(not_written)));
+        }
+    }
+    if let Some(p) = checkpoint {
+        let saved = if written.is_empty() {
+            " but the checkpoint"
+        } else {
+            "; saved the checkpoint"
+        };
+        message.push_str(&format!(
+            "{saved} {}: resume with --resume {}",
+            p.display(),
+            p.display()
+        ));
+    }
+    message
+}
+
+/// The results of a run written so far, for [`RunError::Interrupted`].
+#[derive(Debug, Default)]
+struct Written {
+    paths: Vec<PathBuf>,
+}
+
+impl Written {
+    /// Records `path` as complete and in place.
+    fn push(&mut self, path: &Path) {
+        self.paths.push(path.to_path_buf());
+    }
+
+    /// The interruption after `steps` steps: what was written, and what
+    /// `config` asked for that was not; the checkpoint is named if one was
+    /// asked for and the solve began (it saves one on its way out).
+    fn interrupted(self, config: &RunConfig, steps: u64, solved: bool) -> RunError {
+        let not_written = std::iter::once(config.output_path())
+            .chain(config.extra_outputs().cloned())
+            .filter(|p| !self.paths.contains(p) && Some(p) != config.checkpoint.as_ref())
+            .collect();
+        RunError::Interrupted {
+            steps,
+            written: self.paths,
+            not_written,
+            checkpoint: config.checkpoint.clone().filter(|_| solved),
+        }
+    }
 }
 
 impl RunError {
@@ -217,13 +286,47 @@ pub struct RunStats {
 }
 
 /// Runs the whole batch pipeline once and writes the picture and the other
-/// results asked for. Stops promptly once `cancel` is set (by a Ctrl-C
-/// handler, say) with [`RunError::Interrupted`], writing nothing but the
-/// checkpoint.
-pub fn run(config: &RunConfig, cancel: &AtomicBool) -> Result<RunStats, RunError> {
+/// results asked for. Stops promptly in any phase once `cancel` is set (by
+/// a Ctrl-C handler, say) with [`RunError::Interrupted`], writing nothing
+/// more but the checkpoint.
+pub fn run(config: &RunConfig, cancel: &Cancel) -> Result<RunStats, RunError> {
     check_outputs(config)?;
-    let prepared = prepare::prepare(config)?;
+    remove_stale_temporaries(config);
+    let prepared = match prepare::prepare_cancellable(config, cancel) {
+        Err(PrepareError::Interrupted(_)) => {
+            return Err(Written::default().interrupted(config, 0, false))
+        }
+        prepared => prepared?,
+    };
     run_prepared(config, &prepared, cancel)
+}
+
+/// Removes the temporaries a killed run left in the folders `config`
+/// writes to ([`output::remove_stale_temporaries`]), saying so in one line.
+fn remove_stale_temporaries(config: &RunConfig) {
+    let mut dirs: Vec<PathBuf> = std::iter::once(config.output_path())
+        .chain(config.extra_outputs().cloned())
+        .map(|p| match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        })
+        .collect();
+    dirs.sort();
+    dirs.dedup();
+    for dir in dirs {
+        let removed = output::remove_stale_temporaries(&dir);
+        if removed.is_empty() {
+            continue;
+        }
+        let bytes: u64 = removed.iter().map(|t| t.bytes).sum();
+        eprintln!(
+            "note: removed {} temporary file{} ({:.1} MB) that a killed run left in {}",
+            removed.len(),
+            if removed.len() == 1 { "" } else { "s" },
+            bytes as f64 / 1e6,
+            dir.display()
+        );
+    }
 }
 
 /// The solved state a batch run draws and writes.
@@ -238,9 +341,10 @@ struct Solved<'p> {
 pub fn run_prepared(
     config: &RunConfig,
     prepared: &Prepared,
-    cancel: &AtomicBool,
+    cancel: &Cancel,
 ) -> Result<RunStats, RunError> {
     check_outputs(config)?;
+    remove_stale_temporaries(config);
     if config.adaptive.is_some() && (config.checkpoint.is_some() || config.resume.is_some()) {
         return Err(RunError::Options(
             "--adaptive cannot be combined with --checkpoint or --resume: \
@@ -264,15 +368,17 @@ pub fn run_prepared(
     let mesh: &crate::mesh::Mesh = &solved.mesh;
     let totals = session.totals();
 
-    let interrupted = || RunError::Interrupted {
-        steps: totals.steps,
-        checkpoint: config.checkpoint.clone(),
-    };
-    if cancel.load(Ordering::SeqCst) {
-        return Err(interrupted());
+    let mut written = Written::default();
+    if cancel.is_set() {
+        return Err(written.interrupted(config, totals.steps, true));
     }
     let t = Instant::now();
-    let drawn = draw(config, prepared, &view, mesh, &solved.shown)?;
+    let drawn = match draw(config, prepared, &view, mesh, &solved.shown, cancel) {
+        Err(RunError::Render(RenderError::Cancelled(_))) => {
+            return Err(written.interrupted(config, totals.steps, true))
+        }
+        drawn => drawn?,
+    };
     let frame = drawn.frame();
     seconds.render = t.elapsed().as_secs_f64();
     // One line on a (nearly) black picture, whatever `--quiet` says, like
@@ -287,30 +393,74 @@ pub fn run_prepared(
         eprintln!("{line}");
     }
 
-    if cancel.load(Ordering::SeqCst) {
-        return Err(interrupted());
+    if cancel.is_set() {
+        return Err(written.interrupted(config, totals.steps, true));
     }
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree.
     let exposure = config.exposure.resolve(frame);
-    write_results(config, prepared, &output, &solved, &drawn, &view, exposure)?;
-    let mut stats = run_stats(config, prepared, &session, mesh, dark, exposure, seconds);
-    stats.seconds.write = t.elapsed().as_secs_f64();
-    if let Some(path) = &config.stats {
-        // The picture is complete and stays; the stats are skipped if the
-        // interrupt came while it was written.
-        if cancel.load(Ordering::SeqCst) {
-            return Err(interrupted());
-        }
-        let json = serde_json::to_string_pretty(&stats).map_err(|e| {
-            RunError::Write(OutputError::Io {
-                path: path.clone(),
-                error: std::io::Error::other(e),
-            })
-        })?;
-        output::write_atomically(path, |w| writeln!(w, "{json}")).map_err(RunError::Write)?;
+    if cancel.is_set() {
+        return Err(written.interrupted(config, totals.steps, true));
     }
-    Ok(stats)
+    let results = Results {
+        config,
+        prepared,
+        output: &output,
+        solved: &solved,
+        drawn: &drawn,
+        view: &view,
+        exposure,
+    };
+    let wrote = output::cancelling_writes(cancel, || {
+        results.write(&mut written, cancel)?;
+        let mut stats = run_stats(config, prepared, &session, mesh, dark, exposure, seconds);
+        stats.seconds.write = t.elapsed().as_secs_f64();
+        if let Some(path) = &config.stats {
+            cancel.check()?;
+            let json = serde_json::to_string_pretty(&stats).map_err(|e| {
+                RunError::Write(OutputError::Io {
+                    path: path.clone(),
+                    error: std::io::Error::other(e),
+                })
+            })?;
+            output::write_atomically(path, |w| writeln!(w, "{json}")).map_err(RunError::Write)?;
+            written.push(path);
+        }
+        Ok(stats)
+    });
+    match wrote {
+        Ok(stats) => Ok(stats),
+        // The interrupt seen between two results, a write abandoned on it,
+        // or a failure after it (a gather cut short): the files so far
+        // stay, and are named.
+        Err(e) if cancel.is_set() || is_interruption(&e) => {
+            Err(written.interrupted(config, totals.steps, true))
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// True for an interruption seen inside a phase, or a write abandoned on
+/// one.
+fn is_interruption(e: &RunError) -> bool {
+    match e {
+        RunError::Interrupted { .. } => true,
+        RunError::Write(e) => output::is_cancelled(e),
+        _ => false,
+    }
+}
+
+/// An interruption seen inside a phase, before anyone could say what was
+/// written: [`run_prepared`] replaces it with the full account.
+impl From<Cancelled> for RunError {
+    fn from(_: Cancelled) -> Self {
+        RunError::Interrupted {
+            steps: 0,
+            written: Vec::new(),
+            not_written: Vec::new(),
+            checkpoint: None,
+        }
+    }
 }
 
 /// The picture a batch run drew: the rasterizer's frame at `aa × aa`
@@ -334,13 +484,15 @@ impl Drawn {
 }
 
 /// Draws `shown` (per vertex of `mesh`) through `view`, antialiased as
-/// `config.aa` asks.
+/// `config.aa` asks; stops with [`RenderError::Cancelled`] once `cancel`
+/// is set.
 fn draw(
     config: &RunConfig,
     prepared: &Prepared,
     view: &View,
     mesh: &crate::mesh::Mesh,
     shown: &[crate::color::Rgb],
+    cancel: &Cancel,
 ) -> Result<Drawn, RunError> {
     // Rendered at `aa × aa` samples a pixel, averaged to the picture.
     let aa = antialias::factor_for(view.width(), view.height(), config.aa);
@@ -351,10 +503,11 @@ fn draw(
             view.width() * aa,
             view.height() * aa,
         )?;
-        rasterizer.render(mesh, shown, &fine)?;
+        rasterizer.render_cancellable(mesh, shown, &fine, cancel)?;
     } else {
-        rasterizer.render(mesh, shown, view)?;
+        rasterizer.render_cancellable(mesh, shown, view, cancel)?;
     }
+    cancel.check().map_err(RenderError::Cancelled)?;
     let downsampled = (aa > 1).then(|| antialias::downsample(rasterizer.frame(), aa));
     Ok(Drawn {
         rasterizer,
@@ -363,64 +516,113 @@ fn draw(
     })
 }
 
-/// Writes the picture to `output` and every other result `config` asks
-/// for: the solved mesh, the step log, the convergence plot and the
-/// photometric results, with the picture's `exposure`.
-fn write_results(
-    config: &RunConfig,
-    prepared: &Prepared,
-    output: &Path,
-    solved: &Solved,
-    drawn: &Drawn,
-    view: &View,
+/// What [`Results::write`] writes: the solved and drawn run.
+struct Results<'a, 'p> {
+    config: &'a RunConfig,
+    prepared: &'a Prepared,
+    /// The picture's path.
+    output: &'a Path,
+    solved: &'a Solved<'p>,
+    drawn: &'a Drawn,
+    view: &'a View,
+    /// The picture's exposure, which the exported colours share.
     exposure: f32,
-) -> Result<(), RunError> {
-    let mesh: &crate::mesh::Mesh = &solved.mesh;
-    let frame = drawn.frame();
-    let aa = drawn.aa;
-    if config.mesh_lines {
-        let mut picture = render::to_srgb8(frame, exposure);
-        let depth = if aa > 1 {
-            antialias::nearest_depth(drawn.rasterizer.inv_depth(), view.width() * aa, aa)
-        } else {
-            drawn.rasterizer.inv_depth().to_vec()
-        };
-        render::draw_mesh_edges(&mut picture, mesh, view, &depth, render::MESH_LINES);
-        output::write_rgb8(output, &picture).map_err(RunError::Write)?;
-    } else {
-        output::write_picture(output, frame, Exposure::Fixed(exposure)).map_err(RunError::Write)?;
-    }
-    if let Some(path) = &config.export {
-        // The sky lights the model; it is no part of it.
-        let without_sky = mesh.without_sky(&solved.radiosity);
-        let (mesh, radiosity) = match &without_sky {
-            Some((m, r)) => (m, &r[..]),
-            None => (mesh, &solved.radiosity[..]),
-        };
-        output::write_mesh(
-            path,
-            &prepared.scene,
-            mesh,
-            radiosity,
+}
+
+impl Results<'_, '_> {
+    /// Writes the picture to `output` and every other result `config`
+    /// asks for: the solved mesh, the step log, the convergence plot and
+    /// the photometric results, each added to `written` once complete.
+    /// Checks `cancel` between them; the writes themselves are cancelled
+    /// by the caller's [`output::cancelling_writes`].
+    fn write(&self, written: &mut Written, cancel: &Cancel) -> Result<(), RunError> {
+        let Results {
+            config,
+            prepared,
+            output,
+            solved,
+            drawn,
+            view,
             exposure,
-            &config.scene.stem(),
-        )
-        .map_err(RunError::Write)?;
+        } = *self;
+        let mesh: &crate::mesh::Mesh = &solved.mesh;
+        let frame = drawn.frame();
+        let aa = drawn.aa;
+        if config.mesh_lines {
+            let mut picture = render::to_srgb8(frame, exposure);
+            let depth = if aa > 1 {
+                antialias::nearest_depth(drawn.rasterizer.inv_depth(), view.width() * aa, aa)
+            } else {
+                drawn.rasterizer.inv_depth().to_vec()
+            };
+            render::draw_mesh_edges(&mut picture, mesh, view, &depth, render::MESH_LINES);
+            cancel.check()?;
+            output::write_rgb8(output, &picture).map_err(RunError::Write)?;
+        } else {
+            output::write_picture(output, frame, Exposure::Fixed(exposure))
+                .map_err(RunError::Write)?;
+        }
+        written.push(output);
+        if let Some(path) = &config.export {
+            cancel.check()?;
+            // The sky lights the model; it is no part of it.
+            let without_sky = mesh.without_sky(&solved.radiosity);
+            let (mesh, radiosity) = match &without_sky {
+                Some((m, r)) => (m, &r[..]),
+                None => (mesh, &solved.radiosity[..]),
+            };
+            output::write_mesh(
+                path,
+                &prepared.scene,
+                mesh,
+                radiosity,
+                exposure,
+                &config.scene.stem(),
+            )
+            .map_err(RunError::Write)?;
+            written.push(path);
+        }
+        if let Some(path) = &config.log {
+            cancel.check()?;
+            convergence::write_log_file(path, &solved.records).map_err(RunError::Write)?;
+            written.push(path);
+        }
+        if let Some(path) = &config.plot {
+            cancel.check()?;
+            write_plot(config, path, &solved.records, cancel)?;
+            written.push(path);
+        }
+        cancel.check()?;
+        photometry::write(
+            config,
+            prepared,
+            mesh,
+            &solved.radiosity,
+            frame,
+            view,
+            written,
+            cancel,
+        )?;
+        Ok(())
     }
-    if let Some(path) = &config.log {
-        convergence::write_log_file(path, &solved.records).map_err(RunError::Write)?;
-    }
-    if let Some(path) = &config.plot {
-        convergence::write_plot_file(
-            path,
-            &solved.records,
-            config.solver.threshold,
-            &config.scene.display_name(),
-        )
-        .map_err(RunError::Write)?;
-    }
-    photometry::write(config, prepared, mesh, &solved.radiosity, frame, view)?;
-    Ok(())
+}
+
+/// Draws and writes the convergence plot of `records` to `path`; the
+/// drawing, in a library that cannot be asked to stop, is abandoned once
+/// `cancel` is set ([`crate::cancel::abandonable`]).
+fn write_plot(
+    config: &RunConfig,
+    path: &Path,
+    records: &[StepRecord],
+    cancel: &Cancel,
+) -> Result<(), RunError> {
+    let records = records.to_vec();
+    let threshold = config.solver.threshold;
+    let title = config.scene.display_name();
+    let plot = crate::cancel::abandonable(cancel, move || {
+        convergence::plot(&records, threshold, &title)
+    })?;
+    convergence::write_plot_image(path, plot).map_err(RunError::Write)
 }
 
 /// The figures of a finished run: what was solved and written, with the
@@ -491,7 +693,7 @@ fn solve<'p>(
     config: &RunConfig,
     prepared: &'p Prepared,
     session: &mut Session<'p>,
-    cancel: &AtomicBool,
+    cancel: &Cancel,
 ) -> Result<Solved<'p>, RunError> {
     let fingerprint = fingerprint(&prepared.scene, session.mesh(), &config.solver);
     // The step log: a resumed run's continues the one saved with its
@@ -518,15 +720,12 @@ fn solve<'p>(
     let mut last_save = Instant::now();
     let start = Instant::now();
     loop {
-        if cancel.load(Ordering::SeqCst) {
+        if cancel.is_set() {
             progress.clear();
             save(session, &records)?;
-            return Err(RunError::Interrupted {
-                steps: session.totals().steps,
-                checkpoint: config.checkpoint.clone(),
-            });
+            return Err(Written::default().interrupted(config, session.totals().steps, true));
         }
-        let event = match session.advance(cancel) {
+        let event = match session.advance(cancel.flag()) {
             Ok(event) => event,
             Err(error) => {
                 progress.clear();
@@ -666,4 +865,36 @@ fn drawn(mesh: &crate::mesh::Mesh) -> (usize, usize) {
 /// For `skip_serializing_if`: the field is written only when true.
 fn is_false(b: &bool) -> bool {
     !*b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paths(names: &[&str]) -> Vec<PathBuf> {
+        names.iter().map(PathBuf::from).collect()
+    }
+
+    #[test]
+    fn the_interruption_names_what_was_written_and_what_was_not() {
+        let m = interrupted_message(12, &paths(&["a.png", "a.json"]), &paths(&["a.glb"]), None);
+        assert_eq!(
+            m,
+            "interrupted after 12 steps; wrote a.png, a.json; not written: a.glb"
+        );
+        let m = interrupted_message(3, &[], &paths(&["a.png"]), None);
+        assert_eq!(m, "interrupted after 3 steps; nothing was written");
+        let m = interrupted_message(3, &[], &paths(&["a.png"]), Some(Path::new("c.ckpt")));
+        assert_eq!(
+            m,
+            "interrupted after 3 steps; nothing was written but the checkpoint c.ckpt: \
+             resume with --resume c.ckpt"
+        );
+        let m = interrupted_message(3, &paths(&["a.png"]), &[], Some(Path::new("c.ckpt")));
+        assert_eq!(
+            m,
+            "interrupted after 3 steps; wrote a.png; saved the checkpoint c.ckpt: \
+             resume with --resume c.ckpt"
+        );
+    }
 }

@@ -8,7 +8,8 @@
 //! values are in the scene's radiosity units, not lux, and a warning says
 //! so once.
 
-use super::RunError;
+use super::{RunError, Written};
+use crate::cancel::Cancel;
 use crate::color::Rgb;
 use crate::config::RunConfig;
 use crate::mesh::Mesh;
@@ -37,14 +38,19 @@ pub fn check(config: &RunConfig, prepared: &Prepared) -> Result<(), RunError> {
 
 /// Computes and writes every photometric result `config` asks for, from
 /// `radiosity` (per vertex of `mesh`, the solution) and the picture's
-/// linear `frame` seen through `view`. Returns the seconds spent.
-pub fn write(
+/// linear `frame` seen through `view`, adding each file to `written` once
+/// complete. Returns the seconds spent. The gathers stop with
+/// [`RunError::Interrupted`] soon after `cancel` is set.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn write(
     config: &RunConfig,
     prepared: &Prepared,
     mesh: &Mesh,
     radiosity: &[Rgb],
     frame: &Frame,
     view: &View,
+    written: &mut Written,
+    cancel: &Cancel,
 ) -> Result<f64, RunError> {
     let start = Instant::now();
     if !config.wants_photometry() {
@@ -77,20 +83,21 @@ pub fn write(
     if let Some((at, to)) = &p.illuminance {
         let points = points::load_points(at)?;
         let t = Instant::now();
-        let values = gather().irradiance_at(&points);
+        let values = gather().irradiance_at_cancellable(&points, cancel)?;
         say(format!(
             "illuminance at {} points: {:.2} s",
             points.len(),
             t.elapsed().as_secs_f64()
         ));
         out::write_illuminance(to, &points, &values).map_err(RunError::Write)?;
+        written.push(to);
     }
     if let Some(w) = &p.workplane {
         let grid = out::workplane_grid(&prepared.scene, w.height, w.spacing, units)
             .map_err(|e| RunError::Options(e.to_string()))?;
         let t = Instant::now();
         let plane = gather();
-        let values = plane.irradiance_at(&grid.points);
+        let values = plane.irradiance_at_cancellable(&grid.points, cancel)?;
         say(format!(
             "work plane of {} × {} points {} apart: {:.2} s",
             grid.nx,
@@ -107,6 +114,7 @@ pub fn write(
             .iter()
             .map(|&(x, n)| plane.behind_surfaces(x, n))
             .collect();
+        cancel.check()?;
         let hidden = behind.iter().filter(|&&i| i).count();
         let u = out::write_workplane(
             &w.csv,
@@ -119,6 +127,8 @@ pub fn write(
             photometric,
         )
         .map_err(RunError::Write)?;
+        written.push(&w.csv);
+        written.push(&w.png);
         // Printed whatever -q says, with the points left out, so the
         // figures are never read without knowing what they cover.
         let left_out = if hidden > 0 {
@@ -137,6 +147,7 @@ pub fn write(
         );
     }
     if let Some(f) = &p.falsecolor {
+        cancel.check()?;
         let (values, title, unit): (Vec<Option<f64>>, &str, &str) = match f.quantity {
             Quantity::Luminance => (
                 frame
@@ -153,7 +164,8 @@ pub fn write(
             ),
             Quantity::Illuminance => {
                 let irradiance = vertex_irradiance(&prepared.scene, mesh, radiosity);
-                let e = crate::render::render(mesh, &irradiance, view)?;
+                let mut rasterizer = crate::render::Rasterizer::new();
+                let e = rasterizer.render_cancellable(mesh, &irradiance, view, cancel)?;
                 (
                     e.pixels
                         .iter()
@@ -172,6 +184,7 @@ pub fn write(
         let mapping = Mapping::new(&finite, f.max, f.scale);
         let img = falsecolor::picture(&values, frame.width, frame.height, mapping, title, unit);
         output::write_rgb8(&f.path, &img).map_err(RunError::Write)?;
+        written.push(&f.path);
     }
     Ok(start.elapsed().as_secs_f64())
 }

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 /// The exit codes, shown after both the short and the long help.
 pub const EXIT_CODES: &str =
     "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage, \
-     130 interrupted (Ctrl-C; nothing is written but the --checkpoint).";
+     130 interrupted (Ctrl-C; the message names the files written).";
 
 /// Progressive-refinement radiosity renderer (ray-traced form factors after
 /// Wallace, Elmquist and Haines 1989).

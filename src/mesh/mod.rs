@@ -33,6 +33,7 @@
 //! the corner sees, so corners do not come out dark.
 
 use crate::budget::fmt_bytes;
+use crate::cancel::Cancel;
 use crate::scene::{Polygon, PolygonId, Scene, Shape};
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;
@@ -233,6 +234,10 @@ impl MeshOptions {
 /// Why a mesh could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MeshError {
+    /// The run's cancellation token was set while meshing
+    /// ([`build_cancellable`]).
+    #[error("{0}")]
+    Interrupted(#[from] crate::cancel::Cancelled),
     /// `lenmax` is not a positive finite number.
     #[error("lenmax must be a positive number of scene units, got {0}")]
     BadLenmax(f32),
@@ -490,7 +495,20 @@ pub fn build_with_limit(
     options: &MeshOptions,
     max_elements: u64,
 ) -> Result<Mesh, MeshError> {
-    let mesh = build_unstitched_with_limit(scene, options, max_elements)?;
+    build_cancellable(scene, options, max_elements, &Cancel::never())
+}
+
+/// [`build_with_limit`], stopping with [`MeshError::Interrupted`] soon
+/// after `cancel` is set: it is checked per polygon meshed and before the
+/// mesh is stitched.
+pub fn build_cancellable(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+    cancel: &Cancel,
+) -> Result<Mesh, MeshError> {
+    let mesh = build_unstitched(scene, options, max_elements, cancel)?;
+    cancel.check()?;
     Ok(stitch::stitch(scene, mesh))
 }
 
@@ -501,6 +519,16 @@ pub fn build_unstitched_with_limit(
     scene: &Scene,
     options: &MeshOptions,
     max_elements: u64,
+) -> Result<Mesh, MeshError> {
+    build_unstitched(scene, options, max_elements, &Cancel::never())
+}
+
+/// [`build_unstitched_with_limit`], checking `cancel` per polygon.
+fn build_unstitched(
+    scene: &Scene,
+    options: &MeshOptions,
+    max_elements: u64,
+    cancel: &Cancel,
 ) -> Result<Mesh, MeshError> {
     let max_elements = max_elements.min(MAX_ADDRESSABLE_ELEMENTS);
     check_options(options)?;
@@ -524,6 +552,7 @@ pub fn build_unstitched_with_limit(
     };
     let layers = crate::scene::draw_layers(scene, &crate::scene::plane_classes(scene));
     for (index, (polygon, plan)) in scene.polygons.iter().zip(&plans).enumerate() {
+        cancel.check()?;
         let id = PolygonId(index as u32);
         let v_start = mesh.positions.len() as u32;
         let e_start = mesh.elements.len() as u32;

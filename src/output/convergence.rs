@@ -161,8 +161,15 @@ pub fn write_plot_file(
     threshold: f64,
     title: &str,
 ) -> Result<(), OutputError> {
+    write_plot_image(path, plot(steps, threshold, title))
+}
+
+/// Writes a plot drawn by [`plot`] (or its error) to `path`, atomically:
+/// [`write_plot_file`] for a caller that draws the plot itself (on a
+/// thread it can abandon).
+pub fn write_plot_image(path: &Path, plotted: Result<RgbImage, String>) -> Result<(), OutputError> {
     check_plot_path(path)?;
-    let image = plot(steps, threshold, title).map_err(|e| OutputError::Io {
+    let image = plotted.map_err(|e| OutputError::Io {
         path: path.to_path_buf(),
         error: io::Error::other(format!("cannot draw the plot: {e}")),
     })?;

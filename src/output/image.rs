@@ -15,7 +15,7 @@
 use super::{write_atomically_seekable, OutputError};
 use crate::render::{to_srgb8, Exposure, Frame};
 use ::image::{ImageFormat, Rgb32FImage, RgbImage};
-use std::io::Write;
+use std::io::{Cursor, Seek, Write};
 use std::path::Path;
 
 /// The picture extensions [`PictureFormat::from_path`] understands, for
@@ -80,19 +80,17 @@ pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(
             height: frame.height,
         });
     }
-    let encode = |error| OutputError::Encode {
-        path: path.to_path_buf(),
-        error,
-    };
     match format {
         PictureFormat::Png | PictureFormat::Tiff => {
             let img = to_srgb8(frame, exposure.resolve(frame));
+            // A pass over every pixel done; the next is the encoder's.
+            super::check_cancelled(path)?;
             let kind = if format == PictureFormat::Png {
                 ImageFormat::Png
             } else {
                 ImageFormat::Tiff
             };
-            write_atomically_seekable(path, |w| img.write_to(w, kind).map_err(encode))
+            encode_and_write(path, move |mut w| img.write_to(&mut w, kind))
         }
         PictureFormat::Exr => {
             let raw: Vec<f32> = frame.pixels.iter().flatten().copied().collect();
@@ -103,8 +101,8 @@ pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(
                     height: frame.height,
                 }
             })?;
-            write_atomically_seekable(path, |w| {
-                img.write_to(w, ImageFormat::OpenExr).map_err(encode)
+            encode_and_write(path, move |mut w| {
+                img.write_to(&mut w, ImageFormat::OpenExr)
             })
         }
         PictureFormat::Pfm => write_atomically_seekable(path, |w| {
@@ -115,6 +113,43 @@ pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(
         }),
     }
 }
+
+/// Encodes a picture through `encode` and writes it to `path` atomically.
+///
+/// Inside [`cancelling_writes`](super::cancelling_writes) the picture is
+/// encoded in memory first, on a thread the interrupt abandons
+/// ([`crate::cancel::abandonable`]): an encoder compresses the whole
+/// picture before it writes a byte, seconds for a large one, and cannot be
+/// asked to stop. The bytes are then written as any file is, checking the
+/// token per buffer. Outside, `encode` writes to the temporary directly.
+fn encode_and_write<E>(path: &Path, encode: E) -> Result<(), OutputError>
+where
+    E: FnOnce(&mut dyn WriteSeek) -> ::image::ImageResult<()> + Send + 'static,
+{
+    let encode_error = |error| OutputError::Encode {
+        path: path.to_path_buf(),
+        error,
+    };
+    let io_error = |error| OutputError::Io {
+        path: path.to_path_buf(),
+        error,
+    };
+    let Some(cancel) = super::write_cancel() else {
+        return write_atomically_seekable(path, |w| encode(w).map_err(encode_error));
+    };
+    let encoded = crate::cancel::abandonable(&cancel, move || {
+        let mut bytes = Cursor::new(Vec::new());
+        encode(&mut bytes).map(|()| bytes.into_inner())
+    })
+    .map_err(|c| io_error(std::io::Error::other(c)))?
+    .map_err(encode_error)?;
+    write_atomically_seekable(path, |w| w.write_all(&encoded).map_err(io_error))
+}
+
+/// What an image encoder writes to: a file or a buffer in memory.
+trait WriteSeek: Write + Seek {}
+
+impl<T: Write + Seek> WriteSeek for T {}
 
 /// Writes an 8-bit picture that is already tone-mapped (what a window
 /// shows) as PNG or TIFF, chosen by the extension, atomically. The float
@@ -130,14 +165,19 @@ pub fn write_rgb8(path: &Path, image: &RgbImage) -> Result<(), OutputError> {
             })
         }
     };
-    write_atomically_seekable(path, |w| {
-        image
-            .write_to(w, kind)
-            .map_err(|error| OutputError::Encode {
-                path: path.to_path_buf(),
-                error,
-            })
-    })
+    if super::write_cancel().is_none() {
+        // Not cancellable: encoded straight from the borrowed picture.
+        return write_atomically_seekable(path, |w| {
+            image
+                .write_to(w, kind)
+                .map_err(|error| OutputError::Encode {
+                    path: path.to_path_buf(),
+                    error,
+                })
+        });
+    }
+    let image = image.clone();
+    encode_and_write(path, move |mut w| image.write_to(&mut w, kind))
 }
 
 /// Writes the portable float map: a text header (`PF` for colour, the size,

@@ -33,6 +33,7 @@
 //! test holds the two together).
 
 use super::view::View;
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::mesh::{Mesh, VertexId};
 use glam::{DVec2, DVec3};
@@ -169,16 +170,43 @@ impl Frame {
 
     /// Sets the size, keeping the buffers' contents where the length is
     /// unchanged (the rasterizer clears them in parallel); returns the
-    /// number of pixels.
-    fn resize(&mut self, width: u32, height: u32) -> usize {
+    /// number of pixels. Stops with [`Cancelled`] once `cancel` is set,
+    /// the frame then to be drawn again before use.
+    fn resize(&mut self, width: u32, height: u32, cancel: &Cancel) -> Result<usize, Cancelled> {
         let n = width as usize * height as usize;
         self.width = width;
         self.height = height;
-        self.pixels.resize(n, [0.0; 3]);
-        self.covered.resize(n, false);
-        self.back.resize(n, 0.0);
-        n
+        resize_cancellable(&mut self.pixels, n, [0.0; 3], cancel)?;
+        resize_cancellable(&mut self.covered, n, false, cancel)?;
+        resize_cancellable(&mut self.back, n, 0.0, cancel)?;
+        Ok(n)
     }
+}
+
+/// Elements a buffer grows by between two looks at the token in
+/// [`resize_cancellable`]: a few megabytes, milliseconds to fill.
+const RESIZE_CHUNK: usize = 1 << 20;
+
+/// `v.resize(n, value)`, growing [`RESIZE_CHUNK`] elements at a time and
+/// stopping with [`Cancelled`] once `cancel` is set: filling the buffers
+/// of the largest picture takes seconds on a busy machine.
+fn resize_cancellable<T: Clone>(
+    v: &mut Vec<T>,
+    n: usize,
+    value: T,
+    cancel: &Cancel,
+) -> Result<(), Cancelled> {
+    if n <= v.len() {
+        v.truncate(n);
+        return Ok(());
+    }
+    v.reserve_exact(n - v.len());
+    while v.len() < n {
+        cancel.check()?;
+        let len = (v.len() + RESIZE_CHUNK).min(n);
+        v.resize(len, value.clone());
+    }
+    Ok(())
 }
 
 /// Why a mesh and its radiosities cannot be drawn.
@@ -195,6 +223,10 @@ pub enum RenderError {
     /// The mesh's arrays disagree (a bug in whoever built it).
     #[error("inconsistent mesh: {0}")]
     BadMesh(String),
+    /// The run's cancellation token was set while drawing
+    /// ([`Rasterizer::render_cancellable`]); the picture is incomplete.
+    #[error("{0}")]
+    Cancelled(#[from] crate::cancel::Cancelled),
 }
 
 /// The z-buffer rasterizer. It owns the colour, coverage and depth buffers
@@ -267,17 +299,31 @@ impl Rasterizer {
         radiosity: &[Rgb],
         view: &View,
     ) -> Result<&Frame, RenderError> {
+        self.render_cancellable(mesh, radiosity, view, &Cancel::never())
+    }
+
+    /// [`Rasterizer::render`], stopping with [`RenderError::Cancelled`]
+    /// soon after `cancel` is set: it is checked per run of elements set
+    /// up and per band of tiles drawn, each far below a tenth of a second.
+    pub fn render_cancellable(
+        &mut self,
+        mesh: &Mesh,
+        radiosity: &[Rgb],
+        view: &View,
+        cancel: &Cancel,
+    ) -> Result<&Frame, RenderError> {
         check_mesh(mesh, radiosity)?;
         let (width, height) = (view.width(), view.height());
-        let n = self.frame.resize(width, height);
+        let n = self.frame.resize(width, height, cancel)?;
         // Cleared band by band below, in parallel.
-        self.inv_depth.resize(n, 0.0);
-        self.front.resize(n, false);
+        resize_cancellable(&mut self.inv_depth, n, 0.0, cancel)?;
+        resize_cancellable(&mut self.front, n, false, cancel)?;
 
         let w = width as usize;
         let tiles_x = w.div_ceil(TILE_WIDTH);
         let tiles = tiles_x * (height as usize).div_ceil(TILE_HEIGHT);
-        self.setup(mesh, radiosity, view, tiles_x, tiles);
+        self.setup(mesh, radiosity, view, tiles_x, tiles, cancel);
+        cancel.check()?;
 
         let batches = &self.batches;
         let vertices = &self.vertices;
@@ -306,6 +352,9 @@ impl Rasterizer {
                     back,
                 };
                 for tx in 0..tiles_x {
+                    if cancel.is_set() {
+                        return;
+                    }
                     let tile = ty * tiles_x + tx;
                     let columns = tx * TILE_WIDTH..((tx + 1) * TILE_WIDTH).min(w);
                     // Batches in mesh order, each bin in mesh order: every
@@ -319,6 +368,7 @@ impl Rasterizer {
                     }
                 }
             });
+        cancel.check()?;
         Ok(&self.frame)
     }
 
@@ -326,7 +376,15 @@ impl Rasterizer {
     /// parallel: first every mesh vertex (camera space, which side of each
     /// clip plane, projection), then runs of elements, which keep mesh
     /// order.
-    fn setup(&mut self, mesh: &Mesh, radiosity: &[Rgb], view: &View, tiles_x: usize, tiles: usize) {
+    fn setup(
+        &mut self,
+        mesh: &Mesh,
+        radiosity: &[Rgb],
+        view: &View,
+        tiles_x: usize,
+        tiles: usize,
+        cancel: &Cancel,
+    ) {
         let setup = Setup::new(view);
         self.vertices
             .resize(mesh.positions.len(), ProjectedVertex::default());
@@ -351,6 +409,9 @@ impl Rasterizer {
             .for_each(|(k, batch)| {
                 batch.triangles.clear();
                 batch.local.clear();
+                if cancel.is_set() {
+                    return;
+                }
                 for e in k * chunk..((k + 1) * chunk).min(elements) {
                     // Checked by `check_mesh`: every index below is in range.
                     let polygon = &mesh.polygons[mesh.element_polygon[e].index()];

@@ -51,7 +51,7 @@ pub use repair::coplanar::{
     PLANE_OFFSET_TOLERANCE,
 };
 pub use repair::sides::Sides;
-pub use repair::split::{SplitStats, PARALLEL_SINE, SPLIT_TOLERANCE};
+pub use repair::split::{SplitStats, SplitStop, PARALLEL_SINE, SPLIT_TOLERANCE};
 pub use repair::trapped::COVERED_GAP_SHARE;
 
 /// The camera lives in [`crate::camera`], below the scene; these are

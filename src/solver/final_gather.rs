@@ -35,6 +35,7 @@
 use super::distribution::Directional;
 use super::formfactor::{weighted_point_to_samples, ShooterSample};
 use super::tuning::{LINEAR_CANDIDATES, SHAFT_MIN_VERTICES};
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::mesh::{area_centroid, Mesh};
 use crate::scene::{PolygonId, Scene};
@@ -206,6 +207,28 @@ impl<'a> FinalGather<'a> {
             .par_iter()
             .map(|&(x, n)| self.irradiance(x, n))
             .collect()
+    }
+
+    /// [`FinalGather::irradiance_at`], stopping with [`Cancelled`] soon
+    /// after `cancel` is set: each point checks it (one atomic load) before
+    /// its gather, which takes a millisecond or so.
+    pub fn irradiance_at_cancellable(
+        &self,
+        points: &[(Vec3, Vec3)],
+        cancel: &Cancel,
+    ) -> Result<Vec<Rgb>, Cancelled> {
+        let values = points
+            .par_iter()
+            .map(|&(x, n)| {
+                if cancel.is_set() {
+                    Rgb::BLACK
+                } else {
+                    self.irradiance(x, n)
+                }
+            })
+            .collect();
+        cancel.check()?;
+        Ok(values)
     }
 }
 

@@ -17,8 +17,9 @@ pub(super) mod split;
 pub(super) mod trapped;
 
 use crate::budget::{MemoryBudget, OverBudget};
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
-use crate::scene::{PolygonError, Scene, Sides, SplitStats};
+use crate::scene::{PolygonError, Scene, Sides, SplitStats, SplitStop};
 use glam::Vec3;
 
 /// What the repair passes are told: the choices of the command line that
@@ -49,6 +50,10 @@ pub enum RepairError {
     /// memory budget allows.
     #[error("{0}")]
     Memory(#[from] OverBudget),
+    /// The cancellation token was set during the passes
+    /// ([`run_cancellable`]).
+    #[error("{0}")]
+    Interrupted(#[from] Cancelled),
 }
 
 /// Rays cast into the finished scene, which the trapped-sides pass needs:
@@ -81,10 +86,23 @@ pub struct RepairReport<R> {
 /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE), or when splitting
 /// would go over [`RepairOptions::budget`].
 pub fn run<R: FirstHit>(
-    mut scene: Scene,
+    scene: Scene,
     options: &RepairOptions<'_>,
     build_rays: impl FnOnce(&Scene) -> R,
 ) -> Result<(Scene, RepairReport<R>), RepairError> {
+    run_cancellable(scene, options, build_rays, &Cancel::never())
+}
+
+/// [`run`], stopping with [`RepairError::Interrupted`] soon after `cancel`
+/// is set: it is checked between the passes and per polygon while
+/// splitting, the pass that can take long.
+pub fn run_cancellable<R: FirstHit>(
+    mut scene: Scene,
+    options: &RepairOptions<'_>,
+    build_rays: impl FnOnce(&Scene) -> R,
+    cancel: &Cancel,
+) -> Result<(Scene, RepairReport<R>), RepairError> {
+    cancel.check()?;
     // Solids keep their outside only. Found before the cuts, which leave
     // T-junctions on a box sunk into a floor; the pieces keep the mark.
     if let Some(warning) = scene.orient_solids(options.sides, options.file) {
@@ -93,7 +111,12 @@ pub fn run<R: FirstHit>(
     // Not a quirk of the file, so no warning: geometry passing through
     // geometry is how models are built. Before the back copies, so that
     // each piece gets its own.
-    let split = scene.split_intersections_within(&options.budget)?;
+    let split = scene
+        .split_intersections_in(&options.budget, cancel)
+        .map_err(|stop| match stop {
+            SplitStop::Memory(e) => RepairError::Memory(e),
+            SplitStop::Interrupted(c) => RepairError::Interrupted(c),
+        })?;
     let mut scene = scene.with_sides(options.sides);
     // A luminaire's back is a back copy, or made here as one: after the
     // back copies, so that it finds those of a two-sided scene.
@@ -108,6 +131,7 @@ pub fn run<R: FirstHit>(
     // finished geometry, sky included (silencing a side changes only a
     // material, so they stay valid and are handed back).
     let mut rays = None;
+    cancel.check()?;
     if scene.emits_from_both_sides() {
         let built = build_rays(&scene);
         let first_hit = |origin, direction| built.first_hit_distance(origin, direction);

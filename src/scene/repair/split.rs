@@ -65,6 +65,7 @@
 //! included (the test `a_hundred_thousand_polygons_split_as_counted`).
 
 use crate::budget::{fmt_count, least_run_bytes, MemoryBudget, OverBudget};
+use crate::cancel::{Cancel, Cancelled};
 use crate::scene::{Polygon, PolygonId, Scene};
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -477,6 +478,17 @@ fn pieces_of(
     Ok(changed.then_some(pieces))
 }
 
+/// Why [`Scene::split_intersections_in`] stopped; the scene is unchanged.
+#[derive(Debug, thiserror::Error)]
+pub enum SplitStop {
+    /// The pieces would need more memory than the budget.
+    #[error("{0}")]
+    Memory(#[from] OverBudget),
+    /// The cancellation token was set.
+    #[error("{0}")]
+    Interrupted(#[from] Cancelled),
+}
+
 impl Scene {
     /// Splits every polygon along the lines where other polygons pass
     /// through it (see the module docs for which intersections cut), so
@@ -487,20 +499,23 @@ impl Scene {
     /// Meant to run once, after loading and before `with_sides` adds back
     /// copies; a scene that already has back copies is left unchanged.
     pub fn split_intersections(&mut self) -> SplitStats {
-        // Nothing is over an unlimited budget.
-        self.split_intersections_within(&MemoryBudget::UNLIMITED)
+        // Nothing is over an unlimited budget, and a token nobody holds
+        // is never set.
+        self.split_intersections_in(&MemoryBudget::UNLIMITED, &Cancel::never())
             .unwrap_or_default()
     }
 
-    /// [`Scene::split_intersections`] within the memory budget `budget`:
-    /// the pieces are counted as they are made, and the pass stops with
-    /// the refusal as soon as the scene they make would need more than
-    /// the budget (three crossing families of 40 quads make 201,720
-    /// pieces); the scene is then left as it was.
-    pub fn split_intersections_within(
+    /// [`Scene::split_intersections`] within the memory budget `budget`,
+    /// stopping soon after `cancel` is set. The pieces are counted as they
+    /// are made, and the pass stops with [`SplitStop::Memory`] as soon as
+    /// the scene they make would need more than the budget (three crossing
+    /// families of 40 quads make 201,720 pieces); each polygon checks
+    /// `cancel` before it is cut. Either way the scene is left as it was.
+    pub fn split_intersections_in(
         &mut self,
         budget: &MemoryBudget,
-    ) -> Result<SplitStats, OverBudget> {
+        cancel: &Cancel,
+    ) -> Result<SplitStats, SplitStop> {
         let n = self.polygons.len();
         if n < 2 || self.polygons.iter().any(|p| p.surface.back_of.is_some()) {
             return Ok(SplitStats::default());
@@ -545,6 +560,9 @@ impl Scene {
                 if growth.over() {
                     return Err(());
                 }
+                if cancel.is_set() {
+                    return Ok(None);
+                }
                 let others = overlapping(&bvh, &boxes, p);
                 let cuts = cuts_of(p, &others, &vertices, &planes, eps);
                 if cuts.is_empty() {
@@ -554,9 +572,10 @@ impl Scene {
                 }
             })
             .collect();
+        cancel.check()?;
         let Ok(replaced) = replaced else {
             let added = growth.added.load(Ordering::Relaxed);
-            return Err(OverBudget {
+            return Err(SplitStop::Memory(OverBudget {
                 need: growth.need(added),
                 what: format!(
                     "{} polygons split along their intersections into more than {} pieces, \
@@ -565,7 +584,7 @@ impl Scene {
                     fmt_count(n as u64 + added)
                 ),
                 budget: budget.bytes(),
-            });
+            }));
         };
 
         let mut stats = SplitStats::default();
