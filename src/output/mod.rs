@@ -166,6 +166,30 @@ pub fn check_destination(path: &Path) -> Result<(), OutputError> {
     destination_dir(path).map(|_| ())
 }
 
+/// Checks, before any work is done, that a file of `path`'s name can be
+/// created in its directory: a temporary file whose name is as long as
+/// `path`'s is created there and removed, so a read-only directory or
+/// file system, or a name longer than the file system allows, is found
+/// before the solve rather than after it.
+pub fn check_creatable(path: &Path) -> Result<(), OutputError> {
+    let dir = destination_dir(path)?;
+    let length = path.file_name().map_or(0, |n| n.len());
+    // A dot and random letters, as long as the name in bytes.
+    let probe = tempfile::Builder::new()
+        .prefix(".")
+        .rand_bytes(length.saturating_sub(1).max(1))
+        .tempfile_in(&dir)
+        // The operating system's reason alone: the probe's name would
+        // only confuse.
+        .map_err(|e| {
+            OutputError::io(
+                path,
+                e.raw_os_error().map_or(e, io::Error::from_raw_os_error),
+            )
+        })?;
+    probe.close().map_err(|e| OutputError::io(path, e))
+}
+
 /// The directory `path` goes in, which must exist.
 fn destination_dir(path: &Path) -> Result<PathBuf, OutputError> {
     let dir = match path.parent() {

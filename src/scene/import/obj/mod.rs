@@ -107,6 +107,7 @@ use scan::{
 
 use crate::color::Rgb;
 use crate::scene::error::{cannot_read, FILE_START, MAX_DIAGNOSTICS};
+use crate::scene::import::input::{read_file, InputKind, InputSet, ModelFolder};
 use crate::scene::lighting::emit::GroupScan;
 use crate::scene::{
     CameraSource, Diagnostic, Group, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
@@ -115,7 +116,7 @@ use crate::scene::{
 use glam::{DVec2, DVec3, Vec3};
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::rc::Rc;
 
 /// The name of the material given to faces that come before any `usemtl`.
@@ -172,22 +173,35 @@ pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 /// Errors name the file (the OBJ, an MTL, or the camera file), the line
 /// and the column, and every problem found is reported (up to
 /// [`MAX_DIAGNOSTICS`]).
-pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
+pub fn load_obj(path: &Path, camera: Option<&Path>, inputs: &InputSet) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
+    let bytes = inputs
+        .read(path, InputKind::Scene)
+        .map_err(|e| cannot_read(&file, &e))?;
     // Lossy: a stray Latin-1 byte in a comment must not refuse the model;
     // names are decoded the same way in the OBJ and in its MTL files.
     let text = String::from_utf8_lossy(&bytes);
-    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let folder = ModelFolder::of(path, inputs);
     let read_mtl = |name: &str| -> Result<(String, String), String> {
-        let mtl_path: PathBuf = dir.join(name);
+        let mtl_path = folder.join(name);
         let display = mtl_path.display().to_string();
-        match std::fs::read(&mtl_path) {
+        match folder.read(&mtl_path, InputKind::Material) {
             Ok(bytes) => Ok((display, String::from_utf8_lossy(&bytes).into_owned())),
-            Err(e) => Err(format!("cannot read material library {display}: {e}")),
+            Err(e) => Err(e.to_string()),
         }
     };
-    parse_obj(&text, &file, &read_mtl)?.with_camera_from(camera)
+    let read_texture = |path: &Path| {
+        folder
+            .read(path, InputKind::Texture)
+            .map_err(|e| e.to_string())
+    };
+    let scene = parse_obj_reading(&text, &file, &read_mtl, &read_texture);
+    // A library or texture refused for what it is or where it lies ends
+    // the load, though one that is missing is only warned about.
+    if let Some(refused) = folder.refused() {
+        return Err(Diagnostic::new(&file, FILE_START, refused).into());
+    }
+    scene?.with_camera_read(camera, inputs)
 }
 
 /// Turns a `mtllib` name into the library's name for messages and its
@@ -198,8 +212,29 @@ pub type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
 /// and its libraries from files. `read_mtl` turns a `mtllib` name into
 /// the library's name for messages and its text, or says why it cannot;
 /// `map_Kd` textures are still read from the file system, relative to the
-/// folder of the library's name. The camera frames the model.
+/// folder of the library's name (each through
+/// [`input::read_file`](crate::scene::import::input::read_file), a regular
+/// file within its size limit). The camera frames the model.
 pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene, LoadError> {
+    let read_texture = |path: &Path| {
+        read_file(path, InputKind::Texture)
+            .map(|(bytes, _)| bytes)
+            .map_err(|e| e.to_string())
+    };
+    parse_obj_reading(text, file, read_mtl, &read_texture)
+}
+
+/// Reads a texture's bytes from its path (the library's folder joined to
+/// its `map_Kd` name), or says why it cannot.
+pub type ReadTexture<'a> = dyn Fn(&Path) -> Result<Vec<u8>, String> + 'a;
+
+/// [`parse_obj`], reading `map_Kd` textures through `read_texture`.
+fn parse_obj_reading(
+    text: &str,
+    file: &str,
+    read_mtl: &ReadMtl<'_>,
+    read_texture: &ReadTexture<'_>,
+) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut scan = scan_obj(text, file);
     smooth_surfaces(&mut scan.faces);
@@ -219,6 +254,7 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
     let mut libraries = reading.libraries;
     let mut warnings = reading_warnings(
         &mut libraries,
+        read_texture,
         reading.unreadable,
         reading.mtllib_backslashes,
         &scan,
@@ -358,6 +394,7 @@ fn read_with_tobj(text: &str, file: &str, scan: &Scan, read_mtl: &ReadMtl<'_>) -
 /// face corners that lost a reference, the `mtllib` paths with `\`.
 fn reading_warnings(
     libraries: &mut [Library],
+    read_texture: &ReadTexture<'_>,
     unreadable: Vec<Warning>,
     backslashes: Tally,
     scan: &Scan,
@@ -365,7 +402,7 @@ fn reading_warnings(
 ) -> Vec<Warning> {
     let mut warnings = Vec::new();
     for lib in libraries {
-        read_textures(lib);
+        read_textures(lib, read_texture);
         warnings.append(&mut lib.warnings);
     }
     warnings.extend(unreadable);

@@ -5,6 +5,7 @@
 //! say how a block becomes a [`Material`].
 
 use super::scan::{lines, words};
+use super::ReadTexture;
 use super::{name_list, Tally, DEFAULT_REFLECTANCE, DIFFUSE_SHEEN_LIMIT, MAX_MTL_REFLECTANCE};
 use crate::color::Rgb;
 use crate::scene::error::{fmt_num, negative_channel};
@@ -309,7 +310,7 @@ fn warn_about_materials(lib: &mut Library) {
 /// Reads each `map_Kd` texture of `lib` (relative to the library's folder)
 /// and records its average colour; one warning for those that cannot be
 /// read (they keep their `Kd`), one for paths written with `\`.
-pub(super) fn read_textures(lib: &mut Library) {
+pub(super) fn read_textures(lib: &mut Library, read: &ReadTexture<'_>) {
     let dir = Path::new(&lib.file)
         .parent()
         .map(Path::to_path_buf)
@@ -320,7 +321,7 @@ pub(super) fn read_textures(lib: &mut Library) {
             continue;
         };
         let path = dir.join(name);
-        match average_texture(&path) {
+        match average_texture(&path, read) {
             Ok(rgb) => m.texture = Some(rgb),
             Err(e) => failed.add(*pos, || {
                 format!("{} (material `{}`): {e}", path.display(), m.name)
@@ -352,8 +353,18 @@ pub(super) fn read_textures(lib: &mut Library) {
 /// The average colour of the image at `path`, in linear values (8- and
 /// 16-bit images are sRGB-decoded first; float images are linear
 /// already), alpha ignored. Each channel is in `[0, 1]`.
-pub(crate) fn average_texture(path: &Path) -> Result<Rgb, String> {
-    let image = image::open(path).map_err(|e| e.to_string())?;
+pub(crate) fn average_texture(path: &Path, read: &ReadTexture<'_>) -> Result<Rgb, String> {
+    // Read through `read` (the input rules), decoded from memory: by its
+    // contents, else by the path's extension (TGA has no magic bytes).
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(read(path)?))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    if reader.format().is_none() {
+        if let Ok(format) = image::ImageFormat::from_path(path) {
+            reader.set_format(format);
+        }
+    }
+    let image = reader.decode().map_err(|e| e.to_string())?;
     average_image(&image)
 }
 
