@@ -77,8 +77,8 @@ impl InputKind {
     /// hundred MB); a material library 64 MiB; a texture 512 MiB encoded;
     /// an IES file 64 MiB (its documented maximum of a million values
     /// takes about 15 MB); a points file 1 GiB (tens of millions of
-    /// points); a checkpoint 16 GiB (the state of the largest mesh
-    /// allowed); a camera file, which may be a whole `.sc` scene, as a
+    /// points); a checkpoint 16 GiB (about 500 MB at the default element
+    /// limit, more when `--max-elements` is raised); a camera file, which may be a whole `.sc` scene, as a
     /// scene.
     pub fn max_bytes(self) -> u64 {
         match self {
@@ -596,7 +596,8 @@ mod tests {
         assert!(stays_inside(dir, &dir.join("./a.png")));
         assert!(!stays_inside(dir, &dir.join("../a.png")));
         assert!(!stays_inside(dir, &dir.join("tex/../../a.png")));
-        assert!(!stays_inside(dir, &dir.join("/etc/passwd")));
+        // What joining an absolute name to the folder gives.
+        assert!(!stays_inside(dir, Path::new("/etc/passwd")));
         // A model in the working directory.
         assert!(stays_inside(Path::new(""), Path::new("a.mtl")));
         assert!(!stays_inside(Path::new(""), Path::new("../a.mtl")));
