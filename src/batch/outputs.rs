@@ -171,7 +171,7 @@ fn check_against(config: &RunConfig, inputs: &[InputFile]) -> Result<(), RunErro
             return Err(refuse(
                 out,
                 format!(
-                    "{earlier} and {option} would write this same file: \
+                    "two outputs would write this same file ({earlier} and {option}): \
                      {OUTPUT_OPTIONS} must be different files"
                 ),
             ));

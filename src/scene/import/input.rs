@@ -441,7 +441,13 @@ impl<'a> ModelFolder<'a> {
             .check_inside(path, kind)
             .and_then(|()| self.inputs.read(path, kind));
         if let Err(e) = &result {
-            if e.is_refusal() {
+            // A texture outside the folder only tints a material: it is
+            // skipped with the loader's warning, as a missing one is (real
+            // exports name `../textures/...`). A buffer outside fails the
+            // load by itself.
+            let skipped = matches!(e, InputError::Outside { .. })
+                && matches!(kind, InputKind::Texture | InputKind::GltfData);
+            if e.is_refusal() && !skipped {
                 let mut refused = self.refused.lock().unwrap_or_else(|e| e.into_inner());
                 refused.get_or_insert_with(|| e.to_string());
             }
@@ -451,7 +457,9 @@ impl<'a> ModelFolder<'a> {
 
     /// The message of the first file refused (see
     /// [`InputError::is_refusal`]), if any: the loader ends with it even
-    /// where the model's reader only warned.
+    /// where the model's reader only warned. A texture or glTF file
+    /// refused only for lying outside the folder is not counted: the
+    /// reader's warning says it was skipped.
     pub fn refused(&self) -> Option<String> {
         self.refused
             .lock()
@@ -619,7 +627,13 @@ mod tests {
         assert!(message.contains("`../secret`"), "{message}");
         assert!(message.contains("--allow-outside-paths"), "{message}");
         assert!(!message.contains("secret bytes"), "{message}");
-        assert_eq!(folder.refused(), Some(message));
+        // Skipped with a warning by the glTF reader (a buffer fails by
+        // itself); a material library outside ends the load.
+        assert_eq!(folder.refused(), None);
+        let err = folder
+            .read(&folder.join("../secret"), InputKind::Material)
+            .unwrap_err();
+        assert_eq!(folder.refused(), Some(err.to_string()));
         assert!(strict.files().is_empty());
 
         let lenient = InputSet::new(true);
