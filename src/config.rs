@@ -107,6 +107,9 @@ pub struct RunConfig {
     pub checkpoint_every: Duration,
     /// A checkpoint to continue from instead of starting the solve afresh.
     pub resume: Option<PathBuf>,
+    /// `--allow-outside-paths`: a model may name files outside its folder
+    /// (see [`crate::scene::import::input`]); off by default.
+    pub allow_outside_paths: bool,
     /// Add the ambient term ([`crate::solver::Progressive::ambient`]) to the radiosity
     /// shown: `None` for the default, on in the window and off for files.
     pub ambient: Option<bool>,
@@ -209,6 +212,7 @@ impl RunConfig {
             checkpoint: None,
             checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
             resume: None,
+            allow_outside_paths: false,
             ambient: None,
             adaptive: None,
             mesh_lines: false,

@@ -20,8 +20,8 @@ use crate::mesh::{self, Mesh, MeshError, MeshOptions};
 use crate::render::{View, ViewError};
 use crate::scene::repair::{self, FirstHit, RepairError, RepairOptions};
 use crate::scene::{
-    self, IesError, LoadError, LuminaireError, Photometry, PolygonError, Scene, SplitStats,
-    UnknownName, Warning,
+    self, IesError, InputKind, InputSet, LoadError, LuminaireError, Photometry, PolygonError,
+    Scene, SplitStats, UnknownName, Warning,
 };
 use crate::visibility::Visibility;
 use glam::Vec3;
@@ -106,6 +106,11 @@ pub struct Prepared {
     pub seconds: PhaseSeconds,
     /// What splitting along intersections did to the loaded scene.
     pub split: SplitStats,
+    /// Every file the run reads: those loading read (the scene, its
+    /// libraries, textures and buffers, the camera and IES files) and
+    /// those read later (points, the checkpoint to resume), which no
+    /// output may overwrite.
+    pub inputs: InputSet,
 }
 
 impl Prepared {
@@ -182,7 +187,13 @@ fn prepare_deferred_cancellable(
 ) -> Result<Prepared, PrepareError> {
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
-    let mut scene = load_scene_within(&config.scene, config.camera.as_deref(), &config.max_memory)?;
+    let inputs = declared_inputs(config);
+    let mut scene = load_scene_within(
+        &config.scene,
+        config.camera.as_deref(),
+        &inputs,
+        &config.max_memory,
+    )?;
     cancel.check()?;
     for (name, emission) in &config.emit {
         scene.set_emission(name, *emission)?;
@@ -192,7 +203,7 @@ fn prepare_deferred_cancellable(
             .units()
             .ok_or_else(|| PrepareError::NoUnits(config.scene.display_name()))?;
         for (name, path) in &config.photometry.ies {
-            let photometry = Arc::new(Photometry::load(path)?);
+            let photometry = Arc::new(Photometry::load_into(path, &inputs)?);
             scene
                 .set_luminaire(name, photometry, units)
                 .map_err(|e| PrepareError::Luminaire(name.clone(), Box::new(e)))?;
@@ -273,6 +284,7 @@ fn prepare_deferred_cancellable(
         lenmax: mesh_options.lenmax,
         seconds,
         split,
+        inputs,
     })
 }
 
@@ -312,9 +324,14 @@ impl FirstHit for Visibility {
 }
 
 /// Loads the scene from its source, with the camera of the `.sc` file
-/// `camera` when given (see [`Scene::with_camera_from`]).
-pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, LoadError> {
-    load_scene_within(source, camera, &MemoryBudget::for_machine())
+/// `camera` when given (see [`Scene::with_camera_from`]), recording every
+/// file read in `inputs`.
+pub fn load_scene(
+    source: &SceneSource,
+    camera: Option<&Path>,
+    inputs: &InputSet,
+) -> Result<Scene, LoadError> {
+    load_scene_within(source, camera, inputs, &MemoryBudget::for_machine())
 }
 
 /// [`load_scene`] within the memory budget `budget`
@@ -322,13 +339,30 @@ pub fn load_scene(source: &SceneSource, camera: Option<&Path>) -> Result<Scene, 
 pub fn load_scene_within(
     source: &SceneSource,
     camera: Option<&Path>,
+    inputs: &InputSet,
     budget: &MemoryBudget,
 ) -> Result<Scene, LoadError> {
     let scene = match source {
         SceneSource::Bundled => scene::parse_str(BUNDLED_SCENE, BUNDLED_SCENE_NAME)?,
-        SceneSource::File(path) => scene::load_within(path, budget)?,
+        SceneSource::File(path) => scene::load_with(path, inputs, budget)?,
     };
-    scene.with_camera_from(camera)
+    scene.with_camera_read(camera, inputs)
+}
+
+/// The input set of a run before anything is read: empty but for the
+/// files `config` names that are read only after loading (the points
+/// file, the checkpoint to resume), recorded by identity so that outputs
+/// are checked against them before then; a model's files may lie outside
+/// its folder as `--allow-outside-paths` says.
+pub fn declared_inputs(config: &RunConfig) -> InputSet {
+    let inputs = InputSet::new(config.allow_outside_paths);
+    if let Some((points, _)) = &config.photometry.illuminance {
+        inputs.declare(points, InputKind::Points);
+    }
+    if let Some(resume) = &config.resume {
+        inputs.declare(resume, InputKind::Checkpoint);
+    }
+    inputs
 }
 
 #[cfg(test)]

@@ -333,11 +333,11 @@ fn outputs_never_clobber_the_input_or_each_other() {
         ),
         (
             &["-o", "out.png", "--checkpoint", "in.sc"],
-            "refusing to overwrite the input scene",
+            "--checkpoint would overwrite the scene file",
         ),
         (
             &["-o", "out.png", "--stats", "./in.sc"],
-            "refusing to overwrite the input scene",
+            "--stats would overwrite the scene file",
         ),
         (
             &["-o", "same.png", "--stats", "same.png"],
@@ -378,7 +378,11 @@ fn outputs_never_clobber_the_input_or_each_other() {
         std::fs::hard_link(&input, dir.path().join("alias.png")).unwrap();
         let out = run_in(dir.path(), &["in.sc", "-o", "alias.png"]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-        assert!(stderr(&out).contains("input scene"), "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains("-o would overwrite the scene file in.sc"),
+            "{}",
+            stderr(&out)
+        );
     }
     assert_eq!(std::fs::read_to_string(&input).unwrap(), text);
 }

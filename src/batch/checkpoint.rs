@@ -11,6 +11,7 @@
 
 use crate::output::convergence::StepRecord;
 use crate::output::{self, OutputError};
+use crate::scene::import::input::{read_file, InputError, InputKind};
 use crate::solver::checkpoint::{self, DecodeError, SolverState};
 use crate::solver::SolverError;
 use std::path::{Path, PathBuf};
@@ -26,6 +27,10 @@ pub enum CheckpointError {
         /// What the operating system said.
         error: std::io::Error,
     },
+    /// The file is no regular file, or is over the size limit of a
+    /// checkpoint ([`InputKind::max_bytes`]).
+    #[error("{0}")]
+    Refused(InputError),
     /// The file is not a checkpoint of a supported version, or is damaged.
     #[error("{} is not a usable checkpoint: {reason}", path.display())]
     Invalid {
@@ -93,9 +98,12 @@ pub fn load(
     path: &Path,
     fingerprint: u64,
 ) -> Result<(SolverState, Vec<StepRecord>), CheckpointError> {
-    let bytes = std::fs::read(path).map_err(|error| CheckpointError::Read {
-        path: path.to_path_buf(),
-        error,
+    let (bytes, _) = read_file(path, InputKind::Checkpoint).map_err(|e| match e {
+        InputError::Io { error, .. } => CheckpointError::Read {
+            path: path.to_path_buf(),
+            error,
+        },
+        refused => CheckpointError::Refused(refused),
     })?;
     let decoded = checkpoint::decode(&bytes).map_err(|reason| CheckpointError::Invalid {
         path: path.to_path_buf(),

@@ -36,7 +36,7 @@ pub mod photometry;
 pub mod progress;
 
 pub use checkpoint::CheckpointError;
-pub use outputs::check_outputs;
+pub use outputs::{check_outputs, check_outputs_against};
 
 use crate::cancel::{Cancel, Cancelled};
 use crate::config::RunConfig;
@@ -345,6 +345,8 @@ pub fn run_prepared(
 ) -> Result<RunStats, RunError> {
     check_outputs(config)?;
     remove_stale_temporaries(config);
+    // The files loading read (libraries, textures, buffers) are known now.
+    outputs::check_outputs_against(config, &prepared.inputs)?;
     if config.adaptive.is_some() && (config.checkpoint.is_some() || config.resume.is_some()) {
         return Err(RunError::Options(
             "--adaptive cannot be combined with --checkpoint or --resume: \

@@ -356,6 +356,15 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     pub(crate) resume: Option<PathBuf>,
 
+    /// Let a model read files outside its folder.
+    ///
+    /// By default the files an OBJ or glTF names (mtllib, map_Kd, buffer
+    /// and image URIs) must lie in the model's folder or below it: a name
+    /// that is an absolute path or climbs out with `..` is refused, so a
+    /// downloaded model cannot read other files of the machine.
+    #[arg(long)]
+    pub(crate) allow_outside_paths: bool,
+
     /// No progress bar and no summary line.
     #[arg(short, long)]
     pub(crate) quiet: bool,

@@ -262,6 +262,7 @@ impl TryFrom<Args> for Invocation {
                 args.checkpoint_every.min(MAX_CHECKPOINT_EVERY_SECS),
             ),
             resume: args.resume,
+            allow_outside_paths: args.allow_outside_paths,
             ambient: match (args.ambient, args.no_ambient) {
                 (true, _) => Some(true),
                 (_, true) => Some(false),

@@ -417,6 +417,49 @@ pub fn check_destination(path: &Path) -> Result<(), OutputError> {
     destination_dir(path).map(|_| ())
 }
 
+/// Checks, before any work is done, that a file of `path`'s name can be
+/// created in its directory: a temporary file whose name is as long as
+/// `path`'s is created there and removed, so a read-only directory or
+/// file system, or a name longer than the file system allows, is found
+/// before the solve rather than after it.
+pub fn check_creatable(path: &Path) -> Result<(), OutputError> {
+    let dir = destination_dir(path)?;
+    let length = path.file_name().map_or(1, |n| n.len()).max(1);
+    let seed = std::process::id() as u64
+        ^ std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos() as u64);
+    for attempt in 0..16u64 {
+        // A dot and letters, as long as the name in bytes; another name
+        // if one of these exists.
+        let mut x = seed.wrapping_add(attempt.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        // (A one-byte name gets no dot: `.` is the directory itself.)
+        let name: String = (length > 1)
+            .then_some('.')
+            .into_iter()
+            .chain(std::iter::repeat_with(|| {
+                x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+                char::from(b'a' + ((x >> 33) % 26) as u8)
+            }))
+            .take(length)
+            .collect();
+        let probe = dir.join(name);
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&probe)
+        {
+            Ok(file) => {
+                drop(file);
+                return std::fs::remove_file(&probe).map_err(|e| OutputError::io(path, e));
+            }
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(OutputError::io(path, e)),
+        }
+    }
+    Ok(())
+}
+
 /// The directory `path` goes in, which must exist.
 fn destination_dir(path: &Path) -> Result<PathBuf, OutputError> {
     let dir = match path.parent() {
@@ -626,5 +669,20 @@ mod tests {
         std::fs::write(&file, b"").unwrap();
         let err = write_atomically(&file.join("out.json"), |w| w.write_all(b"x")).unwrap_err();
         assert!(matches!(err, OutputError::NotADirectory { .. }), "{err}");
+    }
+
+    #[test]
+    fn a_name_too_long_to_create_is_found_by_the_probe_which_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        // Most file systems allow names of at most 255 bytes.
+        let long = dir.path().join(format!("{}.png", "a".repeat(296)));
+        let err = check_creatable(&long).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("File name too long"), "{msg}");
+        assert!(!msg.contains("at path"), "{msg}");
+        let fits = dir.path().join(format!("{}.png", "a".repeat(200)));
+        check_creatable(&fits).unwrap();
+        check_creatable(&dir.path().join("a")).unwrap();
+        assert!(entries(dir.path()).is_empty());
     }
 }

@@ -16,6 +16,7 @@
 //! position of whole-file problems, and the messages for unreadable files,
 //! negative colour channels and reflectance at or above one.
 
+use super::import::input::InputError;
 use super::SourcePos;
 use crate::color::Rgb;
 use std::fmt;
@@ -29,8 +30,12 @@ pub const MAX_DIAGNOSTICS: usize = 100;
 pub(crate) const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
 
 /// The diagnostic for a file that cannot be read, at [`FILE_START`].
-pub(crate) fn cannot_read(file: &str, error: &std::io::Error) -> Diagnostic {
-    Diagnostic::new(file, FILE_START, format!("cannot read file: {error}"))
+pub(crate) fn cannot_read(file: &str, error: &InputError) -> Diagnostic {
+    let message = match error {
+        InputError::Io { error, .. } => format!("cannot read file: {error}"),
+        refused => refused.to_string(),
+    };
+    Diagnostic::new(file, FILE_START, message)
 }
 
 /// The message for a colour channel written negative: `keyword` is the

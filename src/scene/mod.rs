@@ -29,12 +29,13 @@ pub use framing::{
 };
 pub use import::gltf::parse_gltf;
 pub use import::ies::{IesError, Photometry};
+pub use import::input::{InputError, InputFile, InputKind, InputSet};
 pub use import::obj::load_obj;
 pub use import::points::{load_points, MeasurementPoint, PointsError};
 pub use import::sc::{
-    load_camera, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION,
+    load_camera, load_camera_into, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION,
 };
-pub use import::{load, load_within};
+pub use import::{load, load_into, load_with, load_within};
 pub use lighting::emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
 };
@@ -248,9 +249,18 @@ impl Scene {
     /// This is the one way a camera override (`--camera`) is applied,
     /// whatever format the scene came from. The scene is loaded first, so
     /// when both files are wrong the scene's mistakes are the ones reported.
-    pub fn with_camera_from(mut self, camera: Option<&Path>) -> Result<Scene, LoadError> {
+    pub fn with_camera_from(self, camera: Option<&Path>) -> Result<Scene, LoadError> {
+        self.with_camera_read(camera, &InputSet::default())
+    }
+
+    /// [`Scene::with_camera_from`], recording the camera file in `inputs`.
+    pub fn with_camera_read(
+        mut self,
+        camera: Option<&Path>,
+        inputs: &InputSet,
+    ) -> Result<Scene, LoadError> {
         if let Some(path) = camera {
-            self.camera = load_camera(path)?;
+            self.camera = load_camera_into(path, inputs)?;
             self.camera_source = CameraSource::File;
         }
         Ok(self)

@@ -88,7 +88,8 @@ use super::texture;
 use crate::budget::{fmt_count, least_run_bytes, MemoryBudget, OverBudget};
 use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
 use crate::color::Rgb;
-use crate::scene::error::{fmt_num, MAX_DIAGNOSTICS};
+use crate::scene::error::{cannot_read, fmt_num, MAX_DIAGNOSTICS};
+use crate::scene::import::input::{InputKind, InputSet, ModelFolder};
 use crate::scene::{
     CameraSource, Diagnostic, Group, GroupKind, LoadError, Material, MaterialId, Polygon, Scene,
     SmoothId, SourcePos, Warning, MAX_EMISSION,
@@ -122,28 +123,51 @@ pub type ReadUri<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
 ///
 /// Errors name the file and the JSON path (or byte offset in a glb) of
 /// each problem, up to [`MAX_DIAGNOSTICS`].
-pub fn load_gltf(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
-    load_gltf_within(path, camera, &MemoryBudget::for_machine())
+pub fn load_gltf(
+    path: &Path,
+    camera: Option<&Path>,
+    inputs: &InputSet,
+) -> Result<Scene, LoadError> {
+    load_gltf_with(path, camera, inputs, &MemoryBudget::for_machine())
 }
 
 /// [`load_gltf`] within the memory budget `budget`: the triangles of
 /// every node instance are counted from the accessors before any is
 /// built, and a scene over the budget is refused; textures are decoded
-/// within it.
+/// within it. Every file read is recorded in a set of its own.
 pub fn load_gltf_within(
     path: &Path,
     camera: Option<&Path>,
     budget: &MemoryBudget,
 ) -> Result<Scene, LoadError> {
+    load_gltf_with(path, camera, &InputSet::default(), budget)
+}
+
+/// [`load_gltf`] recording every file read in `inputs`, within `budget`
+/// as [`load_gltf_within`].
+pub fn load_gltf_with(
+    path: &Path,
+    camera: Option<&Path>,
+    inputs: &InputSet,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path)
-        .map_err(|e| Diagnostic::whole(&file, format!("cannot read file: {e}")))?;
-    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let bytes = inputs
+        .read(path, InputKind::Scene)
+        .map_err(|e| Diagnostic::whole(&file, cannot_read(&file, &e).message))?;
+    let folder = ModelFolder::of(path, inputs);
     let read_uri = |name: &str| -> Result<Vec<u8>, String> {
-        let p = dir.join(name);
-        std::fs::read(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))
+        folder
+            .read(&folder.join(name), InputKind::GltfData)
+            .map_err(|e| e.to_string())
     };
-    parse_gltf_within(&bytes, &file, &read_uri, budget)?.with_camera_from(camera)
+    let scene = parse_gltf_within(&bytes, &file, &read_uri, budget);
+    // An image refused for what it is or where it lies ends the load,
+    // though one that is missing is only warned about.
+    if let Some(refused) = folder.refused() {
+        return Err(Diagnostic::whole(&file, refused).into());
+    }
+    scene?.with_camera_read(camera, inputs)
 }
 
 /// Parses glTF bytes (a glb, or the JSON of a `.gltf`) named `file`;

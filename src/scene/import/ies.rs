@@ -34,6 +34,7 @@
 //! Errors give the file, the line and the column of the offending value
 //! and what was expected there ([`IesError`]).
 
+use super::input::{InputError, InputKind, InputSet};
 use std::f64::consts::PI;
 use std::fmt;
 use std::path::Path;
@@ -110,12 +111,20 @@ impl Photometry {
     /// Reads and parses the IES file at `path`; `name` is how messages name
     /// it.
     pub fn load(path: &Path) -> Result<Photometry, IesError> {
+        Photometry::load_into(path, &InputSet::default())
+    }
+
+    /// [`Photometry::load`], recording the file in `inputs`.
+    pub fn load_into(path: &Path, inputs: &InputSet) -> Result<Photometry, IesError> {
         let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| IesError {
+        let bytes = inputs.read(path, InputKind::Ies).map_err(|e| IesError {
             file: name.clone(),
             line: 0,
             column: 0,
-            message: format!("cannot read the IES file: {e}"),
+            message: match e {
+                InputError::Io { error, .. } => format!("cannot read the IES file: {error}"),
+                refused => refused.to_string(),
+            },
         })?;
         // IES files are ASCII; Latin-1 keywords are not rare, and read as
         // such rather than refused.

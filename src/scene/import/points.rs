@@ -6,6 +6,7 @@
 //! header and skipped; blank lines and lines starting with `#` are
 //! skipped too. Blanks around values are allowed.
 
+use super::input::{read_file, InputError, InputKind};
 use glam::Vec3;
 use std::path::Path;
 
@@ -29,11 +30,20 @@ pub type MeasurementPoint = (Vec3, Vec3);
 /// Reads the points file at `path` (see the module docs).
 pub fn load_points(path: &Path) -> Result<Vec<MeasurementPoint>, PointsError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| PointsError {
+    let cannot = |message: String| PointsError {
         file: name.clone(),
         line: 0,
         column: 0,
-        message: format!("cannot read the points file: {e}"),
+        message,
+    };
+    let (bytes, _) = read_file(path, InputKind::Points).map_err(|e| {
+        cannot(match e {
+            InputError::Io { error, .. } => format!("cannot read the points file: {error}"),
+            refused => refused.to_string(),
+        })
+    })?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        cannot("cannot read the points file: stream did not contain valid UTF-8".to_string())
     })?;
     parse_points(&text, &name)
 }

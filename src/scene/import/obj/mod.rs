@@ -107,6 +107,7 @@ use scan::{
 use crate::budget::{fmt_count, least_run_bytes, MemoryBudget};
 use crate::color::Rgb;
 use crate::scene::error::{cannot_read, FILE_START, MAX_DIAGNOSTICS};
+use crate::scene::import::input::{read_file, InputKind, InputSet, ModelFolder};
 use crate::scene::lighting::emit::GroupScan;
 use crate::scene::{
     CameraSource, Diagnostic, Group, LoadError, Material, MaterialId, Polygon, PolygonError, Scene,
@@ -115,7 +116,7 @@ use crate::scene::{
 use glam::{DVec2, DVec3, Vec3};
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::rc::Rc;
 
 /// The name of the material given to faces that come before any `usemtl`.
@@ -172,33 +173,57 @@ pub const EAR_AREA_TOLERANCE: f64 = 1e-9;
 /// Errors name the file (the OBJ, an MTL, or the camera file), the line
 /// and the column, and every problem found is reported (up to
 /// [`MAX_DIAGNOSTICS`]).
-pub fn load_obj(path: &Path, camera: Option<&Path>) -> Result<Scene, LoadError> {
-    load_obj_within(path, camera, &MemoryBudget::for_machine())
+pub fn load_obj(path: &Path, camera: Option<&Path>, inputs: &InputSet) -> Result<Scene, LoadError> {
+    load_obj_with(path, camera, inputs, &MemoryBudget::for_machine())
 }
 
 /// [`load_obj`] within the memory budget `budget`: a file whose faces
 /// alone would take more is refused before they are built, and textures
-/// are decoded within it.
+/// are decoded within it. Every file read is recorded in a set of its own.
 pub fn load_obj_within(
     path: &Path,
     camera: Option<&Path>,
     budget: &MemoryBudget,
 ) -> Result<Scene, LoadError> {
+    load_obj_with(path, camera, &InputSet::default(), budget)
+}
+
+/// [`load_obj`] recording every file read in `inputs`, within `budget`
+/// as [`load_obj_within`].
+pub fn load_obj_with(
+    path: &Path,
+    camera: Option<&Path>,
+    inputs: &InputSet,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
+    let bytes = inputs
+        .read(path, InputKind::Scene)
+        .map_err(|e| cannot_read(&file, &e))?;
     // Lossy: a stray Latin-1 byte in a comment must not refuse the model;
     // names are decoded the same way in the OBJ and in its MTL files.
     let text = String::from_utf8_lossy(&bytes);
-    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let folder = ModelFolder::of(path, inputs);
     let read_mtl = |name: &str| -> Result<(String, String), String> {
-        let mtl_path: PathBuf = dir.join(name);
+        let mtl_path = folder.join(name);
         let display = mtl_path.display().to_string();
-        match std::fs::read(&mtl_path) {
+        match folder.read(&mtl_path, InputKind::Material) {
             Ok(bytes) => Ok((display, String::from_utf8_lossy(&bytes).into_owned())),
-            Err(e) => Err(format!("cannot read material library {display}: {e}")),
+            Err(e) => Err(e.to_string()),
         }
     };
-    parse_obj_within(&text, &file, &read_mtl, budget)?.with_camera_from(camera)
+    let read_texture = |path: &Path| {
+        folder
+            .read(path, InputKind::Texture)
+            .map_err(|e| e.to_string())
+    };
+    let scene = parse_obj_reading(&text, &file, &read_mtl, &read_texture, budget);
+    // A library or texture refused for what it is or where it lies ends
+    // the load, though one that is missing is only warned about.
+    if let Some(refused) = folder.refused() {
+        return Err(Diagnostic::new(&file, FILE_START, refused).into());
+    }
+    scene?.with_camera_read(camera, inputs)
 }
 
 /// Turns a `mtllib` name into the library's name for messages and its
@@ -209,7 +234,9 @@ pub type ReadMtl<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
 /// and its libraries from files. `read_mtl` turns a `mtllib` name into
 /// the library's name for messages and its text, or says why it cannot;
 /// `map_Kd` textures are still read from the file system, relative to the
-/// folder of the library's name. The camera frames the model.
+/// folder of the library's name (each through
+/// [`input::read_file`](crate::scene::import::input::read_file), a regular
+/// file within its size limit). The camera frames the model.
 pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene, LoadError> {
     parse_obj_within(text, file, read_mtl, &MemoryBudget::for_machine())
 }
@@ -220,6 +247,26 @@ pub fn parse_obj_within(
     text: &str,
     file: &str,
     read_mtl: &ReadMtl<'_>,
+    budget: &MemoryBudget,
+) -> Result<Scene, LoadError> {
+    let read_texture = |path: &Path| {
+        read_file(path, InputKind::Texture)
+            .map(|(bytes, _)| bytes)
+            .map_err(|e| e.to_string())
+    };
+    parse_obj_reading(text, file, read_mtl, &read_texture, budget)
+}
+
+/// Reads a texture's bytes from its path (the library's folder joined to
+/// its `map_Kd` name), or says why it cannot.
+pub type ReadTexture<'a> = dyn Fn(&Path) -> Result<Vec<u8>, String> + 'a;
+
+/// [`parse_obj_within`], reading `map_Kd` textures through `read_texture`.
+fn parse_obj_reading(
+    text: &str,
+    file: &str,
+    read_mtl: &ReadMtl<'_>,
+    read_texture: &ReadTexture<'_>,
     budget: &MemoryBudget,
 ) -> Result<Scene, LoadError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -250,6 +297,7 @@ pub fn parse_obj_within(
     let mut libraries = reading.libraries;
     let mut warnings = reading_warnings(
         &mut libraries,
+        read_texture,
         reading.unreadable,
         reading.mtllib_backslashes,
         &scan,
@@ -390,6 +438,7 @@ fn read_with_tobj(text: &str, file: &str, scan: &Scan, read_mtl: &ReadMtl<'_>) -
 /// face corners that lost a reference, the `mtllib` paths with `\`.
 fn reading_warnings(
     libraries: &mut [Library],
+    read_texture: &ReadTexture<'_>,
     unreadable: Vec<Warning>,
     backslashes: Tally,
     scan: &Scan,
@@ -398,7 +447,7 @@ fn reading_warnings(
 ) -> Vec<Warning> {
     let mut warnings = Vec::new();
     for lib in libraries {
-        read_textures(lib, budget);
+        read_textures(lib, read_texture, budget);
         warnings.append(&mut lib.warnings);
     }
     warnings.extend(unreadable);

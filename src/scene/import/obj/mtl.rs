@@ -5,6 +5,7 @@
 //! say how a block becomes a [`Material`].
 
 use super::scan::{lines, words};
+use super::ReadTexture;
 use super::{name_list, Tally, DEFAULT_REFLECTANCE, DIFFUSE_SHEEN_LIMIT, MAX_MTL_REFLECTANCE};
 use crate::budget::MemoryBudget;
 use crate::color::Rgb;
@@ -311,8 +312,9 @@ fn warn_about_materials(lib: &mut Library) {
 /// Reads each `map_Kd` texture of `lib` (relative to the library's folder)
 /// and records its average colour; one warning for those that cannot be
 /// read (they keep their `Kd`), one for paths written with `\`. A texture
-/// is decoded within `budget` ([`texture`]).
-pub(super) fn read_textures(lib: &mut Library, budget: &MemoryBudget) {
+/// is read through `read` (the input rules) and decoded within `budget`
+/// ([`texture`]).
+pub(super) fn read_textures(lib: &mut Library, read: &ReadTexture<'_>, budget: &MemoryBudget) {
     let dir = Path::new(&lib.file)
         .parent()
         .map(Path::to_path_buf)
@@ -323,7 +325,7 @@ pub(super) fn read_textures(lib: &mut Library, budget: &MemoryBudget) {
             continue;
         };
         let path = dir.join(name);
-        match texture::average_file(&path, budget) {
+        match read(&path).and_then(|bytes| texture::average_bytes(&bytes, budget)) {
             Ok(rgb) => m.texture = Some(rgb),
             Err(e) => failed.add(*pos, || {
                 format!("{} (material `{}`): {e}", path.display(), m.name)

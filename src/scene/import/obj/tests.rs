@@ -388,19 +388,24 @@ fn load_obj_reads_libraries_next_to_the_file_and_a_sidecar_camera() {
         "camera eye 0.5 0.5 3 lookat 0.5 0.5 0 size 32 24 end\n",
     )
     .unwrap();
-    let s = load_obj(&obj, Some(&cam)).unwrap();
+    let s = load_obj(&obj, Some(&cam), &InputSet::default()).unwrap();
     assert_eq!(s.camera_source, CameraSource::File);
     assert_eq!((s.camera.width, s.camera.height), (32, 24));
     assert_eq!(s.materials[s.polygons[0].material.index()].name, "lamp");
     // The dispatch by extension, and the camera override for .sc too.
     assert_eq!(crate::scene::load(&obj).unwrap().polygons, s.polygons);
     let missing = dir.path().join("none.obj");
-    let e = load_obj(&missing, None).unwrap_err();
+    let e = load_obj(&missing, None, &InputSet::default()).unwrap_err();
     assert!(
         messages(&e)[0].contains("none.obj:1:1: error: cannot read file"),
         "{e}"
     );
-    let e = load_obj(&obj, Some(&dir.path().join("nocam.sc"))).unwrap_err();
+    let e = load_obj(
+        &obj,
+        Some(&dir.path().join("nocam.sc")),
+        &InputSet::default(),
+    )
+    .unwrap_err();
     assert!(
         messages(&e)[0].contains("nocam.sc:1:1: error: cannot read file"),
         "{e}"
@@ -585,7 +590,7 @@ fn map_kd_multiplies_kd_by_the_linear_average_of_the_texture() {
         format!("mtllib lib.mtl\n{SQUARE}usemtl wall\nf 1 2 3 4\n"),
     )
     .unwrap();
-    let s = load_obj(&obj, None).unwrap();
+    let s = load_obj(&obj, None, &InputSet::default()).unwrap();
     let rho = |i: usize| s.materials[i].reflectance();
     assert!((rho(0).g - 0.4).abs() < 1e-6, "{:?}", rho(0));
     let srgb188 = srgb_to_linear(188.0 / 255.0);

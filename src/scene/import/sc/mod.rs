@@ -25,6 +25,7 @@ mod tests;
 
 use crate::camera::Camera;
 use crate::scene::error::{cannot_read, FILE_START};
+use crate::scene::import::input::{InputKind, InputSet};
 use crate::scene::{Diagnostic, LoadError, Scene};
 use lexer::{advance, lex};
 use parser::Parser;
@@ -94,8 +95,15 @@ pub fn parse_camera_str(source: &str, file: &str) -> Result<Camera, LoadError> {
 /// Reads `path` and parses its camera (see [`parse_camera_str`]); the
 /// path as given names the file in diagnostics.
 pub fn load_camera(path: &Path) -> Result<Camera, LoadError> {
+    load_camera_into(path, &InputSet::default())
+}
+
+/// [`load_camera`], recording the file in `inputs`.
+pub fn load_camera_into(path: &Path, inputs: &InputSet) -> Result<Camera, LoadError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
+    let bytes = inputs
+        .read(path, InputKind::Camera)
+        .map_err(|e| cannot_read(&file, &e))?;
     let text = decode(&bytes, &file)?;
     parse_camera_str(text, &file)
 }
@@ -103,9 +111,11 @@ pub fn load_camera(path: &Path) -> Result<Camera, LoadError> {
 /// Reads `path` and parses it; the path as given names the file in
 /// diagnostics. A file that cannot be read is reported at `1:1`, a file
 /// that is not UTF-8 at its first bad byte.
-pub(crate) fn load_file(path: &Path) -> Result<Scene, LoadError> {
+pub(crate) fn load_file(path: &Path, inputs: &InputSet) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| cannot_read(&file, &e))?;
+    let bytes = inputs
+        .read(path, InputKind::Scene)
+        .map_err(|e| cannot_read(&file, &e))?;
     parse_bytes(&bytes, &file)
 }
 

@@ -937,7 +937,7 @@ impl Drop for TempFile {
 #[test]
 fn load_file_reads_and_parses() {
     let f = TempFile::new("ok.sc", format!("\u{feff}{WHITE}{TRIANGLE}").as_bytes());
-    match load_file(&f.0) {
+    match load_file(&f.0, &InputSet::default()) {
         Ok(s) => assert_eq!(s.polygons.len(), 1),
         Err(e) => panic!("{e}"),
     }
@@ -946,7 +946,7 @@ fn load_file_reads_and_parses() {
 #[test]
 fn load_file_reports_the_first_bad_utf8_byte() {
     let f = TempFile::new("bad.sc", b"\xEF\xBB\xBFmaterial m\n  color \xff 1 1\nend\n");
-    match load_file(&f.0) {
+    match load_file(&f.0, &InputSet::default()) {
         Ok(_) => panic!("should fail"),
         Err(e) => {
             let d = &e.diagnostics[0];
@@ -972,7 +972,7 @@ fn load_file_reports_the_first_bad_utf8_byte() {
 #[test]
 fn load_file_reports_unreadable_files() {
     let path = std::env::temp_dir().join("radiosity-sc-test-does-not-exist.sc");
-    match load_file(&path) {
+    match load_file(&path, &InputSet::default()) {
         Ok(_) => panic!("should fail"),
         Err(e) => {
             let d = &e.diagnostics[0];
