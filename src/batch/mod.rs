@@ -254,7 +254,9 @@ pub fn run_prepared(
     let mut seconds = prepared.phase_seconds();
     let view = prepared.view(config)?;
     // Bad points or a work plane outside the scene are said before solving.
-    photometry::check(config, prepared)?;
+    // The points are read once, here: a file given as a pipe has no
+    // second reading.
+    let points = photometry::check(config, prepared)?;
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
@@ -294,6 +296,15 @@ pub fn run_prepared(
     // Resolved once, so the picture and the exported colours agree.
     let exposure = config.exposure.resolve(frame);
     write_results(config, prepared, &output, &solved, &drawn, &view, exposure)?;
+    photometry::write(
+        config,
+        prepared,
+        mesh,
+        &solved.radiosity,
+        drawn.frame(),
+        &view,
+        points.as_deref(),
+    )?;
     let mut stats = run_stats(config, prepared, &session, mesh, dark, exposure, seconds);
     stats.seconds.write = t.elapsed().as_secs_f64();
     if let Some(path) = &config.stats {
@@ -419,7 +430,6 @@ fn write_results(
         )
         .map_err(RunError::Write)?;
     }
-    photometry::write(config, prepared, mesh, &solved.radiosity, frame, view)?;
     Ok(())
 }
 

@@ -16,28 +16,35 @@ use crate::output::{self, illuminance as out};
 use crate::prepare::Prepared;
 use crate::render::falsecolor::{self, Mapping, Quantity};
 use crate::render::{Frame, View};
-use crate::scene::import::points;
+use crate::scene::import::points::{self, MeasurementPoint};
 use crate::scene::Photometric;
 use crate::solver::final_gather::{vertex_irradiance, FinalGather};
 use std::time::Instant;
 
 /// Checks what can be checked before solving: the points file parses and
-/// the work plane lies within the scene.
-pub fn check(config: &RunConfig, prepared: &Prepared) -> Result<(), RunError> {
+/// the work plane lies within the scene. Returns the points of
+/// `--illuminance-at`, read here once (the file may be a pipe), for
+/// [`write`].
+pub fn check(
+    config: &RunConfig,
+    prepared: &Prepared,
+) -> Result<Option<Vec<MeasurementPoint>>, RunError> {
     let p = &config.photometry;
-    if let Some((at, _)) = &p.illuminance {
-        points::load_points(at)?;
-    }
+    let points = match &p.illuminance {
+        Some((at, _)) => Some(points::load_points(at)?),
+        None => None,
+    };
     if let Some(w) = &p.workplane {
         out::workplane_grid(&prepared.scene, w.height, w.spacing, config.units())
             .map_err(|e| RunError::Options(e.to_string()))?;
     }
-    Ok(())
+    Ok(points)
 }
 
 /// Computes and writes every photometric result `config` asks for, from
 /// `radiosity` (per vertex of `mesh`, the solution) and the picture's
-/// linear `frame` seen through `view`. Returns the seconds spent.
+/// linear `frame` seen through `view`; `points` are those [`check`] read
+/// for `--illuminance-at`. Returns the seconds spent.
 pub fn write(
     config: &RunConfig,
     prepared: &Prepared,
@@ -45,6 +52,7 @@ pub fn write(
     radiosity: &[Rgb],
     frame: &Frame,
     view: &View,
+    points: Option<&[MeasurementPoint]>,
 ) -> Result<f64, RunError> {
     let start = Instant::now();
     if !config.wants_photometry() {
@@ -74,16 +82,15 @@ pub fn write(
             near_field,
         )
     };
-    if let Some((at, to)) = &p.illuminance {
-        let points = points::load_points(at)?;
+    if let (Some((_, to)), Some(points)) = (&p.illuminance, points) {
         let t = Instant::now();
-        let values = gather().irradiance_at(&points);
+        let values = gather().irradiance_at(points);
         say(format!(
             "illuminance at {} points: {:.2} s",
             points.len(),
             t.elapsed().as_secs_f64()
         ));
-        out::write_illuminance(to, &points, &values).map_err(RunError::Write)?;
+        out::write_illuminance(to, points, &values).map_err(RunError::Write)?;
     }
     if let Some(w) = &p.workplane {
         let grid = out::workplane_grid(&prepared.scene, w.height, w.spacing, units)

@@ -111,8 +111,8 @@ pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImag
             .map(|(x, y)| (x, y.max(PLOT_FLOOR)))
             .collect();
         let last_step = points.last().map_or(1.0, |p| p.0).max(1.0);
-        let threshold_drawn = (threshold > 0.0 && threshold.is_finite())
-            .then_some(threshold.max(PLOT_FLOOR));
+        let threshold_drawn =
+            (threshold > 0.0 && threshold.is_finite()).then_some(threshold.max(PLOT_FLOOR));
         let lowest = points
             .iter()
             .map(|p| p.1)

@@ -1,0 +1,122 @@
+//! Numbers and names that cross into the program: every emission,
+//! reflectance, candela value, multiplier and index is checked at load with
+//! its position, extreme but legal inputs solve to finite values, and names
+//! from model files are printed escaped.
+
+mod common;
+
+use common::{run_in, stderr, write};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A floor and a lamp above it, in OBJ (Y up), with the lamp's material
+/// `light` and the floor's `wall` taken from `m.mtl`.
+const LAMP_OBJ: &str = "mtllib m.mtl
+v -1 0 -1
+v 1 0 -1
+v 1 0 1
+v -1 0 1
+v -0.3 1 -0.3
+v 0.3 1 -0.3
+v 0.3 1 0.3
+v -0.3 1 0.3
+usemtl wall
+f 4 3 2 1
+usemtl light
+f 5 6 7 8
+";
+
+#[test]
+fn thousands_of_threads_are_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let start = Instant::now();
+    let out = run_in(dir.path(), &["--threads", "10000", "-o", "x.png"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--threads must be from 1 to 1024, got 10000"),
+        "{}",
+        stderr(&out)
+    );
+    // Refused as an option, before any loading or solving.
+    assert!(start.elapsed() < Duration::from_secs(10));
+    assert!(!dir.path().join("x.png").exists());
+}
+
+/// The points file is read once: from a pipe, which can be read only once,
+/// the run writes its illuminance (or, where pipes are refused as inputs,
+/// refuses it before writing anything). It used to read the file again
+/// after the solve, and wait forever for a second writer.
+#[cfg(unix)]
+#[test]
+fn the_points_file_is_read_once() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "f.obj", LAMP_OBJ);
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl light\nKe 1 1 1\nKd 0 0 0\nnewmtl wall\nKd 0.5 0.5 0.5\n",
+    );
+    let fifo = dir.path().join("pts.csv");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let writer = std::thread::spawn(move || {
+        // Blocks until the run opens the pipe; one reading only. A run
+        // that refuses the pipe never opens it: then the test's end opens
+        // it to let this thread go.
+        std::fs::write(&fifo, "x,y,z,nx,ny,nz\n0,0.5,0,0,1,0\n").unwrap();
+    });
+    let mut child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .args([
+            "f.obj",
+            "-q",
+            "--max-steps",
+            "3",
+            "--lenmax",
+            "0.5",
+            "-o",
+            "f.png",
+            "--illuminance-at",
+            "pts.csv",
+            "--illuminance-out",
+            "e.csv",
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > Duration::from_secs(120) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut err = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    if !writer.is_finished() {
+        // Unblock the writer: open the pipe for reading and drop it.
+        let _ = std::fs::read(dir.path().join("pts.csv"));
+    }
+    writer.join().unwrap();
+    let status = status.expect("the run waited for a second reading of the points pipe");
+    if status.success() {
+        let csv = std::fs::read_to_string(dir.path().join("e.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 2, "{csv}");
+    } else {
+        assert_eq!(status.code(), Some(2), "{err}");
+        assert!(!dir.path().join("f.png").exists(), "{err}");
+    }
+}
