@@ -120,3 +120,137 @@ fn the_points_file_is_read_once() {
         assert!(!dir.path().join("f.png").exists(), "{err}");
     }
 }
+
+#[test]
+fn a_library_named_twice_is_read_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = LAMP_OBJ.replace("mtllib m.mtl", "mtllib m.mtl m.mtl\nmtllib m.mtl");
+    write(dir.path(), "f.obj", &obj);
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl light\nKe 1 1 1\nKd 0 0 0\nnewmtl wall\nKd 0.5 0.5 0.5\n",
+    );
+    let out = run_in(
+        dir.path(),
+        &[
+            "f.obj",
+            "--max-steps",
+            "2",
+            "--lenmax",
+            "0.5",
+            "-o",
+            "f.png",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("already defined"),
+        "{}",
+        stderr(&out)
+    );
+    // Two different libraries defining one name are still an error.
+    write(dir.path(), "n.mtl", "newmtl wall\nKd 0.2 0.2 0.2\n");
+    write(
+        dir.path(),
+        "g.obj",
+        &LAMP_OBJ.replace("mtllib m.mtl", "mtllib m.mtl n.mtl"),
+    );
+    let out = run_in(dir.path(), &["g.obj", "--max-steps", "2", "-o", "g.png"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out)
+            .contains("n.mtl:1:1: error: material `wall` is already defined in m.mtl at 4:1"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn mtl_emission_above_the_limit_is_refused_at_its_column() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "f.obj", LAMP_OBJ);
+    for (ke, col) in [
+        ("1e39 1e39 1e39", 4),
+        ("1 1e100 1", 6),
+        ("1e20 1e20 2e20", 14),
+    ] {
+        write(
+            dir.path(),
+            "m.mtl",
+            &format!("newmtl light\nKe {ke}\nKd 0 0 0\nnewmtl wall\nKd 0.5 0.5 0.5\n"),
+        );
+        let out = run_in(dir.path(), &["f.obj", "--max-steps", "2", "-o", "f.pfm"]);
+        assert_eq!(out.status.code(), Some(2), "{ke}: {}", stderr(&out));
+        let expected = format!("m.mtl:2:{col}: error: `Ke` channel");
+        assert!(stderr(&out).contains(&expected), "{ke}: {}", stderr(&out));
+        assert!(stderr(&out).contains("at most 1e20"), "{}", stderr(&out));
+        assert!(!dir.path().join("f.pfm").exists());
+    }
+}
+
+/// The values of a PFM picture (`PF`, little-endian when the scale is
+/// negative), in file order.
+fn pfm_values(bytes: &[u8]) -> Vec<f32> {
+    let mut parts = bytes.splitn(4, |&b| b == b'\n');
+    assert_eq!(parts.next(), Some(&b"PF"[..]));
+    let size = std::str::from_utf8(parts.next().unwrap()).unwrap();
+    let (w, h) = size.split_once(' ').unwrap();
+    let n = w.parse::<usize>().unwrap() * h.parse::<usize>().unwrap() * 3;
+    let scale: f64 = std::str::from_utf8(parts.next().unwrap())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(scale < 0.0, "little-endian");
+    let data = parts.next().unwrap();
+    data[..4 * n]
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+/// Emission at the limit, reflectance at its largest, in OBJ+MTL through
+/// the whole program: every written value is finite.
+#[test]
+fn emission_at_the_limit_writes_finite_pictures() {
+    let dir = tempfile::tempdir().unwrap();
+    for scale in [1e-6f64, 1.0, 1e9] {
+        let obj: String = LAMP_OBJ
+            .lines()
+            .map(|l| match l.strip_prefix("v ") {
+                Some(v) => {
+                    let c: Vec<String> = v
+                        .split(' ')
+                        .map(|x| (x.parse::<f64>().unwrap() * scale).to_string())
+                        .collect();
+                    format!("v {}\n", c.join(" "))
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        write(dir.path(), "f.obj", &obj);
+        write(dir.path(), "m.mtl", "newmtl light\nKe 1e20 1e20 1e20\nKd 0.999 0.999 0.999\nnewmtl wall\nKd 0.999 0.999 0.999\n");
+        let out = run_in(
+            dir.path(),
+            &[
+                "f.obj",
+                "--max-steps",
+                "4",
+                "--lenmax",
+                &(0.5 * scale).to_string(),
+                "-o",
+                "f.pfm",
+            ],
+        );
+        assert!(out.status.success(), "scale {scale}: {}", stderr(&out));
+        let values = pfm_values(&std::fs::read(dir.path().join("f.pfm")).unwrap());
+        assert!(
+            values.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "scale {scale}"
+        );
+        assert!(
+            values.iter().any(|&v| v > 1e19),
+            "scale {scale}: the lamp is seen"
+        );
+    }
+}
