@@ -92,7 +92,7 @@ pub enum UsageError {
     /// `--exposure` is not a positive finite number.
     #[error("--exposure must be a positive number, got {0}")]
     Exposure(f32),
-    /// `--threads 0`, or more than [`MAX_THREADS`].
+    /// `--threads 0`, or more than `MAX_THREADS` (1024).
     #[error(
         "--threads must be from 1 to {MAX_THREADS}, got {0} (this machine has {cores} cores; \
          omit --threads to use them all)",
