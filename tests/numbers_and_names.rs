@@ -254,3 +254,24 @@ fn emission_at_the_limit_writes_finite_pictures() {
         );
     }
 }
+
+/// Names from a model reach the terminal escaped: an object named with
+/// ESC, CR and a quote cannot recolour the terminal, overwrite a line or
+/// break the suggested `--emit` command out of its quotes.
+#[test]
+fn names_are_printed_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = LAMP_OBJ
+        .replace("mtllib m.mtl\n", "mtllib m.mtl\no Lamp\u{1b}[31m'x\r\n")
+        .replace("usemtl light\n", "usemtl light\u{1b}]0;t\u{7}\n");
+    write(dir.path(), "f.obj", &obj);
+    write(dir.path(), "m.mtl", "newmtl wall\nKd 0.5 0.5 0.5\n");
+    let out = run_in(dir.path(), &["f.obj", "--max-steps", "1", "-o", "f.png"]);
+    let err = stderr(&out);
+    assert!(
+        !err.contains('\u{1b}') && !err.contains('\r') && !err.contains('\u{7}'),
+        "{err:?}"
+    );
+    assert!(err.contains(r"Lamp\u{1b}[31m'\''x"), "{err}");
+    assert!(err.contains(r"light\u{1b}]0;t\u{7}"), "{err}");
+}

@@ -82,6 +82,7 @@
 //! `0:0`.
 
 mod glb;
+mod indices;
 
 use super::obj::{average_image, is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
 use crate::camera::{Camera, DEFAULT_SIZE, MAX_PICTURE_SIDE};
@@ -156,6 +157,12 @@ pub fn parse_gltf(bytes: &[u8], file: &str, read_uri: &ReadUri<'_>) -> Result<Sc
             ))
         }
     };
+    if let Some((path, index)) = indices::first_wrapping_index(json_bytes) {
+        return Err(fail(format!(
+            "{path}: index {index} is out of range (glTF indices are at most {})",
+            u32::MAX
+        )));
+    }
     let mut warnings = Vec::new();
     validate(&root, file, &mut warnings)?;
     let document = ::gltf::Document::from_json_without_validation(root);
