@@ -66,8 +66,10 @@ fn exit_code(stop: Stop) -> u8 {
             2
         }
         Stop::Threads(threads, e) => {
-            eprintln!("error: cannot start {threads} threads: {e}");
-            1
+            // Exit 1 means a result could not be written; a pool the
+            // system refuses is a problem of the options given.
+            eprintln!("error: cannot start {threads} threads: {e}; give fewer with --threads");
+            2
         }
         Stop::Run(e) => {
             // Load errors already read `FILE:LINE:COL: error: ...`.

@@ -41,9 +41,11 @@ pub enum CheckpointError {
     },
     /// The checkpoint was written for another scene, mesh or solver options.
     #[error(
-        "checkpoint {} was saved for a different scene, mesh or form-factor options \
-         (give the same scene, --emit, --sky, --lenmax, --inset, --form-factor, --hemicube-res, \
-         --shooter-samples and --no-near-field as the run that saved it)",
+        "checkpoint {} was saved for a different scene, mesh or solver options \
+         (give the same scene, --emit, --ies, --sky, --lenmax, --inset, --form-factor, \
+         --hemicube-res, --shooter-samples, --unshot and the same solver switches \
+         (--no-near-field, --no-shaft-culling, --no-clustering, --no-overshoot, \
+         --exact-receivers, --without, --exact) as the run that saved it)",
         path.display()
     )]
     Mismatch {
@@ -203,6 +205,28 @@ mod tests {
         let e = load(&path, 8).unwrap_err();
         assert!(matches!(e, CheckpointError::Mismatch { .. }), "{e}");
         assert!(e.to_string().contains("different scene"), "{e}");
+        // Every option the fingerprint covers is named, so a user can
+        // tell which one to repeat.
+        for option in [
+            "--emit",
+            "--ies",
+            "--sky",
+            "--lenmax",
+            "--inset",
+            "--form-factor",
+            "--hemicube-res",
+            "--shooter-samples",
+            "--unshot",
+            "--no-near-field",
+            "--no-shaft-culling",
+            "--no-clustering",
+            "--no-overshoot",
+            "--exact-receivers",
+            "--without",
+            "--exact)",
+        ] {
+            assert!(e.to_string().contains(option), "{option} missing: {e}");
+        }
         let e = load(&dir.path().join("missing"), 7).unwrap_err();
         assert!(e.to_string().contains("cannot read checkpoint"), "{e}");
     }

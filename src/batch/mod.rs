@@ -45,6 +45,7 @@ use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, OutputError};
 use crate::prepare::{self, PhaseSeconds, PrepareError, Prepared};
 use crate::render::{self, antialias, Exposure, Frame, Rasterizer, RenderError, View, ViewError};
+use crate::scene::MeasurementPoint;
 use crate::session::{Event, PassStats, Session, SessionOptions};
 use crate::solver::checkpoint::fingerprint;
 use crate::solver::SolverError;
@@ -360,7 +361,9 @@ pub fn run_prepared(
     let mut seconds = prepared.phase_seconds();
     let view = prepared.view(config)?;
     // Bad points or a work plane outside the scene are said before solving.
-    photometry::check(config, prepared)?;
+    // The points are read once, here: a file given as a pipe has no
+    // second reading.
+    let points = photometry::check(config, prepared)?;
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
@@ -412,6 +415,7 @@ pub fn run_prepared(
         drawn: &drawn,
         view: &view,
         exposure,
+        points: points.as_deref(),
     };
     let wrote = output::cancelling_writes(cancel, || {
         results.write(&mut written, cancel)?;
@@ -529,6 +533,8 @@ struct Results<'a, 'p> {
     view: &'a View,
     /// The picture's exposure, which the exported colours share.
     exposure: f32,
+    /// The `--illuminance-at` points, read once before the solve.
+    points: Option<&'a [MeasurementPoint]>,
 }
 
 impl Results<'_, '_> {
@@ -546,6 +552,7 @@ impl Results<'_, '_> {
             drawn,
             view,
             exposure,
+            points,
         } = *self;
         let mesh: &crate::mesh::Mesh = &solved.mesh;
         let frame = drawn.frame();
@@ -602,6 +609,7 @@ impl Results<'_, '_> {
             &solved.radiosity,
             frame,
             view,
+            points,
             written,
             cancel,
         )?;

@@ -17,29 +17,36 @@ use crate::output::{self, illuminance as out};
 use crate::prepare::Prepared;
 use crate::render::falsecolor::{self, Mapping, Quantity};
 use crate::render::{Frame, View};
-use crate::scene::import::points;
+use crate::scene::import::points::{self, MeasurementPoint};
 use crate::scene::Photometric;
 use crate::solver::final_gather::{vertex_irradiance, FinalGather};
 use std::time::Instant;
 
 /// Checks what can be checked before solving: the points file parses and
-/// the work plane lies within the scene.
-pub fn check(config: &RunConfig, prepared: &Prepared) -> Result<(), RunError> {
+/// the work plane lies within the scene. Returns the points of
+/// `--illuminance-at`, read here once (the file may be a pipe), for
+/// [`write()`].
+pub fn check(
+    config: &RunConfig,
+    prepared: &Prepared,
+) -> Result<Option<Vec<MeasurementPoint>>, RunError> {
     let p = &config.photometry;
-    if let Some((at, _)) = &p.illuminance {
-        points::load_points(at)?;
-    }
+    let points = match &p.illuminance {
+        Some((at, _)) => Some(points::load_points(at)?),
+        None => None,
+    };
     if let Some(w) = &p.workplane {
         out::workplane_grid(&prepared.scene, w.height, w.spacing, config.units())
             .map_err(|e| RunError::Options(e.to_string()))?;
     }
-    Ok(())
+    Ok(points)
 }
 
 /// Computes and writes every photometric result `config` asks for, from
 /// `radiosity` (per vertex of `mesh`, the solution) and the picture's
 /// linear `frame` seen through `view`, adding each file to `written` once
-/// complete. Returns the seconds spent. The gathers stop with
+/// complete; `points` are those [`check`] read for `--illuminance-at`.
+/// Returns the seconds spent. The gathers stop with
 /// [`RunError::Interrupted`] soon after `cancel` is set.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write(
@@ -49,6 +56,7 @@ pub(super) fn write(
     radiosity: &[Rgb],
     frame: &Frame,
     view: &View,
+    points: Option<&[MeasurementPoint]>,
     written: &mut Written,
     cancel: &Cancel,
 ) -> Result<f64, RunError> {
@@ -80,16 +88,15 @@ pub(super) fn write(
             near_field,
         )
     };
-    if let Some((at, to)) = &p.illuminance {
-        let points = points::load_points(at)?;
+    if let (Some((_, to)), Some(points)) = (&p.illuminance, points) {
         let t = Instant::now();
-        let values = gather().irradiance_at_cancellable(&points, cancel)?;
+        let values = gather().irradiance_at_cancellable(points, cancel)?;
         say(format!(
             "illuminance at {} points: {:.2} s",
             points.len(),
             t.elapsed().as_secs_f64()
         ));
-        out::write_illuminance(to, &points, &values).map_err(RunError::Write)?;
+        out::write_illuminance(to, points, &values).map_err(RunError::Write)?;
         written.push(to);
     }
     if let Some(w) = &p.workplane {

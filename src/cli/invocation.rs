@@ -23,6 +23,14 @@ use std::time::Duration;
 /// ones mean "never" and would overflow a [`Duration`] for infinite input.
 const MAX_CHECKPOINT_EVERY_SECS: f64 = 1e9;
 
+/// The most worker threads `--threads` may ask for. The solver and
+/// renderer gain nothing past the machine's cores, and a count in the
+/// thousands is a typo that would start that many threads (each with its
+/// stack) before anything useful happens. A fixed number rather than one
+/// derived from the cores, so a command valid on one machine is valid on
+/// every other.
+pub const MAX_THREADS: usize = 1024;
+
 /// How the run is driven, decided once from the options.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -85,9 +93,13 @@ pub enum UsageError {
     /// `--exposure` is not a positive finite number.
     #[error("--exposure must be a positive number, got {0}")]
     Exposure(f32),
-    /// `--threads 0`.
-    #[error("--threads must be at least 1")]
-    Threads,
+    /// `--threads 0`, or more than `MAX_THREADS` (1024).
+    #[error(
+        "--threads must be from 1 to {MAX_THREADS}, got {0} (this machine has {cores} cores; \
+         omit --threads to use them all)",
+        cores = std::thread::available_parallelism().map_or(1, |n| n.get())
+    )]
+    Threads(usize),
     /// `--falsecolor-max` is not a positive finite number.
     #[error("--falsecolor-max must be a positive number, got {0}")]
     FalsecolorMax(f64),
@@ -202,7 +214,8 @@ impl TryFrom<Args> for Invocation {
         };
         let threads = match args.threads {
             None => None,
-            Some(n) => Some(NonZeroUsize::new(n).ok_or(UsageError::Threads)?),
+            Some(n) if n > MAX_THREADS => return Err(UsageError::Threads(n)),
+            Some(n) => Some(NonZeroUsize::new(n).ok_or(UsageError::Threads(n))?),
         };
         if let Some(max) = args.falsecolor_max {
             if !(max.is_finite() && max > 0.0) {

@@ -34,6 +34,14 @@ pub const PLOT_SIZE: (u32, u32) = (900, 560);
 /// The CSV header line (without the line break).
 pub const LOG_HEADER: &str = "step,shooter,shooter_line,shot_power,unshot_fraction,rays,seconds";
 
+/// The lowest value the plot's log axis reaches: an unshot fraction or a
+/// threshold below it (a `--threshold 1e-307`, a subnormal fraction) is
+/// drawn on the axis' floor. Thirty decades hold any solve an `f64` sum can
+/// tell apart from zero (its unshot fractions stop near `1e-16`), while a
+/// log axis spanning subnormal numbers would need hundreds of decades and
+/// its tick arithmetic loses precision there.
+pub const PLOT_FLOOR: f64 = 1e-30;
+
 /// The font family the plot's text is drawn with (the bundled font).
 const FONT: &str = crate::render::text::FONT_FAMILY;
 
@@ -100,15 +108,19 @@ pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImag
         let points: Vec<(f64, f64)> = std::iter::once((0.0, 1.0))
             .chain(steps.iter().map(|s| (s.step as f64, s.unshot_fraction)))
             .filter(|&(_, y)| y > 0.0 && y.is_finite())
+            .map(|(x, y)| (x, y.max(PLOT_FLOOR)))
             .collect();
         let last_step = points.last().map_or(1.0, |p| p.0).max(1.0);
+        let threshold_drawn =
+            (threshold > 0.0 && threshold.is_finite()).then_some(threshold.max(PLOT_FLOOR));
         let lowest = points
             .iter()
             .map(|p| p.1)
-            .chain((threshold > 0.0).then_some(threshold))
+            .chain(threshold_drawn)
             .fold(1.0, f64::min);
-        // A decade of room below the lowest value, and some above 1.
-        let y_range = (lowest / 10.0)..2.0;
+        // A decade of room below the lowest value (down to the floor), and
+        // some above 1.
+        let y_range = (lowest / 10.0).max(PLOT_FLOOR)..2.0;
         let mut chart = ChartBuilder::on(&root)
             .caption(format!("convergence of {title}"), (FONT, 22).into_font())
             .margin(16)
@@ -131,10 +143,10 @@ pub fn plot(steps: &[StepRecord], threshold: f64, title: &str) -> Result<RgbImag
             .map_err(|e| e.to_string())?
             .label("unshot fraction")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
-        if threshold > 0.0 {
+        if let Some(drawn) = threshold_drawn {
             chart
                 .draw_series(LineSeries::new(
-                    vec![(0.0, threshold), (last_step, threshold)],
+                    vec![(0.0, drawn), (last_step, drawn)],
                     RED.stroke_width(1),
                 ))
                 .map_err(|e| e.to_string())?
@@ -226,6 +238,29 @@ mod tests {
         assert!(caption_ink > 100, "caption pixels: {caption_ink}");
         // No steps at all (nothing emits): still a plot.
         assert!(plot(&[], 1e-3, "dark").is_ok());
+    }
+
+    #[test]
+    fn plot_of_tiny_subnormal_and_zero_values_finishes() {
+        // A subnormal threshold once made the log axis loop forever: draw
+        // on another thread and give it far more time than a plot takes.
+        let mut s = steps(4);
+        s[1].unshot_fraction = 1e-200;
+        s[2].unshot_fraction = 5e-324;
+        s[3].unshot_fraction = 0.0;
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for threshold in [1e-307, 5e-324, f64::MIN_POSITIVE, 0.0, 1e-40] {
+                tx.send(plot(&s, threshold, "tiny").map(|i| i.dimensions()))
+                    .unwrap();
+            }
+        });
+        for _ in 0..5 {
+            let drawn = rx
+                .recv_timeout(std::time::Duration::from_secs(60))
+                .expect("the plot did not finish");
+            assert_eq!(drawn, Ok(PLOT_SIZE));
+        }
     }
 
     #[test]

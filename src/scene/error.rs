@@ -58,6 +58,28 @@ pub(crate) fn reflectance_too_high(what: &str, rho: Rgb) -> String {
     )
 }
 
+/// `text` as printed on a terminal: every control character (ESC, CR,
+/// LF, tab, DEL, the C1 range...) written as its Rust escape (`\u{1b}`,
+/// `\r`, `\n`), so a name read from a model can never move the cursor,
+/// recolour the terminal or start a line that looks like another message.
+/// Everything else, non-ASCII letters included, is kept. Used for every
+/// name and message a loader prints ([`Diagnostic`], [`Warning`], the
+/// `--emit` suggestions).
+pub fn escape_controls(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
 /// One problem found while loading, with its position.
 ///
 /// A text format (`.sc`, `.obj`, `.mtl`, a `.gltf` file's JSON syntax)
@@ -110,14 +132,11 @@ impl Diagnostic {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (file, message) = (escape_controls(&self.file), escape_controls(&self.message));
         if self.line == 0 {
-            return write!(f, "{}: error: {}", self.file, self.message);
+            return write!(f, "{file}: error: {message}");
         }
-        write!(
-            f,
-            "{}:{}:{}: error: {}",
-            self.file, self.line, self.col, self.message
-        )
+        write!(f, "{file}:{}:{}: error: {message}", self.line, self.col)
     }
 }
 
@@ -160,13 +179,10 @@ impl Warning {
 
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (file, message) = (escape_controls(&self.file), escape_controls(&self.message));
         match self.pos {
-            Some(pos) => write!(
-                f,
-                "{}:{}:{}: warning: {}",
-                self.file, pos.line, pos.col, self.message
-            ),
-            None => write!(f, "{}: warning: {}", self.file, self.message),
+            Some(pos) => write!(f, "{file}:{}:{}: warning: {message}", pos.line, pos.col),
+            None => write!(f, "{file}: warning: {message}"),
         }
     }
 }
@@ -307,6 +323,16 @@ mod warning_tests {
     fn warnings_read_as_one_line_with_their_place() {
         let at = Warning::at("room.obj", SourcePos { line: 12, col: 3 }, "`Kd` 1 clamped");
         assert_eq!(at.to_string(), "room.obj:12:3: warning: `Kd` 1 clamped");
+        // Control characters of a name are shown escaped, never sent
+        // to the terminal.
+        let hostile = Warning::file("r\u{1b}[2J.obj", "material `a\r\nb\u{7f}` x");
+        assert_eq!(
+            hostile.to_string(),
+            "r\\u{1b}[2J.obj: warning: material `a\\r\\nb\\u{7f}` x"
+        );
+        let d = Diagnostic::new("m.mtl", SourcePos { line: 2, col: 1 }, "`\u{9b}31m`");
+        assert_eq!(d.to_string(), "m.mtl:2:1: error: `\\u{9b}31m`");
+        assert_eq!(escape_controls("é plain"), "é plain");
         let whole = Warning::file("room.obj", "nothing emits light");
         assert_eq!(whole.to_string(), "room.obj: warning: nothing emits light");
     }

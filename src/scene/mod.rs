@@ -21,7 +21,7 @@ mod lighting;
 mod polygon;
 pub mod repair;
 
-pub use error::{Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
+pub use error::{escape_controls, Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
 pub use framing::{
     frame_camera, EYE_ACROSS_FRACTIONS, EYE_ALONG_FRACTIONS, EYE_CLEARANCE_FRACTION,
     EYE_HEIGHT_FRACTIONS, FRAMING_RAYS, RAY_EDGE_TOLERANCE, RAY_PARALLEL_COSINE, ROOM_FOV_DEG,

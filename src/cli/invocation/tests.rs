@@ -270,8 +270,15 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
         ),
         (
             &["--threads", "0"],
-            UsageError::Threads,
-            "--threads must be at least 1",
+            UsageError::Threads(0),
+            "--threads must be from 1 to 1024, got 0",
+        ),
+        (
+            // Thousands of threads is a typo, not a request: refused
+            // before any is started.
+            &["--threads", "10000"],
+            UsageError::Threads(10000),
+            "--threads must be from 1 to 1024, got 10000",
         ),
     ];
     for (args, error, message) in cases {

@@ -82,6 +82,7 @@
 //! `0:0`.
 
 mod glb;
+mod indices;
 
 use super::obj::{is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
 use super::texture;
@@ -205,6 +206,12 @@ pub fn parse_gltf_within(
             ))
         }
     };
+    if let Some((path, index)) = indices::first_wrapping_index(json_bytes) {
+        return Err(fail(format!(
+            "{path}: index {index} is out of range (glTF indices are at most {})",
+            u32::MAX
+        )));
+    }
     let mut warnings = Vec::new();
     validate(&root, file, &mut warnings)?;
     let document = ::gltf::Document::from_json_without_validation(root);

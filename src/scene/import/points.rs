@@ -2,12 +2,21 @@
 //!
 //! A CSV file, one point a line: `x,y,z,nx,ny,nz`, the position in scene
 //! units and the normal of the surface the light falls on (normalised
-//! here; any length but zero). A first line that is not numbers is a
-//! header and skipped; blank lines and lines starting with `#` are
-//! skipped too. Blanks around values are allowed.
+//! here; any finite length but zero, however large or small). Coordinates
+//! are at most [`MAX_COORDINATE`] in magnitude, as the scene's are.
+//!
+//! The first line that is not blank or a comment is a header, and skipped,
+//! when every field of it is a word (it starts with a letter or `_`, as
+//! `x,y,z,nx,ny,nz` does); a line with any number or empty field in it is
+//! data, so a typo in the first point (`1,2,x,0,1,0`) is an error at its
+//! column rather than a header silently dropped. Blank lines and lines
+//! starting with `#` are skipped, and so is a UTF-8 byte order mark.
+//! Blanks around values are allowed.
 
 use super::input::{read_file, InputError, InputKind};
-use glam::Vec3;
+use crate::scene::error::fmt_num;
+use crate::scene::MAX_COORDINATE;
+use glam::{DVec3, Vec3};
 use std::path::Path;
 
 /// Why a points file could not be read: `FILE:LINE:COLUMN: error: ...`.
@@ -50,6 +59,7 @@ pub fn load_points(path: &Path) -> Result<Vec<MeasurementPoint>, PointsError> {
 
 /// Parses the text of a points file named `file` in messages.
 pub fn parse_points(text: &str, file: &str) -> Result<Vec<MeasurementPoint>, PointsError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut points = Vec::new();
     let mut seen_data = false;
     for (k, line) in text.lines().enumerate() {
@@ -71,9 +81,7 @@ pub fn parse_points(text: &str, file: &str) -> Result<Vec<MeasurementPoint>, Poi
             fields.push((field.trim(), column));
             start += field.len() + 1;
         }
-        let is_header = !seen_data
-            && points.is_empty()
-            && fields.iter().any(|(f, _)| f.parse::<f32>().is_err());
+        let is_header = !seen_data && fields.iter().all(|(f, _)| is_word(f));
         if is_header {
             seen_data = true;
             continue;
@@ -88,9 +96,23 @@ pub fn parse_points(text: &str, file: &str) -> Result<Vec<MeasurementPoint>, Poi
                 ),
             ));
         }
-        let mut v = [0.0f32; 6];
-        for (slot, (field, column)) in v.iter_mut().zip(&fields) {
-            match field.parse::<f32>() {
+        let mut v = [0.0f64; 6];
+        for (k, (slot, (field, column))) in v.iter_mut().zip(&fields).enumerate() {
+            match field.parse::<f64>() {
+                _ if field.is_empty() => {
+                    return Err(err(*column, "expected a number, the field is empty".into()))
+                }
+                Ok(x) if k < 3 && x.is_finite() && x.abs() > MAX_COORDINATE => {
+                    return Err(err(
+                        *column,
+                        format!(
+                            "coordinate `{field}` is too far from the origin; coordinates must \
+                             be at most {} in magnitude",
+                            fmt_num(MAX_COORDINATE)
+                        ),
+                    ))
+                }
+                // A normal is only a direction: any finite f64 will do.
                 Ok(x) if x.is_finite() => *slot = x,
                 _ => {
                     return Err(err(
@@ -100,15 +122,14 @@ pub fn parse_points(text: &str, file: &str) -> Result<Vec<MeasurementPoint>, Poi
                 }
             }
         }
-        let normal = Vec3::new(v[3], v[4], v[5]);
-        let unit = normal.normalize_or_zero();
-        if unit == Vec3::ZERO || !unit.is_finite() {
+        let Some(unit) = unit_normal(DVec3::new(v[3], v[4], v[5])) else {
             return Err(err(
                 fields[3].1,
                 "the normal nx,ny,nz must not be zero".into(),
             ));
-        }
-        points.push((Vec3::new(v[0], v[1], v[2]), unit));
+        };
+        let position = DVec3::new(v[0], v[1], v[2]).as_vec3();
+        points.push((position, unit));
     }
     if points.is_empty() {
         return Err(PointsError {
@@ -119,6 +140,31 @@ pub fn parse_points(text: &str, file: &str) -> Result<Vec<MeasurementPoint>, Poi
         });
     }
     Ok(points)
+}
+
+/// True for a header field: a word starting with a letter or `_` (never
+/// a number, which may start with a digit, a sign or a point, nor empty).
+fn is_word(field: &str) -> bool {
+    field
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_')
+        && !matches!(
+            field.to_ascii_lowercase().as_str(),
+            "inf" | "infinity" | "nan"
+        )
+}
+
+/// `n` as an `f32` unit vector, or `None` when it is zero. The components
+/// are divided by the largest magnitude first, so the length neither
+/// overflows (`1e300`) nor underflows (`1e-300`) when squared.
+fn unit_normal(n: DVec3) -> Option<Vec3> {
+    let largest = n.abs().max_element();
+    if largest == 0.0 || !largest.is_finite() {
+        return None;
+    }
+    let unit = (n / largest).normalize();
+    unit.is_finite().then(|| unit.as_vec3())
 }
 
 #[cfg(test)]
@@ -160,5 +206,52 @@ mod tests {
         // A header only on the first line.
         let e = parse_points("1,2,3,0,0,1\nx,y,z,a,b,c\n", "p.csv").unwrap_err();
         assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn a_header_is_words_only_and_a_typo_in_the_first_point_is_an_error() {
+        // A byte order mark before the header (Excel writes one).
+        let p = parse_points("\u{feff}x,y,z,nx,ny,nz\n1,2,3,0,1,0\n", "p.csv").unwrap();
+        assert_eq!(p, vec![(Vec3::new(1.0, 2.0, 3.0), Vec3::Y)]);
+        // ... and before data.
+        let p = parse_points("\u{feff}1,2,3,0,1,0\n", "p.csv").unwrap();
+        assert_eq!(p.len(), 1);
+        // A typo on the first line is not a header.
+        let e = parse_points("1,2,x,0,1,0\n4,5,6,0,1,0\n", "p.csv").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 5), "{e}");
+        assert!(e.message.contains("`x`"), "{e}");
+        // Nor is a first line with an empty field, or `inf`.
+        let e = parse_points("1,,3,0,1,0\n", "p.csv").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 3), "{e}");
+        assert!(e.message.contains("empty"), "{e}");
+        let e = parse_points("inf,2,3,0,1,0\n", "p.csv").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 1), "{e}");
+        // An empty field after the first line too.
+        let e = parse_points("1,2,3,0,1,0\n1,2,3,0,, 1\n", "p.csv").unwrap_err();
+        assert_eq!((e.line, e.column), (2, 9), "{e}");
+    }
+
+    #[test]
+    fn normals_of_any_finite_nonzero_length_are_normalised() {
+        let p = parse_points(
+            "0,0,0,0,1e30,0\n0,0,0,0,0,1e-30\n0,0,0,3e300,4e300,0\n0,0,0,1e-320,0,0\n",
+            "p.csv",
+        )
+        .unwrap();
+        let normals: Vec<Vec3> = p.iter().map(|q| q.1).collect();
+        assert_eq!(normals[0], Vec3::Y);
+        assert_eq!(normals[1], Vec3::Z);
+        assert!((normals[2] - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-6);
+        assert_eq!(normals[3], Vec3::X);
+        let e = parse_points("0,0,0,0,0,1e400\n", "p.csv").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 11), "{e}");
+    }
+
+    #[test]
+    fn coordinates_beyond_the_scene_limit_are_refused() {
+        assert!(parse_points("1e12,0,0,0,1,0\n", "p.csv").is_ok());
+        let e = parse_points("0,-1e13,0,0,1,0\n", "p.csv").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 3), "{e}");
+        assert!(e.message.contains("at most 1e12"), "{e}");
     }
 }

@@ -13,7 +13,7 @@
 //! importers that have no such names (`.sc`) leave the list empty.
 
 use crate::color::Rgb;
-use crate::scene::error::Warning;
+use crate::scene::error::{escape_controls, Warning};
 use crate::scene::{Material, MaterialId, PolygonId, Scene};
 use std::collections::HashMap;
 use std::fmt;
@@ -114,7 +114,8 @@ impl fmt::Display for UnknownName {
             (_, false) if self.groups.is_empty() => "material, object or mesh",
             (_, false) => "material, object, mesh or group",
         };
-        write!(f, "no {kinds} is named `{}`; the scene has ", self.name)?;
+        let name = escape_controls(&self.name);
+        write!(f, "no {kinds} is named `{name}`; the scene has ")?;
         let lists = [
             ("material", "materials", &self.materials),
             ("object", "objects", &self.objects),
@@ -143,7 +144,7 @@ fn list_names<'a>(names: impl ExactSizeIterator<Item = &'a str>) -> String {
     let total = names.len();
     let mut out: Vec<String> = names
         .take(MAX_LISTED_NAMES)
-        .map(|n| format!("`{n}`"))
+        .map(|n| format!("`{}`", escape_controls(n)))
         .collect();
     if total > MAX_LISTED_NAMES {
         out.push(format!("and {} more", total - MAX_LISTED_NAMES));
@@ -374,7 +375,7 @@ impl Scene {
                 }
                 format!(
                     "{} {}: make {} emit with --emit NAME=VALUE \
-                     (radiosity in the scene's units, V or R,G,B), for instance --emit '{name}=10'",
+                     (radiosity in the scene's units, V or R,G,B), for instance --emit '{}=10'",
                     named.join(", "),
                     if hints.len() == 1 {
                         "looks like a lamp"
@@ -382,6 +383,9 @@ impl Scene {
                         "look like lamps"
                     },
                     if hints.len() == 1 { "it" } else { "them" },
+                    // Inside single quotes for a POSIX shell: a quote in
+                    // the name ends them, is written escaped, and reopens.
+                    name.replace('\'', r"'\''"),
                 )
             }
             None => {

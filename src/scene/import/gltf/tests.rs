@@ -101,3 +101,23 @@ fn uris_are_data_or_relative_paths() {
         "a `data:` URI that is not base64"
     );
 }
+
+#[test]
+fn indices_beyond_u32_are_refused_not_wrapped() {
+    let no_uri = |_: &str| -> Result<Vec<u8>, String> { Err("no files".into()) };
+    for (json, path) in [
+        (
+            r#"{"asset":{"version":"2.0"},"scene":4294967296,"scenes":[{"nodes":[]}]}"#,
+            "scene",
+        ),
+        (
+            r#"{"asset":{"version":"2.0"},"materials":[{},{}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":4294967297}]}]}"#,
+            "meshes[0].primitives[0].material",
+        ),
+    ] {
+        let e = parse_gltf(json.as_bytes(), "w.gltf", &no_uri).unwrap_err();
+        let expected = format!("w.gltf: error: {path}: index ");
+        assert!(e.to_string().contains(&expected), "{e}");
+        assert!(e.to_string().contains("out of range"), "{e}");
+    }
+}

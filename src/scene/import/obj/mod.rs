@@ -361,6 +361,7 @@ fn read_with_tobj(text: &str, file: &str, scan: &Scan, read_mtl: &ReadMtl<'_>) -
     let mtl_diags: RefCell<Vec<Diagnostic>> = RefCell::new(Vec::new());
     let obj_warnings: RefCell<Vec<Warning>> = RefCell::new(Vec::new());
     let mtllib_backslashes = RefCell::new(Tally::default());
+    let read_once: RefCell<std::collections::HashSet<String>> = RefCell::default();
     let mut reader = CountingReader {
         bytes: text.as_bytes(),
         pos: consumed.clone(),
@@ -398,6 +399,10 @@ fn read_with_tobj(text: &str, file: &str, scan: &Scan, read_mtl: &ReadMtl<'_>) -
         let mut map = HashMap::new();
         for read in reads {
             let (mtl_file, mtl_text) = match read {
+                // A library named again (`mtllib m.mtl m.mtl`, or on a
+                // later line) is read once: its materials are not
+                // redefinitions of themselves.
+                Ok((mtl_file, _)) if !read_once.borrow_mut().insert(mtl_file.clone()) => continue,
                 Ok(x) => x,
                 Err(message) => {
                     obj_warnings.borrow_mut().push(Warning::at(

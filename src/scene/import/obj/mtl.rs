@@ -10,6 +10,7 @@ use super::{name_list, Tally, DEFAULT_REFLECTANCE, DIFFUSE_SHEEN_LIMIT, MAX_MTL_
 use crate::budget::MemoryBudget;
 use crate::color::Rgb;
 use crate::scene::error::{fmt_num, negative_channel};
+use crate::scene::import::sc::MAX_EMISSION;
 use crate::scene::import::texture;
 use crate::scene::{Diagnostic, Material, SourcePos, Warning};
 use std::path::Path;
@@ -253,6 +254,23 @@ fn set_color(
     let at = |col: u32| SourcePos { line: number_, col };
     match color(w) {
         Err((c, message)) => diags.push(Diagnostic::new(file, at(c), message)),
+        Ok(rgb) if keyword == "Ke" && rgb.max_channel() > MAX_EMISSION => {
+            // The `.sc` format's limit: emission × area summed over the
+            // scene stays finite, and so do the pictures' f32 values.
+            let (word, c) = w[1..]
+                .iter()
+                .copied()
+                .find(|(x, _)| x.parse::<f64>().is_ok_and(|x| x > MAX_EMISSION))
+                .unwrap_or(w[0]);
+            diags.push(Diagnostic::new(
+                file,
+                at(c),
+                format!(
+                    "`Ke` channel {word} is too large; emission must be at most {} per channel",
+                    fmt_num(MAX_EMISSION)
+                ),
+            ));
+        }
         Ok(rgb) if keyword == "Ke" => m.ke = rgb,
         Ok(rgb) if rgb.max_channel() >= 1.0 => {
             // Same hue, brightest channel at the cap.
