@@ -25,7 +25,7 @@ use std::time::Instant;
 /// Checks what can be checked before solving: the points file parses and
 /// the work plane lies within the scene. Returns the points of
 /// `--illuminance-at`, read here once (the file may be a pipe), for
-/// [`write()`].
+/// the photometric results written after the solve.
 pub fn check(
     config: &RunConfig,
     prepared: &Prepared,

@@ -47,6 +47,12 @@ pub const MAX_ANGLES: usize = 10_000;
 /// The most candela values a file may list (vertical × horizontal).
 pub const MAX_VALUES: usize = 1_000_000;
 
+/// The largest intensity a file may give, candela, after the multiplier
+/// and ballast factor: a million times the brightest searchlight (about
+/// 1e9 cd), so no real file comes near it, while the flux and the
+/// luminaire's exitance computed from it stay far from overflow.
+pub const MAX_CANDELA: f64 = 1e15;
+
 /// How far (degrees) the first and last angles may be from the values the
 /// format allows (0, 90, 180, 360), for files written with rounding.
 pub const ANGLE_TOLERANCE_DEG: f64 = 1e-3;
@@ -584,7 +590,19 @@ fn read_candela(
                 format!("candela values must be >= 0, got {}", c.0),
             ));
         }
-        candela.push(c.0 * multiplier.0 * ballast.0);
+        let intensity = c.0 * multiplier.0 * ballast.0;
+        if !intensity.is_finite() || intensity > MAX_CANDELA {
+            return Err(err(
+                c.1,
+                c.2,
+                format!(
+                    "candela value {} times the multiplier and ballast factor is {intensity:e} cd, \
+                     above the largest allowed, {MAX_CANDELA:e} cd",
+                    c.0
+                ),
+            ));
+        }
+        candela.push(intensity);
     }
     if let Some((text, line, column)) = numbers.tokens.next() {
         return Err(err(
@@ -594,13 +612,6 @@ fn read_candela(
                 "unexpected `{text}` after the {} candela values the header announces",
                 nv * nh
             ),
-        ));
-    }
-    if candela.iter().any(|c| !c.is_finite()) {
-        return Err(err(
-            tilt + 2,
-            1,
-            "the candela values times the multiplier overflow".into(),
         ));
     }
     Ok(candela)
@@ -690,6 +701,31 @@ mod tests {
         // π I0 lumens for a cosine distribution (within the interpolation).
         let flux = p.flux(PI / 2.0);
         assert!((flux / (PI * 1000.0) - 1.0).abs() < 0.01, "{flux}");
+    }
+
+    /// Finite but absurd intensities (1e300 cd, or a multiplier that makes
+    /// them so) are refused where they stand: they made non-finite pixels.
+    #[test]
+    fn intensities_above_the_limit_are_refused_at_their_value() {
+        for (text, line, column) in [
+            (
+                "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n1e300 0\n",
+                6,
+                1,
+            ),
+            (
+                "TILT=NONE\n1 -1 1e10 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 1e6\n",
+                6,
+                4,
+            ),
+        ] {
+            let e = Photometry::parse(text, "hot.ies").unwrap_err();
+            assert_eq!((e.line, e.column), (line, column), "{e}");
+            assert!(e.message.contains("above the largest allowed"), "{e}");
+        }
+        let at_limit =
+            format!("TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n{MAX_CANDELA:e} 0\n");
+        assert!(Photometry::parse(&at_limit, "ok.ies").is_ok());
     }
 
     #[test]

@@ -60,6 +60,24 @@ pub enum LuminaireError {
     /// The distribution sends no light below the horizontal.
     #[error("the distribution sends no light downwards (θ ≤ 90°), so `{0}` would emit nothing")]
     Dark(String),
+    /// The flux spread over one of the polygons would be an exitance above
+    /// [`MAX_EMISSION`](crate::scene::MAX_EMISSION) (a tiny polygon, or a
+    /// scene in the wrong units).
+    #[error(
+        "`{name}`: {flux:e} lm over {area:e} m² is an exitance of {exitance:e} lm/m², above the \
+         largest allowed emission, {max:e} (is the polygon tiny, or --units wrong?)",
+        max = crate::scene::MAX_EMISSION
+    )]
+    TooBright {
+        /// The name given to `--ies`.
+        name: String,
+        /// The luminaire's flux below its plane, lumens.
+        flux: f64,
+        /// The polygon's area, square metres.
+        area: f64,
+        /// Their quotient, lumens per square metre.
+        exitance: f64,
+    },
 }
 
 impl Scene {
@@ -81,7 +99,16 @@ impl Scene {
         }
         for (k, id) in members.iter().enumerate() {
             let polygon = &self.polygons[id.index()];
-            let exitance = flux / units.square_metres(polygon.area);
+            let area = units.square_metres(polygon.area);
+            let exitance = flux / area;
+            if !exitance.is_finite() || exitance > crate::scene::MAX_EMISSION {
+                return Err(LuminaireError::TooBright {
+                    name: name.to_string(),
+                    flux,
+                    area,
+                    exitance,
+                });
+            }
             let c0 = (polygon.vertices[1] - polygon.vertices[0]).normalize_or_zero();
             self.materials.push(Material {
                 name: format!("{name} (luminaire {})", k + 1),
@@ -241,6 +268,33 @@ mod tests {
     fn cosine() -> Arc<Photometry> {
         let text = "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n";
         Arc::new(Photometry::parse(text, "c.ies").unwrap())
+    }
+
+    /// The brightest intensity a file may hold, over a square millimetre,
+    /// is an exitance above the emission limit: refused, not solved into
+    /// non-finite values.
+    #[test]
+    fn a_luminaire_brighter_than_the_emission_limit_is_refused() {
+        let polygons = testutil::closed_box(1.0, [0, 1, 1, 1, 1, 1]);
+        let materials = || {
+            vec![
+                testutil::grey("lamp", 1.0, 0.5),
+                testutil::grey("w", 0.0, 0.5),
+            ]
+        };
+        let text = format!(
+            "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n{:e} 0\n",
+            crate::scene::import::ies::MAX_CANDELA
+        );
+        let hot = Arc::new(Photometry::parse(&text, "hot.ies").unwrap());
+        let mut scene = testutil::scene(polygons.clone(), materials());
+        let e = scene
+            .set_luminaire("lamp", hot.clone(), Units::Mm)
+            .unwrap_err();
+        assert!(matches!(e, LuminaireError::TooBright { .. }), "{e}");
+        // The same over a square metre is allowed.
+        let mut scene = testutil::scene(polygons, materials());
+        assert_eq!(scene.set_luminaire("lamp", hot, Units::M).unwrap(), 1);
     }
 
     #[test]

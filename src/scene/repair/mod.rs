@@ -35,7 +35,7 @@ pub struct RepairOptions<'a> {
     pub file: &'a str,
     /// The memory the repaired scene may take: the splitting along
     /// intersections stops when its pieces would need more
-    /// ([`Scene::split_intersections_within`]).
+    /// ([`Scene::split_intersections_in`]).
     pub budget: MemoryBudget,
 }
 
