@@ -154,7 +154,7 @@ impl Photometry {
             ..
         } = header;
         let (vertical, horizontal, symmetry) = read_angles(&mut numbers, nv, nh)?;
-        let candela = read_candela(&mut numbers, &header, tilt)?;
+        let candela = read_candela(&mut numbers, &header)?;
         Ok(Photometry {
             vertical: vertical
                 .iter()
@@ -563,14 +563,9 @@ fn read_angles(
     Ok((vertical, horizontal, symmetry))
 }
 
-/// Reads the candela values (times the multiplier and the ballast factor)
-/// and checks that nothing follows them; `tilt` is the index of the TILT
-/// line.
-fn read_candela(
-    numbers: &mut Numbers<'_>,
-    header: &Header,
-    tilt: usize,
-) -> Result<Vec<f64>, IesError> {
+/// Reads the candela values (times the multiplier and the ballast factor,
+/// each at most [`MAX_CANDELA`]) and checks that nothing follows them.
+fn read_candela(numbers: &mut Numbers<'_>, header: &Header) -> Result<Vec<f64>, IesError> {
     let file = numbers.file;
     let Header {
         nv,
