@@ -58,7 +58,7 @@ pub(crate) fn cell_weights(
             let (lo, hi) = bounds(&p);
             stamp = stamp.wrapping_add(1);
             candidates.clear();
-            grid.visit(lo, hi, |k| {
+            grid.visit_triangle(&p, |k| {
                 if seen[k] != stamp {
                     seen[k] = stamp;
                     candidates.push(k);
@@ -231,11 +231,52 @@ impl Buckets {
         (clamp(at.x), clamp(at.y))
     }
 
-    /// Calls `f` with every cell of the buckets the box `lo..hi` meets
-    /// (a cell may come more than once).
-    fn visit(&self, lo: DVec2, hi: DVec2, mut f: impl FnMut(usize)) {
-        let ((x0, y0), (x1, y1)) = (self.index(lo), self.index(hi));
+    /// Calls `f` with every cell of the buckets the triangle `t` meets (a
+    /// cell may come more than once): per row of buckets, those between
+    /// the triangle's least and greatest `x` within the row. A long thin
+    /// triangle across the grid (the fan of a polygon of many vertices)
+    /// meets a row or two of buckets, where its bounding box would meet
+    /// most of the grid.
+    fn visit_triangle(&self, t: &[DVec2; 3], mut f: impl FnMut(usize)) {
+        let (lo, hi) = bounds(t);
+        // Far above rounding, so a bucket the triangle touches is visited.
+        let pad = 1e-9 * (self.size.x + self.size.y) * self.n as f64;
+        let (y0, y1) = (self.index(lo).1, self.index(hi).1);
         for y in y0..=y1 {
+            // The row's band; the first and last rows hold everything
+            // beyond the grid, as `index` clamps it there.
+            let band_lo = if y == 0 {
+                f64::NEG_INFINITY
+            } else {
+                self.lo.y + y as f64 * self.size.y - pad
+            };
+            let band_hi = if y + 1 == self.n {
+                f64::INFINITY
+            } else {
+                self.lo.y + (y + 1) as f64 * self.size.y + pad
+            };
+            let (mut xmin, mut xmax) = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut take = |x: f64| {
+                xmin = xmin.min(x);
+                xmax = xmax.max(x);
+            };
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                if (band_lo..=band_hi).contains(&a.y) {
+                    take(a.x);
+                }
+                // Where the edge crosses the band's two lines.
+                for line in [band_lo, band_hi] {
+                    if line.is_finite() && (a.y - line) * (b.y - line) < 0.0 {
+                        take(a.x + (b.x - a.x) * ((line - a.y) / (b.y - a.y)));
+                    }
+                }
+            }
+            if xmin > xmax {
+                continue;
+            }
+            let x0 = self.index(DVec2::new(xmin - pad, lo.y)).0;
+            let x1 = self.index(DVec2::new(xmax + pad, lo.y)).0;
             for x in x0..=x1 {
                 for &k in &self.cells[y * self.n + x] {
                     f(k);
@@ -249,6 +290,53 @@ impl Buckets {
 mod tests {
     use super::*;
     use crate::testutil::{grey, polygon, regular_mesh, scene};
+
+    /// The fan of a 64-gon (long thin triangles across the grid of
+    /// buckets), read by 12 × 12 cells: each cell's weights sum to the
+    /// area of its overlap with the elements, found by clipping every
+    /// triangle against every cell, so the buckets a triangle visits miss
+    /// no cell it overlaps.
+    #[test]
+    fn thin_triangles_reach_every_cell_they_cross() {
+        let disc: Vec<[f32; 3]> = (0..64)
+            .map(|k| {
+                let a = std::f32::consts::TAU * k as f32 / 64.0;
+                [a.cos(), a.sin(), 0.0]
+            })
+            .collect();
+        let s = scene(vec![polygon(0, &disc)], vec![grey("floor", 0.0, 0.5)]);
+        let mesh = regular_mesh(&s, 0.4);
+        let pm = &mesh.polygons[0];
+        let side = 2.2 / 12.0;
+        let cells: Vec<[Vec3; 4]> = (0..144)
+            .map(|k| {
+                let (x, y) = (-1.1 + (k % 12) as f32 * side, -1.1 + (k / 12) as f32 * side);
+                [
+                    Vec3::new(x, y, 0.0),
+                    Vec3::new(x + side, y, 0.0),
+                    Vec3::new(x + side, y + side, 0.0),
+                    Vec3::new(x, y + side, 0.0),
+                ]
+            })
+            .collect();
+        let weights = cell_weights(&mesh, pm, &cells);
+        let frame = Frame::new(pm.normal);
+        let (mut clipped, mut scratch) = (Vec::new(), Vec::new());
+        for (cell, w) in cells.iter().zip(&weights) {
+            let square = frame.convex(cell);
+            let mut covered = 0.0;
+            for e in pm.elements.clone() {
+                for tri in mesh.elements[e as usize].triangles() {
+                    clipped.clear();
+                    clipped.extend(tri.map(|v| frame.project(mesh.positions[v.index()])));
+                    clip(&mut clipped, &square, &mut scratch);
+                    covered += area_centroid(&clipped).map_or(0.0, |(a, _)| a);
+                }
+            }
+            let got: f64 = w.iter().map(|&(_, a)| f64::from(a)).sum();
+            assert!((got - covered).abs() < 1e-6, "{got} against {covered}");
+        }
+    }
 
     /// A unit square meshed into 5 × 5 elements, read by 3 × 3 cells: every
     /// cell's weights sum to its area, every vertex's over the cells to
