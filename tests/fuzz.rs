@@ -1280,13 +1280,7 @@ fn fuzz(target: &Target, cases: u64, seed: u64) -> Summary {
         summary.cases += 1;
         summary.slowest = summary.slowest.max(elapsed);
         let problem = match &outcome {
-            Err(p) => Some(format!(
-                "panicked: {}",
-                p.downcast_ref::<String>()
-                    .cloned()
-                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                    .unwrap_or_default()
-            )),
+            Err(p) => Some(format!("panicked: {}", common::panic_message(p.as_ref()))),
             Ok(_) if elapsed > PER_INPUT_LIMIT => Some(format!("took {elapsed:?}")),
             Ok(o) => {
                 summary.accepted += o.is_ok() as u64;

@@ -75,13 +75,7 @@ fn fuzz(name: &str, default_cases: u64, mut one: impl FnMut(&mut Rng) -> (String
         }));
         let problem = match outcome {
             Ok(problem) => problem,
-            Err(p) => Some(format!(
-                "panicked: {}",
-                p.downcast_ref::<String>()
-                    .cloned()
-                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                    .unwrap_or_default()
-            )),
+            Err(p) => Some(format!("panicked: {}", common::panic_message(p.as_ref()))),
         };
         if let Some(problem) = problem {
             failures.push(format!("case {case} (seed {seed:#x}): {problem}\n{shown}"));

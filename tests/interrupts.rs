@@ -32,32 +32,6 @@ fn spawn_in(dir: &Path, args: &[&str]) -> Child {
         .expect("the radiosity binary starts")
 }
 
-/// Sends `signal` (`INT`, `TERM`) to the child.
-fn signal(child: &Child, signal: &str) {
-    let ok = Command::new("kill")
-        .args([&format!("-{signal}"), &child.id().to_string()])
-        .status()
-        .expect("kill runs")
-        .success();
-    assert!(ok, "kill -{signal} failed");
-}
-
-/// Waits at most `limit` for the child; kills it and fails if it hangs.
-fn wait_at_most(child: &mut Child, limit: Duration) -> ExitStatus {
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            return status;
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("did not stop within {limit:?} of the interrupt");
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-}
-
 /// Sends `sig` and returns the exit status, the seconds it took and the
 /// child's stderr.
 fn interrupt(child: &mut Child, sig: &str) -> (ExitStatus, Duration, String) {

@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use std::path::Path;
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// Starts the binary in `dir` (no display), without waiting.
@@ -19,31 +19,6 @@ fn spawn_in(dir: &Path, args: &[&str]) -> Child {
         .stderr(Stdio::piped())
         .spawn()
         .expect("the radiosity binary starts")
-}
-
-/// Sends SIGINT, as Ctrl-C in a terminal does.
-fn interrupt(child: &Child) {
-    let ok = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill runs")
-        .success();
-    assert!(ok, "kill -INT failed");
-}
-
-/// Waits at most `limit` for the child; kills it and fails if it hangs.
-fn wait_at_most(child: &mut Child, limit: Duration) -> ExitStatus {
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            return status;
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            panic!("did not stop within {limit:?} of the interrupt");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
 }
 
 fn child_stderr(child: &mut Child) -> String {
@@ -76,7 +51,7 @@ fn ctrl_c_stops_promptly_writes_nothing_and_exits_130() {
     std::thread::sleep(Duration::from_millis(1500));
     assert!(child.try_wait().unwrap().is_none(), "finished too early");
     let t = Instant::now();
-    interrupt(&child);
+    signal(&child, "INT");
     let status = wait_at_most(&mut child, Duration::from_secs(5));
     let err = child_stderr(&mut child);
     assert_eq!(status.code(), Some(130), "{err}");
@@ -151,7 +126,7 @@ fn interrupted_and_resumed_solve_gives_the_same_bits() {
         }
         let delay = (nanos >> attempt) % (solve_ms / 2 + 1);
         std::thread::sleep(Duration::from_millis(delay));
-        interrupt(&child);
+        signal(&child, "INT");
         let status = wait_at_most(&mut child, Duration::from_secs(10));
         let err = child_stderr(&mut child);
         if status.code() == Some(130) {
