@@ -949,14 +949,11 @@ fn inset_positions<'a>(
     distance: f32,
 ) -> impl Iterator<Item = Vec3> + 'a {
     let v = &polygon.vertices;
-    let extent = polygon
-        .vertices
-        .iter()
-        .flat_map(|a| v.iter().map(move |b| a.distance(*b)))
-        .fold(0.0f32, f32::max);
+    let extent = crate::scene::polygon_extent_f32(v);
     let tolerance = ON_EDGE_TOLERANCE * extent;
-    let edges: Vec<(Vec3, Vec3, Vec3)> = (0..v.len())
-        .filter_map(|k| {
+    // Per vertex `k`, the edge from it to the next (none when they meet).
+    let edges: Vec<Option<(Vec3, Vec3, Vec3)>> = (0..v.len())
+        .map(|k| {
             let (a, b) = (v[k], v[(k + 1) % v.len()]);
             let dir = (b - a).normalize_or_zero();
             // For a counter-clockwise polygon, normal × edge points inside.
@@ -964,20 +961,96 @@ fn inset_positions<'a>(
             (dir != Vec3::ZERO).then_some((a, dir, inward))
         })
         .collect();
+    // A polygon of many edges (a disc of thousands of vertices) finds the
+    // edges near a vertex through a grid rather than testing them all.
+    let near = (edges.len() > EDGE_GRID_MIN && distance != 0.0)
+        .then(|| EdgeGrid::new(v, extent, tolerance));
+    let mut candidates = Vec::new();
     positions.iter().map(move |&p| {
         if distance == 0.0 {
             return p;
         }
         let mut moved = p;
-        for &(a, dir, inward) in &edges {
+        let mut test = |&(a, dir, inward): &(Vec3, Vec3, Vec3)| {
             let rel = p - a;
             let off_line = rel - rel.dot(dir) * dir;
             if off_line.length() <= tolerance {
                 moved += inward * distance;
             }
+        };
+        match &near {
+            None => edges.iter().flatten().for_each(&mut test),
+            Some(grid) => {
+                // In edge order, as the loop over every edge adds them.
+                grid.near(p, &mut candidates);
+                candidates
+                    .iter()
+                    .filter_map(|&k| edges[k as usize].as_ref())
+                    .for_each(&mut test);
+            }
         }
         moved
     })
+}
+
+/// Edges above which [`inset_positions`] looks edges up in an
+/// [`EdgeGrid`].
+const EDGE_GRID_MIN: usize = 32;
+
+/// A polygon's boundary edges binned in cubic cells by their bounds grown
+/// by the on-edge tolerance: the edges a point may lie on are those of
+/// its cell.
+struct EdgeGrid {
+    cell: f32,
+    bins: HashMap<[i32; 3], Vec<u32>>,
+}
+
+impl EdgeGrid {
+    fn new(v: &[Vec3], extent: f32, tolerance: f32) -> EdgeGrid {
+        let n = v.len();
+        // About one edge's length a cell, so each edge meets a few; at
+        // least an eighth of the longest edge, so none meets more than
+        // 9 × 9 × 9.
+        let longest = (0..n)
+            .map(|k| v[k].distance(v[(k + 1) % n]))
+            .fold(0.0f32, f32::max);
+        let cell = (extent / (n as f32).sqrt())
+            .max(longest / 8.0)
+            .max(4.0 * tolerance)
+            .max(f32::MIN_POSITIVE);
+        let mut grid = EdgeGrid {
+            cell,
+            bins: HashMap::new(),
+        };
+        for k in 0..n {
+            let (a, b) = (v[k], v[(k + 1) % n]);
+            let (lo, hi) = (
+                grid.key(a.min(b) - Vec3::splat(tolerance)),
+                grid.key(a.max(b) + Vec3::splat(tolerance)),
+            );
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        grid.bins.entry([x, y, z]).or_default().push(k as u32);
+                    }
+                }
+            }
+        }
+        grid
+    }
+
+    fn key(&self, p: Vec3) -> [i32; 3] {
+        (p / self.cell).floor().to_array().map(|x| x as i32)
+    }
+
+    /// The edges (their first vertex's index) whose grown bounds may hold
+    /// `p`, ascending, into `out`.
+    fn near(&self, p: Vec3, out: &mut Vec<u32>) {
+        out.clear();
+        if let Some(edges) = self.bins.get(&self.key(p)) {
+            out.extend_from_slice(edges);
+        }
+    }
 }
 
 impl Mesh {

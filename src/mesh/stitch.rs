@@ -113,22 +113,33 @@ pub(crate) fn stitch_with_origins(scene: &Scene, mut mesh: Mesh) -> (Mesh, Optio
 fn boundary_edges(scene: &Scene, mesh: &Mesh) -> Vec<BoundaryEdge> {
     let mut out = Vec::new();
     let mut mask: Vec<u64> = Vec::new();
+    let mut candidates = Vec::new();
     for (polygon, pm) in scene.polygons.iter().zip(&mesh.polygons) {
-        let lines = edge_lines(polygon);
+        let (lines, near) = edge_lines(polygon);
         let first = pm.vertices.start;
         mask.clear();
         mask.extend(pm.vertices.clone().map(|v| {
             let p = mesh.positions[v as usize];
-            lines
-                .iter()
-                .enumerate()
-                .filter(|(_, (a, dir, tolerance))| {
-                    let rel = p - *a;
-                    (rel - rel.dot(*dir) * *dir).length() <= *tolerance
+            let on = |k: usize| {
+                lines[k].is_some_and(|(a, dir, tolerance)| {
+                    let rel = p - a;
+                    (rel - rel.dot(dir) * dir).length() <= tolerance
                 })
-                // Edges past the 64th share the last bit: a false
-                // candidate is only tested, never inserted wrongly.
-                .fold(0u64, |m, (k, _)| m | 1 << k.min(63))
+            };
+            // Edges past the 64th share the last bit: a false
+            // candidate is only tested, never inserted wrongly.
+            let bit = |m: u64, k: usize| m | 1 << k.min(63);
+            match &near {
+                None => (0..lines.len()).filter(|&k| on(k)).fold(0u64, bit),
+                Some(grid) => {
+                    grid.near(p, &mut candidates);
+                    candidates
+                        .iter()
+                        .map(|&k| k as usize)
+                        .filter(|&k| on(k))
+                        .fold(0u64, bit)
+                }
+            }
         }));
         for e in pm.elements.clone() {
             let c = mesh.elements[e as usize].corners();
@@ -148,21 +159,26 @@ fn boundary_edges(scene: &Scene, mesh: &Mesh) -> Vec<BoundaryEdge> {
     out
 }
 
-/// Each edge of a polygon as `(start, unit direction, tolerance)`, the
-/// tolerance that of the inset rule (a fraction of the polygon's extent).
-fn edge_lines(polygon: &crate::scene::Polygon) -> Vec<(Vec3, Vec3, f32)> {
+/// A polygon edge's start, unit direction and on-edge tolerance.
+type EdgeLine = (Vec3, Vec3, f32);
+
+/// Each edge of a polygon, by its first vertex, as `(start, unit
+/// direction, tolerance)` (none where two vertices meet), the tolerance
+/// that of the inset rule (a fraction of the polygon's extent); and for a
+/// polygon of many edges, the grid that finds the edges near a point.
+fn edge_lines(polygon: &crate::scene::Polygon) -> (Vec<Option<EdgeLine>>, Option<super::EdgeGrid>) {
     let v = &polygon.vertices;
-    let extent = v
-        .iter()
-        .flat_map(|a| v.iter().map(move |b| a.distance(*b)))
-        .fold(0.0f32, f32::max);
-    (0..v.len())
-        .filter_map(|k| {
+    let extent = crate::scene::polygon_extent_f32(v);
+    let tolerance = super::ON_EDGE_TOLERANCE * extent;
+    let lines = (0..v.len())
+        .map(|k| {
             let (a, b) = (v[k], v[(k + 1) % v.len()]);
             let dir = (b - a).normalize_or_zero();
-            (dir != Vec3::ZERO).then_some((a, dir, super::ON_EDGE_TOLERANCE * extent))
+            (dir != Vec3::ZERO).then_some((a, dir, tolerance))
         })
-        .collect()
+        .collect();
+    let near = (v.len() > super::EDGE_GRID_MIN).then(|| super::EdgeGrid::new(v, extent, tolerance));
+    (lines, near)
 }
 
 /// A uniform grid: cell coordinates packed in a `u64`, 21 bits per axis.

@@ -280,3 +280,49 @@ fn bad_options_and_huge_meshes_are_refused() {
         other => panic!("expected TooManyElements, got {other:?}"),
     }
 }
+
+/// The inset of a polygon of many edges, whose edges near each point are
+/// found through a grid, moves every point exactly as testing every edge
+/// does: on a vertex (two edges), on an edge, just off it, and inside.
+#[test]
+fn the_edge_grid_finds_every_edge_a_point_lies_on() {
+    let n = 300;
+    let disc: Vec<[f32; 3]> = (0..n)
+        .map(|k| {
+            let a = std::f32::consts::TAU * k as f32 / n as f32;
+            [3.0 * a.cos(), 0.5 * a.sin() - 1.0, 2.0 * a.sin()]
+        })
+        .collect();
+    let p = testutil::polygon(0, &disc);
+    let v = &p.vertices;
+    let mut points = Vec::new();
+    for k in 0..n {
+        let (a, b) = (v[k], v[(k + 1) % n]);
+        points.extend([a, (a + b) * 0.5, a.lerp(b, 0.1), a.lerp(b, 0.5) * 0.999]);
+    }
+    points.push(Vec3::new(0.0, -1.0, 0.0));
+    let d = 0.01;
+    let extent = crate::scene::polygon_extent_f32(v);
+    let tolerance = ON_EDGE_TOLERANCE * extent;
+    let every_edge = |q: Vec3| {
+        let mut moved = q;
+        for k in 0..n {
+            let (a, b) = (v[k], v[(k + 1) % n]);
+            let dir = (b - a).normalize_or_zero();
+            let inward = p.normal.cross(dir).normalize_or_zero();
+            let rel = q - a;
+            if (rel - rel.dot(dir) * dir).length() <= tolerance {
+                moved += inward * d;
+            }
+        }
+        moved
+    };
+    let got: Vec<Vec3> = inset_positions(&p, &points, d).collect();
+    let mut moved = 0;
+    for (q, g) in points.iter().zip(&got) {
+        assert_eq!(*g, every_edge(*q), "at {q}");
+        moved += (*g != *q) as usize;
+    }
+    // Every vertex and point on an edge moved; the others did not.
+    assert_eq!(moved, 3 * n);
+}

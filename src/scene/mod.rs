@@ -42,6 +42,8 @@ pub use lighting::emit::{
 pub use lighting::luminaire::{Luminaire, LuminaireError};
 pub use lighting::sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
 pub use lighting::units::{Photometric, Units};
+pub(crate) use polygon::polygon_extent_f32;
+pub use polygon::EXACT_DIAMETER_MAX_VERTICES;
 pub use polygon::{
     PolygonError, Shape, COINCIDENT_TOLERANCE, CONVEXITY_TOLERANCE, COORDINATE_ROUNDING,
     MAX_COORDINATE, MIN_EXTENT, PARALLELOGRAM_TOLERANCE, PLANARITY_TOLERANCE, TURNING_TOLERANCE,
