@@ -11,26 +11,13 @@ mod common;
 
 use common::*;
 use std::path::Path;
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Child, Command, ExitStatus};
 use std::time::{Duration, Instant};
 
 /// How long an interrupted run may take to exit: generous for a loaded
 /// two-core machine, while each phase interrupted below would otherwise
 /// take far longer.
 const BOUND: Duration = Duration::from_secs(3);
-
-/// Starts the binary in `dir` (no display), without waiting.
-fn spawn_in(dir: &Path, args: &[&str]) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .current_dir(dir)
-        .env_remove("DISPLAY")
-        .env_remove("WAYLAND_DISPLAY")
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the radiosity binary starts")
-}
 
 /// Sends `sig` and returns the exit status, the seconds it took and the
 /// child's stderr.
