@@ -928,7 +928,7 @@ impl<'a> Reader<'a> {
         }
         let result = self
             .image_bytes(index)
-            .and_then(|bytes| texture::average_bytes(&bytes, &self.budget));
+            .and_then(|bytes| texture::average_bytes(&bytes, None, &self.budget));
         self.textures.insert(index, result.clone());
         result
     }

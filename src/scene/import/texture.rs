@@ -21,7 +21,6 @@
 use crate::budget::{fmt_bytes, MemoryBudget};
 use crate::color::Rgb;
 use std::io::{BufRead, Cursor, Seek};
-use std::path::Path;
 use std::sync::OnceLock;
 
 /// The largest side of a texture decoded whole (not a PNG), in pixels:
@@ -32,32 +31,45 @@ pub const MAX_SIDE: u32 = 16_384;
 /// 1 GiB (a 16k × 16k RGBA image of 8 bits is 1 GiB).
 pub const MAX_DECODED_BYTES: u64 = 1 << 30;
 
-/// The average colour of the image file at `path`, in linear values, each
-/// channel in `[0, 1]`.
-pub fn average_file(path: &Path, budget: &MemoryBudget) -> Result<Rgb, String> {
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    average_bytes(&bytes, budget)
-}
-
-/// The average colour of the encoded image `bytes`, as [`average_file`].
-pub fn average_bytes(bytes: &[u8], budget: &MemoryBudget) -> Result<Rgb, String> {
-    let reader = image::ImageReader::new(Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
+/// The average colour of the encoded image `bytes`, in linear values, each
+/// channel in `[0, 1]`. The format is found from the bytes, else it is
+/// `hint` (the file name's extension: TGA has no magic bytes).
+pub fn average_bytes(
+    bytes: &[u8],
+    hint: Option<image::ImageFormat>,
+    budget: &MemoryBudget,
+) -> Result<Rgb, String> {
+    let reader = reader(bytes, hint)?;
     if reader.format() == Some(image::ImageFormat::Png) {
         return average_png(Cursor::new(bytes));
     }
-    average_whole(bytes, budget)
+    average_whole(bytes, hint, budget)
+}
+
+/// A reader of `bytes` in the format they show, else `hint`.
+fn reader(
+    bytes: &[u8],
+    hint: Option<image::ImageFormat>,
+) -> Result<image::ImageReader<Cursor<&[u8]>>, String> {
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    if reader.format().is_none() {
+        if let Some(format) = hint {
+            reader.set_format(format);
+        }
+    }
+    Ok(reader)
 }
 
 /// A non-PNG image decoded whole in its own pixel format, after its
 /// header's size was checked against the budget.
-fn average_whole(bytes: &[u8], budget: &MemoryBudget) -> Result<Rgb, String> {
-    let guess = || {
-        image::ImageReader::new(Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| e.to_string())
-    };
+fn average_whole(
+    bytes: &[u8],
+    hint: Option<image::ImageFormat>,
+    budget: &MemoryBudget,
+) -> Result<Rgb, String> {
+    let guess = || reader(bytes, hint);
     let (w, h) = guess()?.into_dimensions().map_err(|e| e.to_string())?;
     let limit = MAX_DECODED_BYTES.min(budget.bytes() / 2);
     // Up to 16 bytes a pixel (RGBA of 32-bit floats) in the decoded buffer.
@@ -278,7 +290,7 @@ mod tests {
         // Half its rows white: 1.2 GB as 8-bit RGB, 4.8 GB as floats.
         let bytes = one_bit_png(20_000, 20_000, |y| y % 2 == 0);
         assert!(bytes.len() < 200_000, "{} bytes", bytes.len());
-        let avg = average_bytes(&bytes, &MemoryBudget::new(100_000_000)).unwrap();
+        let avg = average_bytes(&bytes, None, &MemoryBudget::new(100_000_000)).unwrap();
         for c in avg.to_array() {
             assert!((c - 0.5).abs() < 1e-12, "{avg:?}");
         }
@@ -294,7 +306,7 @@ mod tests {
         image::DynamicImage::ImageRgb8(img)
             .write_to(&mut Cursor::new(&mut png), image::ImageFormat::Png)
             .unwrap();
-        let avg = average_bytes(&png, &MemoryBudget::UNLIMITED).unwrap();
+        let avg = average_bytes(&png, None, &MemoryBudget::UNLIMITED).unwrap();
         assert!((avg.r - 0.5).abs() < 1e-12, "{avg:?}");
         let grey = image::DynamicImage::ImageRgb16(image::ImageBuffer::from_pixel(
             3,
@@ -304,9 +316,26 @@ mod tests {
         let mut tiff = Vec::new();
         grey.write_to(&mut Cursor::new(&mut tiff), image::ImageFormat::Tiff)
             .unwrap();
-        let avg = average_bytes(&tiff, &MemoryBudget::UNLIMITED).unwrap();
+        let avg = average_bytes(&tiff, None, &MemoryBudget::UNLIMITED).unwrap();
         assert!(
             (avg.g - srgb_to_linear(188.0 / 255.0)).abs() < 1e-9,
+            "{avg:?}"
+        );
+    }
+
+    /// A TGA has no magic bytes: its format comes from the file name's
+    /// extension, given as the hint.
+    #[test]
+    fn a_tga_is_read_by_its_extension() {
+        let grey =
+            image::DynamicImage::ImageRgb8(image::RgbImage::from_pixel(4, 2, image::Rgb([188; 3])));
+        let mut tga = Vec::new();
+        grey.write_to(&mut Cursor::new(&mut tga), image::ImageFormat::Tga)
+            .unwrap();
+        let hint = image::ImageFormat::from_path("wood.tga").ok();
+        let avg = average_bytes(&tga, hint, &MemoryBudget::UNLIMITED).unwrap();
+        assert!(
+            (avg.r - srgb_to_linear(188.0 / 255.0)).abs() < 1e-9,
             "{avg:?}"
         );
     }
@@ -326,7 +355,7 @@ mod tests {
         bmp.extend_from_slice(&1u16.to_le_bytes());
         bmp.extend_from_slice(&24u16.to_le_bytes());
         bmp.extend_from_slice(&[0; 24]);
-        let e = average_bytes(&bmp, &MemoryBudget::UNLIMITED).unwrap_err();
+        let e = average_bytes(&bmp, None, &MemoryBudget::UNLIMITED).unwrap_err();
         assert!(e.starts_with("the image is 20000 × 20000 pixels"), "{e}");
     }
 }

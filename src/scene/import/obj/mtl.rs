@@ -343,7 +343,9 @@ pub(super) fn read_textures(lib: &mut Library, read: &ReadTexture<'_>, budget: &
             continue;
         };
         let path = dir.join(name);
-        match read(&path).and_then(|bytes| texture::average_bytes(&bytes, budget)) {
+        match read(&path).and_then(|bytes| {
+            texture::average_bytes(&bytes, image::ImageFormat::from_path(&path).ok(), budget)
+        }) {
             Ok(rgb) => m.texture = Some(rgb),
             Err(e) => failed.add(*pos, || {
                 format!("{} (material `{}`): {e}", path.display(), m.name)
