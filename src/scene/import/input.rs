@@ -645,4 +645,54 @@ mod tests {
         assert_eq!(lenient.files().len(), 1);
         assert_eq!(folder.refused(), None);
     }
+
+    /// Every file the program reads goes through this module: outside it
+    /// (and outside tests), no source file opens or reads a file itself.
+    /// The memory budget's reads of the system's own files (`/proc`,
+    /// `/sys`) are the exception.
+    #[test]
+    fn no_other_module_reads_files_itself() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let allowed = ["scene/import/input.rs", "budget.rs"];
+        let forbidden = [
+            "fs::read(",
+            "fs::read_to_string(",
+            "File::open(",
+            "image::open(",
+            "OpenOptions::new().read(",
+        ];
+        let mut stack = vec![root.clone()];
+        let mut checked = 0;
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    stack.push(path);
+                    continue;
+                }
+                let name = path
+                    .strip_prefix(&root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                if !name.ends_with(".rs")
+                    || allowed.contains(&name.as_str())
+                    || name.ends_with("tests.rs")
+                {
+                    continue;
+                }
+                let text = std::fs::read_to_string(&path).unwrap();
+                // Unit tests sit after the module's `#[cfg(test)]`.
+                let code = text.split("#[cfg(test)]").next().unwrap_or_default();
+                for pattern in forbidden {
+                    assert!(
+                        !code.contains(pattern),
+                        "src/{name} calls `{pattern}`: read files through scene::import::input"
+                    );
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked > 100, "only {checked} source files found");
+    }
 }
