@@ -188,7 +188,7 @@ fn prepare_deferred_cancellable(
     let mut seconds = PhaseSeconds::default();
     let t = Instant::now();
     let inputs = declared_inputs(config);
-    let mut scene = load_scene_within(
+    let mut scene = load_scene(
         &config.scene,
         config.camera.as_deref(),
         &inputs,
@@ -325,18 +325,9 @@ impl FirstHit for Visibility {
 
 /// Loads the scene from its source, with the camera of the `.sc` file
 /// `camera` when given (see [`Scene::with_camera_from`]), recording every
-/// file read in `inputs`.
+/// file read in `inputs`, within the memory budget `budget`
+/// ([`scene::load_with`]).
 pub fn load_scene(
-    source: &SceneSource,
-    camera: Option<&Path>,
-    inputs: &InputSet,
-) -> Result<Scene, LoadError> {
-    load_scene_within(source, camera, inputs, &MemoryBudget::for_machine())
-}
-
-/// [`load_scene`] within the memory budget `budget`
-/// ([`scene::load_within`]).
-pub fn load_scene_within(
     source: &SceneSource,
     camera: Option<&Path>,
     inputs: &InputSet,

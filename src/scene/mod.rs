@@ -35,7 +35,7 @@ pub use import::points::{load_points, MeasurementPoint, PointsError};
 pub use import::sc::{
     load_camera, load_camera_into, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION,
 };
-pub use import::{load, load_into, load_with, load_within};
+pub use import::{load, load_with};
 pub use lighting::emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
 };

@@ -135,17 +135,7 @@ pub fn load_gltf(
 /// [`load_gltf`] within the memory budget `budget`: the triangles of
 /// every node instance are counted from the accessors before any is
 /// built, and a scene over the budget is refused; textures are decoded
-/// within it. Every file read is recorded in a set of its own.
-pub fn load_gltf_within(
-    path: &Path,
-    camera: Option<&Path>,
-    budget: &MemoryBudget,
-) -> Result<Scene, LoadError> {
-    load_gltf_with(path, camera, &InputSet::default(), budget)
-}
-
-/// [`load_gltf`] recording every file read in `inputs`, within `budget`
-/// as [`load_gltf_within`].
+/// within it.
 pub fn load_gltf_with(
     path: &Path,
     camera: Option<&Path>,
@@ -179,7 +169,7 @@ pub fn parse_gltf(bytes: &[u8], file: &str, read_uri: &ReadUri<'_>) -> Result<Sc
 }
 
 /// [`parse_gltf`] within the memory budget `budget`, as
-/// [`load_gltf_within`].
+/// [`load_gltf_with`].
 pub fn parse_gltf_within(
     bytes: &[u8],
     file: &str,

@@ -22,28 +22,18 @@ use std::path::Path;
 /// Wavefront OBJ (with its MTL libraries) for `.obj`, glTF 2.0 for
 /// `.gltf` and `.glb`, else `.sc`. Errors carry the file name and the
 /// line and column (for glTF, the JSON path). The files a model names
-/// must lie inside its folder; [`load_into`] can allow otherwise.
+/// must lie inside its folder; [`load_with`] can allow otherwise.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
     load_with(path, &InputSet::default(), &MemoryBudget::for_machine())
-}
-
-/// [`load`] within the memory budget `budget`: OBJ and glTF files whose
-/// geometry would take more are refused before it is built, and their
-/// textures are decoded within it. (A `.sc` file's polygons are written
-/// one by one, so its size bounds them.)
-pub fn load_within(path: &Path, budget: &MemoryBudget) -> Result<Scene, LoadError> {
-    load_with(path, &InputSet::default(), budget)
 }
 
 /// [`load`], recording every file read (the scene, its material libraries,
 /// textures and buffers) in `inputs`, whose
 /// [`allow_outside_paths`](InputSet::allow_outside_paths) says whether a
-/// model may name files outside its folder.
-pub fn load_into(path: &Path, inputs: &InputSet) -> Result<Scene, LoadError> {
-    load_with(path, inputs, &MemoryBudget::for_machine())
-}
-
-/// [`load_into`] within `budget`, as [`load_within`].
+/// model may name files outside its folder, within the memory budget
+/// `budget`: OBJ and glTF files whose geometry would take more are refused
+/// before it is built, and their textures are decoded within it. (A `.sc`
+/// file's polygons are written one by one, so its size bounds them.)
 pub fn load_with(
     path: &Path,
     inputs: &InputSet,

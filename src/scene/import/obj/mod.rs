@@ -179,17 +179,7 @@ pub fn load_obj(path: &Path, camera: Option<&Path>, inputs: &InputSet) -> Result
 
 /// [`load_obj`] within the memory budget `budget`: a file whose faces
 /// alone would take more is refused before they are built, and textures
-/// are decoded within it. Every file read is recorded in a set of its own.
-pub fn load_obj_within(
-    path: &Path,
-    camera: Option<&Path>,
-    budget: &MemoryBudget,
-) -> Result<Scene, LoadError> {
-    load_obj_with(path, camera, &InputSet::default(), budget)
-}
-
-/// [`load_obj`] recording every file read in `inputs`, within `budget`
-/// as [`load_obj_within`].
+/// are decoded within it.
 pub fn load_obj_with(
     path: &Path,
     camera: Option<&Path>,
@@ -242,7 +232,7 @@ pub fn parse_obj(text: &str, file: &str, read_mtl: &ReadMtl<'_>) -> Result<Scene
 }
 
 /// [`parse_obj`] within the memory budget `budget`, as
-/// [`load_obj_within`].
+/// [`load_obj_with`].
 pub fn parse_obj_within(
     text: &str,
     file: &str,
