@@ -10,10 +10,14 @@
 //!   edge, so every interior grid line (a blend of the two) is short enough;
 //! - a **triangle** becomes `n²` triangles by a regular subdivision of each
 //!   edge into `n` parts, `n` from its longest edge;
-//! - a **convex polygon** of five or more vertices is first split into a fan
-//!   of triangles around its centroid (collinear vertices dropped), and every
-//!   fan triangle is subdivided with the same `n`, so the fan's shared edges
-//!   carry the same vertices.
+//! - a **convex polygon** of five or six vertices (collinear vertices
+//!   dropped) is first split into a fan of triangles around its centroid,
+//!   and every fan triangle is subdivided with the same `n`, so the fan's
+//!   shared edges carry the same vertices;
+//! - a convex polygon of more vertices (a disc, a cylinder's cap) becomes
+//!   the Delaunay triangulation of its rim cut every `lenmax` and a
+//!   triangular lattice inside (`lattice`), whose size follows its area
+//!   and perimeter rather than its vertex count.
 //!
 //! Element vertices are shared between neighbouring elements of the same
 //! polygon, never between polygons: each polygon's radiosity is
@@ -42,6 +46,7 @@ use std::ops::Range;
 pub mod budget;
 pub mod covered;
 mod handle;
+mod lattice;
 pub mod refine;
 pub mod stitch;
 pub mod weld;
@@ -606,7 +611,15 @@ enum Cut {
     Triangle([Vec3; 3]),
     /// A fan of triangles `(apex, rim[k], rim[k+1])` around a closed rim.
     Fan { apex: Vec3, rim: Vec<Vec3> },
+    /// A convex polygon of more than [`FAN_MAX_RIM`] vertices, meshed by
+    /// [`lattice::mesh`].
+    Lattice { rim: Vec<Vec3>, normal: Vec3 },
 }
+
+/// The most rim vertices a convex polygon is cut as a fan with: past
+/// this, a fan's `m · n²` elements outgrow the lattice's, and its
+/// triangles grow thin.
+const FAN_MAX_RIM: usize = 6;
 
 /// What sets one polygon's mesh size at any lenmax: the lengths its
 /// subdivision counts come from, and how the counts become elements and
@@ -635,6 +648,9 @@ enum Form {
     Triangle,
     /// A fan of this many triangles, each cut `nu` times per edge.
     Fan(u32),
+    /// A rim and lattice ([`lattice`]) over this area and perimeter (scene
+    /// units) with this many rim vertices.
+    Lattice { area: f32, perimeter: f32, rim: u32 },
 }
 
 /// Subdivisions so that `length / n < lenmax`.
@@ -678,6 +694,14 @@ impl Span {
                     vertices: (m.saturating_mul(nu + inner)).saturating_add(1),
                 }
             }
+            Form::Lattice {
+                area,
+                perimeter,
+                rim,
+            } => {
+                let (elements, vertices) = lattice::size_at(area, perimeter, rim, lenmax);
+                MeshSize { elements, vertices }
+            }
         }
     }
 }
@@ -714,14 +738,34 @@ impl Plan {
                         ..polygon.clone()
                     });
                 }
-                let apex = area_centroid(&rim);
-                let mut longest = 0.0f32;
-                for k in 0..rim.len() {
-                    let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
-                    longest = longest.max(a.distance(b)).max(apex.distance(a));
+                if rim.len() > FAN_MAX_RIM && !polygon.surface.sky {
+                    let diameter = crate::scene::polygon_extent_f32(&rim);
+                    let rim = lattice::simplify(&rim, ON_EDGE_TOLERANCE * diameter);
+                    let perimeter = (0..rim.len())
+                        .map(|k| rim[k].distance(rim[(k + 1) % rim.len()]))
+                        .sum::<f32>();
+                    let form = Form::Lattice {
+                        area: polygon.area as f32,
+                        perimeter,
+                        rim: rim.len() as u32,
+                    };
+                    // The lattice's size comes from `form`; `u` and `v`
+                    // only say how large the polygon is.
+                    let cut = Cut::Lattice {
+                        rim,
+                        normal: polygon.normal,
+                    };
+                    (cut, diameter, diameter, form)
+                } else {
+                    let apex = area_centroid(&rim);
+                    let mut longest = 0.0f32;
+                    for k in 0..rim.len() {
+                        let (a, b) = (rim[k], rim[(k + 1) % rim.len()]);
+                        longest = longest.max(a.distance(b)).max(apex.distance(a));
+                    }
+                    let form = Form::Fan(rim.len() as u32);
+                    (Cut::Fan { apex, rim }, longest, longest, form)
                 }
-                let form = Form::Fan(rim.len() as u32);
-                (Cut::Fan { apex, rim }, longest, longest, form)
             }
         };
         // A sky facet's radiosity is its emission, the same everywhere:
@@ -776,6 +820,20 @@ impl Plan {
                     shortest = shortest.min(a.distance(c)).min(apex.distance(a));
                 }
                 (nu, nu, shortest / nu as f32)
+            }
+            Cut::Lattice { rim, normal } => {
+                let mesh = lattice::mesh(rim, *normal, lenmax);
+                let first = b.mesh.positions.len() as u32;
+                for &p in &mesh.positions {
+                    b.vertex(p);
+                }
+                for t in &mesh.triangles {
+                    let [a, c, d] = t.map(|i| VertexId(first + i));
+                    b.element(Element::triangle(a, c, d));
+                }
+                // Not a grid: one "division" each way, so nothing takes
+                // it for one.
+                (1, 1, mesh.min_edge)
             }
         }
     }
@@ -948,28 +1006,59 @@ fn inset_positions<'a>(
     positions: &'a [Vec3],
     distance: f32,
 ) -> impl Iterator<Item = Vec3> + 'a {
-    let v = &polygon.vertices;
-    let extent = crate::scene::polygon_extent_f32(v);
-    let tolerance = ON_EDGE_TOLERANCE * extent;
-    // Per vertex `k`, the edge from it to the next (none when they meet).
-    let edges: Vec<Option<(Vec3, Vec3, Vec3)>> = (0..v.len())
-        .map(|k| {
-            let (a, b) = (v[k], v[(k + 1) % v.len()]);
-            let dir = (b - a).normalize_or_zero();
-            // For a counter-clockwise polygon, normal × edge points inside.
-            let inward = polygon.normal.cross(dir).normalize_or_zero();
-            (dir != Vec3::ZERO).then_some((a, dir, inward))
-        })
-        .collect();
-    // A polygon of many edges (a disc of thousands of vertices) finds the
-    // edges near a vertex through a grid rather than testing them all.
-    let near = (edges.len() > EDGE_GRID_MIN && distance != 0.0)
-        .then(|| EdgeGrid::new(v, extent, tolerance));
-    let mut candidates = Vec::new();
-    positions.iter().map(move |&p| {
-        if distance == 0.0 {
+    let mut inset = Inset::new(polygon, distance);
+    positions.iter().map(move |&p| inset.at(p))
+}
+
+/// The inset rule of one polygon, built once and asked point by point
+/// (stitching asks it once per inserted vertex).
+struct Inset {
+    /// Per vertex `k`, the edge from it to the next as `(start, unit
+    /// direction, inward normal)` (none where the two vertices meet).
+    edges: Vec<Option<(Vec3, Vec3, Vec3)>>,
+    /// Distance from an edge's line within which a point is on the edge.
+    tolerance: f32,
+    /// How far a point on an edge moves inward, in scene units.
+    distance: f32,
+    /// For a polygon of many edges, the grid that finds those near a point.
+    near: Option<EdgeGrid>,
+    candidates: Vec<u32>,
+}
+
+impl Inset {
+    fn new(polygon: &Polygon, distance: f32) -> Inset {
+        let v = &polygon.vertices;
+        let extent = crate::scene::polygon_extent_f32(v);
+        let tolerance = ON_EDGE_TOLERANCE * extent;
+        let edges = (0..v.len())
+            .map(|k| {
+                let (a, b) = (v[k], v[(k + 1) % v.len()]);
+                let dir = (b - a).normalize_or_zero();
+                // For a counter-clockwise polygon, normal × edge points inside.
+                let inward = polygon.normal.cross(dir).normalize_or_zero();
+                (dir != Vec3::ZERO).then_some((a, dir, inward))
+            })
+            .collect::<Vec<_>>();
+        // A polygon of many edges (a disc of thousands of vertices) finds
+        // the edges near a vertex through a grid rather than testing them
+        // all.
+        let near = (edges.len() > EDGE_GRID_MIN && distance != 0.0)
+            .then(|| EdgeGrid::new(v, extent, tolerance));
+        Inset {
+            edges,
+            tolerance,
+            distance,
+            near,
+            candidates: Vec::new(),
+        }
+    }
+
+    /// The evaluation point of a vertex at `p`.
+    fn at(&mut self, p: Vec3) -> Vec3 {
+        if self.distance == 0.0 {
             return p;
         }
+        let (tolerance, distance) = (self.tolerance, self.distance);
         let mut moved = p;
         let mut test = |&(a, dir, inward): &(Vec3, Vec3, Vec3)| {
             let rel = p - a;
@@ -978,19 +1067,19 @@ fn inset_positions<'a>(
                 moved += inward * distance;
             }
         };
-        match &near {
-            None => edges.iter().flatten().for_each(&mut test),
+        match &self.near {
+            None => self.edges.iter().flatten().for_each(&mut test),
             Some(grid) => {
                 // In edge order, as the loop over every edge adds them.
-                grid.near(p, &mut candidates);
-                candidates
+                grid.near(p, &mut self.candidates);
+                self.candidates
                     .iter()
-                    .filter_map(|&k| edges[k as usize].as_ref())
+                    .filter_map(|&k| self.edges[k as usize].as_ref())
                     .for_each(&mut test);
             }
         }
         moved
-    })
+    }
 }
 
 /// Edges above which [`inset_positions`] looks edges up in an

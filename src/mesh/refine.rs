@@ -130,7 +130,7 @@ pub struct RefineReport {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
 #[error(
     "refining no further: the next refinement would make about {elements} elements, \
-     over --max-elements {max}"
+     over the limit of {max} (--max-elements, or what --max-memory holds)"
 )]
 pub struct Refused {
     /// Elements the refused mesh could have had (an upper bound).

@@ -36,7 +36,7 @@
 //! vertex looks in its own cell only. The cost is `O(n log n)` in the
 //! boundary vertices.
 
-use super::{inset_positions, Element, Mesh, VertexId};
+use super::{Element, Inset, Mesh, VertexId};
 use crate::scene::{PolygonId, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -488,6 +488,8 @@ fn rebuild(
         }
         let e_start = out.elements.len() as u32;
         let mut added = 0u32;
+        // Built at the polygon's first inserted vertex, if any.
+        let mut inset = None;
         for e in pm.elements.clone() {
             let element = mesh.elements[e as usize];
             let mut touched = false;
@@ -501,10 +503,8 @@ fn rebuild(
                 // then the (at most ε) offset back to the copied position.
                 let (a, b) = (positions[edge.a as usize], positions[edge.b as usize]);
                 let on_line = a.lerp(b, hit.t);
-                let sample = inset_positions(polygon, std::slice::from_ref(&on_line), pm.inset)
-                    .next()
-                    .unwrap_or(on_line)
-                    + (p - on_line);
+                let inset = inset.get_or_insert_with(|| Inset::new(polygon, pm.inset));
+                let sample = inset.at(on_line) + (p - on_line);
                 on_edge[edge.edge as usize].push(out.positions.len() as u32);
                 out.positions.push(p);
                 out.sample_positions.push(sample);

@@ -1009,7 +1009,7 @@ mod tests {
     fn the_locator_finds_what_the_search_of_every_element_finds() {
         use super::{point_source, Locator, SampleSource};
         use crate::testutil::{grey, polygon, regular_mesh, scene, Xorshift};
-        // A 40-gon, fanned and subdivided: slivers around a centre.
+        // A 40-gon, meshed as a rim and lattice: elements of many shapes.
         let disc: Vec<[f32; 3]> = (0..40)
             .map(|k| {
                 let a = -std::f32::consts::TAU * k as f32 / 40.0;
@@ -1028,6 +1028,7 @@ mod tests {
             points.push(glam::Vec3::new(x, 1e-4 * (rng.unit_f32() - 0.5), z));
         }
         let mut inside = 0;
+        let total = points.len();
         for p in points {
             let found = point_source(&mesh, pm, p);
             inside += matches!(found, SampleSource::Triangle(_, w) if w.iter().all(|&x| x >= 0.0))
@@ -1035,7 +1036,7 @@ mod tests {
             assert_eq!(locator.source(&mesh, pm, p), found, "at {p}");
         }
         // Most points are inside the disc, so the grid answered them.
-        assert!(inside > 1500, "{inside} points inside");
+        assert!(2 * inside > total, "{inside} of {total} points inside");
     }
 
     /// A shot sends, per channel, its sign's part beyond what the point
