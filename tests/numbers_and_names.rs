@@ -61,9 +61,10 @@ fn the_points_file_is_read_once() {
     assert!(made.success());
     let writer = std::thread::spawn(move || {
         // Blocks until the run opens the pipe; one reading only. A run
-        // that refuses the pipe never opens it: then the test's end opens
-        // it to let this thread go.
-        std::fs::write(&fifo, "x,y,z,nx,ny,nz\n0,0.5,0,0,1,0\n").unwrap();
+        // that refuses the pipe may close it first (the write then fails)
+        // or never open it: then the test's end opens it to let this
+        // thread go.
+        let _ = std::fs::write(&fifo, "x,y,z,nx,ny,nz\n0,0.5,0,0,1,0\n");
     });
     let mut child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
         .current_dir(dir.path())
@@ -106,11 +107,22 @@ fn the_points_file_is_read_once() {
         .unwrap()
         .read_to_string(&mut err)
         .unwrap();
-    if !writer.is_finished() {
-        // Unblock the writer: open the pipe for reading and drop it.
-        let _ = std::fs::read(dir.path().join("pts.csv"));
+    // Unblock a writer still waiting for a reader: open the pipe for
+    // reading without blocking (a blocking open would wait for ever if
+    // the writer finished in between), until it is done.
+    while !writer.is_finished() {
+        use std::os::unix::fs::OpenOptionsExt;
+        if let Ok(mut pipe) = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(dir.path().join("pts.csv"))
+        {
+            let _ = pipe.read_to_end(&mut Vec::new());
+        }
+        std::thread::sleep(Duration::from_millis(10));
     }
-    writer.join().unwrap();
+    // The writer may fail once the run has refused the pipe and closed it.
+    let _ = writer.join();
     let status = status.expect("the run waited for a second reading of the points pipe");
     if status.success() {
         let csv = std::fs::read_to_string(dir.path().join("e.csv")).unwrap();

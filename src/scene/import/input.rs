@@ -220,7 +220,7 @@ pub enum InputError {
     /// climbing out with `..`) and that is not allowed.
     #[error(
         "refusing to read the {} `{name}`: it lies outside the model's folder {} (an absolute \
-         path, or one climbing out with `..`); --allow-outside-paths reads it",
+         path, one climbing out with `..`, or a link to outside); --allow-outside-paths reads it",
         kind.name(),
         folder_name(folder)
     )]
@@ -309,11 +309,9 @@ pub fn read_file(path: &Path, kind: InputKind) -> Result<(Vec<u8>, InputFile), I
         kind,
         error,
     };
-    // Looked up before opening: opening a FIFO blocks until a writer comes.
-    let meta = std::fs::metadata(path).map_err(io_error)?;
-    check_file(path, &meta, kind)?;
-    let file = File::open(path).map_err(io_error)?;
-    // Checked again on what was opened, in case the name changed hands.
+    let file = open(path).map_err(io_error)?;
+    // What was opened is what is checked: no name lookup between the
+    // check and the read for another file to take its place.
     let meta = file.metadata().map_err(io_error)?;
     check_file(path, &meta, kind)?;
     let cap = kind.max_bytes();
@@ -342,9 +340,24 @@ pub fn check_readable(path: &Path, kind: InputKind) -> Result<(), InputError> {
         kind,
         error,
     };
-    let meta = std::fs::metadata(path).map_err(io_error)?;
-    check_file(path, &meta, kind)?;
-    File::open(path).map(drop).map_err(io_error)
+    let file = open(path).map_err(io_error)?;
+    let meta = file.metadata().map_err(io_error)?;
+    check_file(path, &meta, kind)
+}
+
+/// Opens `path` for reading without blocking: a FIFO opens at once (and
+/// is then refused as not a regular file) instead of waiting for a
+/// writer, a device without waiting for a carrier. Reads from a regular
+/// file are the same either way.
+fn open(path: &Path) -> io::Result<File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    options.open(path)
 }
 
 /// The files a run reads, with their identities, and whether models may
@@ -483,8 +496,28 @@ impl<'a> ModelFolder<'a> {
 }
 
 /// True when `path` is `dir` joined to a relative path that never climbs
-/// above `dir` (`a/../b` stays inside, `../b` and `/b` do not).
+/// above `dir` (`a/../b` stays inside, `../b` and `/b` do not), and, when
+/// it exists, its real path (symbolic links followed) lies below `dir`'s
+/// real path: a link inside the folder to `/etc/passwd` is outside.
 fn stays_inside(dir: &Path, path: &Path) -> bool {
+    if !stays_inside_as_written(dir, path) {
+        return false;
+    }
+    // The empty folder is the working directory.
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    match (dir.canonicalize(), path.canonicalize()) {
+        (Ok(dir), Ok(path)) => path.starts_with(dir),
+        // Missing: the read that follows says so.
+        _ => true,
+    }
+}
+
+/// [`stays_inside`] by the components of `path` as written.
+fn stays_inside_as_written(dir: &Path, path: &Path) -> bool {
     let Ok(rest) = path.strip_prefix(dir) else {
         return false;
     };
@@ -609,6 +642,26 @@ mod tests {
         // A model in the working directory.
         assert!(stays_inside(Path::new(""), Path::new("a.mtl")));
         assert!(!stays_inside(Path::new(""), Path::new("../a.mtl")));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_inside_the_folder_to_outside_is_outside() {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::write(root.path().join("secret"), b"secret bytes").unwrap();
+        let dir = root.path().join("model");
+        std::fs::create_dir(&dir).unwrap();
+        std::fs::write(dir.join("real.png"), b"png").unwrap();
+        std::os::unix::fs::symlink(root.path().join("secret"), dir.join("out.png")).unwrap();
+        std::os::unix::fs::symlink(dir.join("real.png"), dir.join("in.png")).unwrap();
+        assert!(!stays_inside(&dir, &dir.join("out.png")));
+        assert!(stays_inside(&dir, &dir.join("in.png")));
+        assert!(stays_inside(&dir, &dir.join("real.png")));
+        // A folder reached through a link is still itself.
+        std::os::unix::fs::symlink(&dir, root.path().join("alias")).unwrap();
+        let alias = root.path().join("alias");
+        assert!(stays_inside(&alias, &alias.join("real.png")));
+        assert!(!stays_inside(&alias, &alias.join("out.png")));
     }
 
     #[test]
