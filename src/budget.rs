@@ -130,6 +130,13 @@ impl MemoryBudget {
     pub fn fits(&self, need: u64) -> bool {
         need <= self.bytes
     }
+
+    /// The most elements, each with a vertex of its own, that fit besides
+    /// the base of a run ([`run_bytes`] of no polygons): the limit an
+    /// adaptive refinement grows the mesh to.
+    pub fn elements_within(&self) -> u64 {
+        self.bytes.saturating_sub(BASE_BYTES) / (BYTES_PER_ELEMENT + BYTES_PER_VERTEX)
+    }
 }
 
 /// The machine's default budget: the least of three quarters of the

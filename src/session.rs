@@ -47,7 +47,8 @@ pub struct SessionOptions {
     /// Refine and continue after each converged pass, or `None` to solve
     /// the prepared mesh only.
     pub refine: Option<RefineOptions>,
-    /// The run's element limit: a refinement is refused (with
+    /// The run's element limit (the smaller of `--max-elements` and the
+    /// elements `--max-memory` holds): a refinement is refused (with
     /// [`Event::Refused`]) before its mesh would have more elements than
     /// this or than [`RefineOptions::max_elements`], whichever is smaller.
     pub max_elements: u64,
@@ -64,7 +65,8 @@ impl SessionOptions {
         SessionOptions {
             solver: config.solver,
             refine: config.adaptive,
-            max_elements: config.max_elements,
+            // Refinement stops where the memory budget would, too.
+            max_elements: config.max_elements.min(config.max_memory.elements_within()),
             ambient: config.ambient.unwrap_or(ambient_default),
         }
     }

@@ -516,7 +516,7 @@ fn adaptive_refinement_respects_max_elements() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("refining no further")
-            && stderr(&out).contains("--max-elements 1100"),
+            && stderr(&out).contains("over the limit of 1100 (--max-elements"),
         "{}",
         stderr(&out)
     );

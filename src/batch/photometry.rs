@@ -32,7 +32,7 @@ pub fn check(
 ) -> Result<Option<Vec<MeasurementPoint>>, RunError> {
     let p = &config.photometry;
     let points = match &p.illuminance {
-        Some((at, _)) => Some(points::load_points(at)?),
+        Some((at, _)) => Some(points::load_points_within(at, &config.max_memory)?),
         None => None,
     };
     if let Some(w) = &p.workplane {

@@ -14,6 +14,7 @@
 //! Blanks around values are allowed.
 
 use super::input::{read_file, InputError, InputKind};
+use crate::budget::{fmt_count, MemoryBudget};
 use crate::scene::error::fmt_num;
 use crate::scene::MAX_COORDINATE;
 use glam::{DVec3, Vec3};
@@ -36,8 +37,22 @@ pub struct PointsError {
 /// One measurement point: a position in scene units and a unit normal.
 pub type MeasurementPoint = (Vec3, Vec3);
 
-/// Reads the points file at `path` (see the module docs).
+/// Bytes a measurement point takes from its reading to its result: the
+/// point itself, its irradiance and the CSV row written for it.
+pub const BYTES_PER_POINT: u64 = 128;
+
+/// Reads the points file at `path` (see the module docs), under no memory
+/// budget.
 pub fn load_points(path: &Path) -> Result<Vec<MeasurementPoint>, PointsError> {
+    load_points_within(path, &MemoryBudget::UNLIMITED)
+}
+
+/// Reads the points file at `path`, refusing it before parsing when its
+/// text and a point per line would not fit `budget`.
+pub fn load_points_within(
+    path: &Path,
+    budget: &MemoryBudget,
+) -> Result<Vec<MeasurementPoint>, PointsError> {
     let name = path.display().to_string();
     let cannot = |message: String| PointsError {
         file: name.clone(),
@@ -51,6 +66,13 @@ pub fn load_points(path: &Path) -> Result<Vec<MeasurementPoint>, PointsError> {
             refused => refused.to_string(),
         })
     })?;
+    let lines = bytes.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+    let need = (bytes.len() as u64).saturating_add(lines.saturating_mul(BYTES_PER_POINT));
+    budget
+        .check(need, || {
+            format!("{} lines of measurement points", fmt_count(lines))
+        })
+        .map_err(|over| cannot(over.to_string()))?;
     let text = String::from_utf8(bytes).map_err(|_| {
         cannot("cannot read the points file: stream did not contain valid UTF-8".to_string())
     })?;
