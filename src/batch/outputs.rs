@@ -149,7 +149,15 @@ fn check_against(config: &RunConfig, inputs: &[InputFile]) -> Result<(), RunErro
                 ));
             }
         }
-        if let Some(input) = inputs.iter().find(|input| input.is(out)) {
+        // A resumed solve goes on saving to the checkpoint it resumed
+        // from: the one output that may be an input, as the state is
+        // read whole before the first save replaces it.
+        let updates_its_checkpoint =
+            |input: &&InputFile| *option == "--checkpoint" && input.kind == InputKind::Checkpoint;
+        if let Some(input) = inputs
+            .iter()
+            .find(|input| input.is(out) && !updates_its_checkpoint(input))
+        {
             let also = if input.path == *out {
                 String::new()
             } else {
