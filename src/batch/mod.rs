@@ -391,7 +391,7 @@ pub fn run_prepared(
     // Not when nothing emits: the load warning has said why already.
     let dark =
         render::PictureCoverage::of(drawn.rasterizer.frame(), drawn.rasterizer.front_faces())
-            .dark_warning()
+            .dark_warning_with(|| prepared.scene.eye_outside_lights(view.eye()))
             .filter(|_| prepared.scene.emits())
             .map(|w| format!("warning: {w}"));
     if let Some(line) = &dark {
