@@ -69,8 +69,7 @@ pub const FRAME_INTERVAL: Duration = Duration::from_millis(16);
 /// a new solution once this many times its last drawing's time has
 /// passed.
 const PUBLISH_SHARE: u32 = 4;
-/// Radians of orbit per pixel of mouse drag.
-pub const ORBIT_PER_PIXEL: f32 = 0.008;
+pub use controls::ORBIT_PER_PIXEL;
 
 /// Radians the view turns per pixel of left-drag when looking around: a
 /// drag across a 640-pixel window turns it by about 100 degrees.
@@ -232,7 +231,10 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
         let mut ui = Ui {
             prepared,
             window: &mut window,
-            camera: CameraControl::new(home),
+            camera: {
+                let (lo, hi) = prepared.scene.bounds();
+                CameraControl::new(home).within(lo, hi)
+            },
             exposure: config.exposure,
             exposure_scale: 1.0,
             show_mesh: false,
@@ -769,8 +771,8 @@ impl<'a> Ui<'a> {
                 self.camera.look(-dx * LOOK_PER_PIXEL, -dy * LOOK_PER_PIXEL);
             } else if motion.buttons.left {
                 let pivot = self.pivot.unwrap_or(self.camera.camera().lookat);
-                self.camera
-                    .orbit_about(pivot, -dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
+                let k = self.camera.orbit_per_pixel(pivot);
+                self.camera.orbit_about(pivot, -dx * k, dy * k);
             } else if let Some(target) = self.pivot {
                 // Drag up moves towards the point, down away.
                 let stop = self.zoom_stop();
