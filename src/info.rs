@@ -91,13 +91,19 @@ fn report(config: &RunConfig, ready: &ReadyScene) -> String {
         fmt_value(size.z),
         fmt_value(scene.extent())
     );
-    let source = match (scene.camera_source, config.camera_override.is_empty()) {
-        (CameraSource::File, true) => "from the file",
-        (CameraSource::AutoFramed, true) => "automatic",
-        (CameraSource::File, false) => "from the file, changed by the options",
-        (CameraSource::AutoFramed, false) => "automatic, changed by the options",
+    let mut camera = scene.camera;
+    if let Some((width, height)) = config.size {
+        camera.width = width;
+        camera.height = height;
+    }
+    let changed = !config.camera_override.is_empty() || config.size.is_some();
+    let source = match (scene.camera_source, changed) {
+        (CameraSource::File, false) => "from the file",
+        (CameraSource::AutoFramed, false) => "automatic",
+        (CameraSource::File, true) => "from the file, changed by the options",
+        (CameraSource::AutoFramed, true) => "automatic, changed by the options",
     };
-    let _ = writeln!(out, "camera ({source}): {}", options_text(&scene.camera));
+    let _ = writeln!(out, "camera ({source}): {}", options_text(&camera));
     let lenmax = ready.mesh_options.lenmax;
     let which = if config.lenmax.is_some() {
         "given by --lenmax"

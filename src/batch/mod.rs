@@ -501,24 +501,23 @@ fn draw(
     cancel: &Cancel,
 ) -> Result<Drawn, RunError> {
     // Rendered at `aa × aa` samples a pixel, averaged to the picture.
-    let aa = antialias::factor_for(view.width(), view.height(), config.aa);
+    let camera = crate::camera::Camera {
+        width: view.width(),
+        height: view.height(),
+        ..prepared.scene.camera
+    };
     let mut rasterizer = Rasterizer::new();
-    if aa > 1 {
-        let fine = View::with_size(
-            &prepared.scene.camera,
-            view.width() * aa,
-            view.height() * aa,
-        )?;
-        rasterizer.render_cancellable(mesh, shown, &fine, cancel)?;
-    } else {
-        rasterizer.render_cancellable(mesh, shown, view, cancel)?;
-    }
-    cancel.check().map_err(RenderError::Cancelled)?;
-    let downsampled = (aa > 1).then(|| antialias::downsample(rasterizer.frame(), aa));
+    let drawn =
+        antialias::draw(&mut rasterizer, mesh, shown, &camera, config.aa, cancel).map_err(|e| {
+            match e {
+                antialias::DrawError::View(e) => RunError::View(e),
+                antialias::DrawError::Render(e) => RunError::Render(e),
+            }
+        })?;
     Ok(Drawn {
         rasterizer,
-        aa,
-        downsampled,
+        aa: drawn.aa,
+        downsampled: drawn.downsampled,
     })
 }
 
