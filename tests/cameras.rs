@@ -430,3 +430,48 @@ fn info_reads_every_bundled_scene_and_a_downloaded_model() {
     assert!(text.contains("groups (7): floor (1 polygon)"), "{text}");
     assert_eq!(common::listing(dir.path()), Vec::<String>::new());
 }
+
+#[test]
+fn the_ambient_term_does_not_light_up_a_view_of_unlit_walls() {
+    let dir = tempfile::tempdir().unwrap();
+    write_room(dir.path());
+    // Outside the lit room, looking at its walls, with the ambient term
+    // shown as the window shows it: exposed for the ambient term alone,
+    // the walls came out a bright, flat salmon (mean 174 of 255 on them).
+    write(
+        dir.path(),
+        "outside.sc",
+        "camera\n  eye 0 10 -20\n  lookat 0 1 0\nend\n",
+    );
+    let out = run_in(
+        dir.path(),
+        &[
+            "room.obj",
+            "--emit",
+            "Lamp=10",
+            "--camera",
+            "outside.sc",
+            "--ambient",
+            "--max-steps",
+            "5",
+            "--size",
+            "64x48",
+            "-q",
+            "-o",
+            "x.png",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(dir.path().join("x.png")).unwrap().to_rgb8();
+    let walls: Vec<f64> = img
+        .pixels()
+        .filter(|p| p.0.iter().any(|&c| c > 0))
+        .map(|p| p.0.iter().map(|&c| f64::from(c)).sum::<f64>() / 3.0)
+        .collect();
+    assert!(walls.len() > 100, "{} pixels of wall", walls.len());
+    let mean = walls.iter().sum::<f64>() / walls.len() as f64;
+    assert!(
+        mean < 90.0,
+        "the unlit walls are bright: mean {mean} of 255"
+    );
+}

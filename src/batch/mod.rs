@@ -402,8 +402,17 @@ pub fn run_prepared(
         return Err(written.interrupted(config, totals.steps, true));
     }
     let t = Instant::now();
-    // Resolved once, so the picture and the exported colours agree.
-    let exposure = config.exposure.resolve(frame);
+    // Resolved once, so the picture and the exported colours agree; with
+    // the ambient term shown (--ambient), as the window does.
+    let exposure = match config.exposure {
+        Exposure::Auto if session.options().ambient && totals.steps > 0 => {
+            let (w, h) = render::exposure_probe_size(view.width(), view.height());
+            let probe = View::with_size(&prepared.scene.camera, w, h)?;
+            let mut alone = Rasterizer::new();
+            render::auto_exposure_beside(frame, alone.render(mesh, &solved.radiosity, &probe)?)
+        }
+        exposure => exposure.resolve(frame),
+    };
     if cancel.is_set() {
         return Err(written.interrupted(config, totals.steps, true));
     }

@@ -187,6 +187,10 @@ struct Progress<'p> {
     /// publication.
     mesh: Option<MeshRef<'p>>,
     radiosity: Vec<Rgb>,
+    /// The solution alone (without the ambient term) when
+    /// [`Progress::radiosity`] shows the ambient term, published with it
+    /// from the first step on; empty before, and without the ambient term.
+    solution: Vec<Rgb>,
     step: u64,
     unshot_fraction: f64,
     rays: u64,
@@ -270,6 +274,8 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
             writes: Vec::new(),
             buffer: vec![0; w * h],
             radiosity: Vec::new(),
+            solution: Vec::new(),
+            probe: Rasterizer::new(),
             mesh: None,
             pointer: Pointer::default(),
             written: 0,
@@ -371,6 +377,9 @@ fn solve_in_background<'p>(
                 if session.pass() == 1 && due {
                     let t = Instant::now();
                     session.shown(&mut p.radiosity);
+                    if session.options().ambient {
+                        session.solution(&mut p.solution);
+                    }
                     publishing = t.elapsed();
                     published = Instant::now();
                 }
@@ -382,6 +391,9 @@ fn solve_in_background<'p>(
             Ok(Event::Stopped(reason)) => {
                 stopped = Some(reason);
                 session.shown(&mut p.radiosity);
+                if session.options().ambient && session.totals().steps > 0 {
+                    session.solution(&mut p.solution);
+                }
                 p.mesh = Some(session.mesh_ref());
             }
             Ok(Event::Refined(_)) => {
@@ -451,6 +463,12 @@ struct Ui<'a> {
     writes: Vec<Writing>,
     buffer: Vec<u32>,
     radiosity: Vec<Rgb>,
+    /// The solution without the ambient term, per vertex of the same mesh
+    /// (see [`Progress::solution`]), for the exposure.
+    solution: Vec<Rgb>,
+    /// Draws the solution alone, small, for the automatic exposure
+    /// ([`render::auto_exposure_beside`]).
+    probe: Rasterizer,
     /// The mesh [`Ui::radiosity`] belongs to (`None`: nothing published
     /// yet).
     mesh: Option<MeshRef<'a>>,
@@ -555,6 +573,7 @@ impl<'a> Ui<'a> {
                 let t = Instant::now();
                 if let Ok(p) = progress.lock() {
                     self.radiosity.clone_from(&p.radiosity);
+                    self.solution.clone_from(&p.solution);
                     self.mesh.clone_from(&p.mesh);
                 }
                 shown_version = version;
@@ -627,7 +646,19 @@ impl<'a> Ui<'a> {
             &mut self.first_look,
         );
         let frame = self.rasterizer.render(mesh, radiosity, &view)?;
-        let exposure = self.exposure.resolve(frame) * self.exposure_scale;
+        // Once light has been shot, the ambient term brightens the picture
+        // but does not set its exposure (before, it is all there is).
+        let beside = self.solution.len() == radiosity.len();
+        let exposure = match self.exposure {
+            Exposure::Auto if beside => {
+                let camera = self.camera.camera();
+                let (pw, ph) = render::exposure_probe_size(view.width(), view.height());
+                let probe = View::with_size(camera, pw, ph)?;
+                let alone = self.probe.render(mesh, &self.solution, &probe)?;
+                render::auto_exposure_beside(frame, alone)
+            }
+            exposure => exposure.resolve(frame),
+        } * self.exposure_scale;
         self.exposure_used = exposure;
         self.picture = render::to_srgb8(frame, exposure);
         if self.show_mesh {
