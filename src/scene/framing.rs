@@ -471,7 +471,8 @@ impl Scene {
     }
 
     /// True when `eye` stands outside a closed surface that holds the
-    /// lights: the rays from some light ([`Scene::light_points`]) nearly
+    /// lights: the rays from some light (a point just in front of one of
+    /// the [`LIGHTS_PROBED`] most powerful emitting polygons) nearly
     /// all hit a surface (as a room's do, [`ROOM_MIN_FRONT_FRACTION`]) and
     /// those from the eye do not. A camera there sees the unlit outside of
     /// the room, or nothing.
