@@ -12,9 +12,20 @@
 //!   the orthonormal camera frame and is what the renderer's `View` is made
 //!   from;
 //! - the picture-size limits ([`MAX_PICTURE_SIDE`], [`MAX_PICTURE_PIXELS`],
-//!   [`picture_size_ok`]).
+//!   [`picture_size_ok`]);
+//! - [`CameraOverride`] (`adjust.rs`), the parts of a camera the command
+//!   line replaces (`--eye`, `--look-at`, `--up`, `--fov`);
+//! - the camera written out to be used again (`print.rs`): as those
+//!   options ([`options_text`]) and as a `.sc` `camera` block
+//!   ([`sc_block`]), both reading back to the same camera, bit for bit.
 //!
 //! It imports nothing from the renderer or the scene, so both may use it.
+
+mod adjust;
+mod print;
+
+pub use adjust::{CameraOverride, OverrideError};
+pub use print::{fmt_fov_deg, fmt_point, fmt_value, options_text, sc_block};
 
 use glam::Vec3;
 use thiserror::Error;

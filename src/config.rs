@@ -85,6 +85,10 @@ pub struct RunConfig {
     pub stats: Option<PathBuf>,
     /// A `.sc` file whose `camera` block replaces the scene's camera.
     pub camera: Option<PathBuf>,
+    /// `--eye`, `--look-at`, `--up`, `--fov`: parts of the camera that
+    /// replace those of the scene's (its own, [`RunConfig::camera`]'s or
+    /// the automatic one); empty by default.
+    pub camera_override: crate::camera::CameraOverride,
     /// Where to write the solved mesh (`.glb` or `.ply`), if anywhere.
     pub export: Option<PathBuf>,
     /// Where to write the per-step CSV log, if anywhere.
@@ -204,6 +208,7 @@ impl RunConfig {
             stats: None,
             progress: false,
             camera: None,
+            camera_override: crate::camera::CameraOverride::default(),
             export: None,
             log: None,
             plot: None,

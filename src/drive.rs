@@ -26,6 +26,10 @@ pub fn run(
     let config = &invocation.config;
     match invocation.mode {
         Mode::Batch => batch(config, None, cancel, arm_cancel),
+        Mode::Info => {
+            print!("{}", crate::info::describe(config)?);
+            Ok(None)
+        }
         Mode::Window => {
             // Says why the picture goes to a file instead of a window.
             let fallback = |why: &str| {

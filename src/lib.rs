@@ -9,6 +9,7 @@ pub mod cli;
 pub mod color;
 pub mod config;
 pub mod drive;
+pub mod info;
 pub mod mesh;
 pub mod output;
 pub mod prepare;

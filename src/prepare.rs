@@ -70,6 +70,10 @@ pub enum PrepareError {
     /// ([`prepare_cancellable`]).
     #[error("{0}")]
     Interrupted(#[from] Cancelled),
+    /// `--eye`, `--look-at`, `--up` or `--fov` make an unusable camera
+    /// with the scene's other parts; the message names the options.
+    #[error("{0}")]
+    Camera(#[from] crate::camera::OverrideError),
 }
 
 /// Seconds spent in each phase of a run.
@@ -180,12 +184,39 @@ pub fn prepare_deferred(config: &RunConfig) -> Result<Prepared, PrepareError> {
     prepare_deferred_cancellable(config, &Cancel::never())
 }
 
-/// [`prepare_deferred`] checking `cancel` as [`prepare_cancellable`] does.
-fn prepare_deferred_cancellable(
-    config: &RunConfig,
-    cancel: &Cancel,
-) -> Result<Prepared, PrepareError> {
-    let mut seconds = PhaseSeconds::default();
+/// A scene made ready to mesh ([`ready_to_mesh`]): loaded, lit as the
+/// options say, repaired, its camera final and its mesh options chosen;
+/// what `--info` describes and what [`prepare`] meshes.
+pub struct ReadyScene {
+    /// The scene after the repair passes, with its warnings (the loader's,
+    /// the passes', nothing emitting, a coarsened default lenmax), not yet
+    /// printed.
+    pub scene: Scene,
+    /// What splitting along intersections did.
+    pub split: SplitStats,
+    /// The mesh options: `--lenmax` or the default within the vertex
+    /// budget, and `--inset`.
+    pub mesh_options: MeshOptions,
+    /// Every file the run reads (see [`Prepared::inputs`]).
+    pub inputs: InputSet,
+    /// The BVH the repair passes built, and the seconds it took.
+    rays: Option<(Visibility, f64)>,
+    /// Seconds of loading and repairing (the BVH's not counted) and of
+    /// choosing the mesh options.
+    load_seconds: f64,
+    options_seconds: f64,
+}
+
+/// Loads the scene and makes it ready to mesh: `--emit`, `--ies`, the
+/// repair passes, the camera (moved inside the room that holds the lights
+/// when it was framed outside it, then `--eye`, `--look-at`, `--up` and
+/// `--fov`), the mesh options. Prints nothing.
+pub fn ready_to_mesh(config: &RunConfig) -> Result<ReadyScene, PrepareError> {
+    ready_cancellable(config, &Cancel::never())
+}
+
+/// [`ready_to_mesh`] checking `cancel` between its phases.
+fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, PrepareError> {
     let t = Instant::now();
     let inputs = declared_inputs(config);
     let mut scene = load_scene(
@@ -231,16 +262,14 @@ fn prepare_deferred_cancellable(
             RepairError::Memory(e) => PrepareError::Memory(e),
             RepairError::Interrupted(c) => PrepareError::Interrupted(c),
         })?;
-    let split = repaired.split;
-    let visibility = OnceLock::new();
-    if let Some(built) = repaired.rays {
-        // Set once, here, before anyone can read it.
-        let _ = visibility.set((built, bvh_seconds));
-    }
     if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
         scene.warnings.push(warning);
     }
-    seconds.load = t.elapsed().as_secs_f64() - bvh_seconds;
+    // Once the lights are set and the back sides made: an automatic
+    // camera outside the room that holds the lights goes in.
+    scene.frame_inside_lights();
+    scene.camera = config.camera_override.apply(&scene.camera)?;
+    let load_seconds = t.elapsed().as_secs_f64() - bvh_seconds;
 
     let t = Instant::now();
     let mut mesh_options = match config.lenmax {
@@ -259,7 +288,40 @@ fn prepare_deferred_cancellable(
         }
     };
     mesh_options.inset = config.inset;
-    let options_seconds = t.elapsed().as_secs_f64();
+    Ok(ReadyScene {
+        scene,
+        split: repaired.split,
+        mesh_options,
+        inputs,
+        rays: repaired.rays.map(|built| (built, bvh_seconds)),
+        load_seconds,
+        options_seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// [`prepare_deferred`] checking `cancel` as [`prepare_cancellable`] does.
+fn prepare_deferred_cancellable(
+    config: &RunConfig,
+    cancel: &Cancel,
+) -> Result<Prepared, PrepareError> {
+    let ReadyScene {
+        scene,
+        split,
+        mesh_options,
+        inputs,
+        rays,
+        load_seconds,
+        options_seconds,
+    } = ready_cancellable(config, cancel)?;
+    let mut seconds = PhaseSeconds {
+        load: load_seconds,
+        ..PhaseSeconds::default()
+    };
+    let visibility = OnceLock::new();
+    if let Some(built) = rays {
+        // Set once, here, before anyone can read it.
+        let _ = visibility.set(built);
+    }
     // Said before the solve, whatever `--quiet` says: a warning explains a
     // picture that is not what the user expected (a coarser mesh too).
     for warning in &scene.warnings {

@@ -153,7 +153,13 @@ fn open_cornell(dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
 /// 160×120 window in `dir` on `display` with `extra` arguments, and waits
 /// for its window. Returns the program (stdout piped) and the window's id.
 fn open_scene(name: &str, dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
-    let scene = common::scene(&format!("{name}.sc"));
+    open_file(&common::scene(&format!("{name}.sc")), dir, display, extra)
+}
+
+/// [`open_scene`] for the scene file `scene`, its window found by the
+/// file's stem.
+fn open_file(scene: &Path, dir: &Path, display: &str, extra: &[&str]) -> (Reaper, String) {
+    let name = scene.file_stem().unwrap().to_str().unwrap().to_string();
     let mut args = vec![scene.to_str().unwrap(), "--size", "160x120"];
     args.extend_from_slice(extra);
     let child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
@@ -428,10 +434,118 @@ fn looking_around_stays_in_every_bundled_room_and_the_panel_toggles() {
             .map(|(x, y, _)| (x, y))
             .collect();
         assert!(differ.len() > 200, "{name}: the panel is not on the screen");
+        // Four lines at most: the solve, the exposure and mesh, the keys,
+        // and what the last key did (here `w`'s file).
         assert!(
-            differ.iter().all(|&(x, y)| x < 160 && y < 60),
+            differ.iter().all(|&(x, y)| x < 160 && y < 64),
             "{name}: the screen differs from the picture outside the panel"
         );
         assert_eq!(bare, picture, "{name}: i hides the panel");
     }
+}
+
+/// `c` prints the camera as options and as a `.sc` block, Shift+C saves
+/// it next to the scene (a second press under a new name), and `f` writes
+/// the view at `--aa` samples a pixel: the same view and exposure as `w`'s
+/// picture, with smoother edges. The saved camera renders the same view.
+#[test]
+fn camera_keys_print_and_save_the_view_and_f_writes_it_at_full_quality() {
+    // A failed test poisons the lock; the next one may still run.
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let Some((_xvfb, display)) = x_server() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("box.sc");
+    std::fs::copy(common::scene("cornell.sc"), &scene).unwrap();
+    let (mut program, window) = open_file(
+        &scene,
+        dir.path(),
+        &display,
+        &["--lenmax", "80", "--max-steps", "4", "--aa", "3"],
+    );
+    wait_for(Duration::from_secs(60), || {
+        let title = xdotool(&display, &["getwindowname", &window])?;
+        title.contains("step limit").then_some(())
+    })
+    .expect("the solve reaches its step limit");
+    xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus");
+    xdotool(&display, &["key", "c"]).expect("key c");
+    xdotool(&display, &["key", "shift+c"]).expect("key C");
+    let saved = dir.path().join("box-camera.sc");
+    wait_for(Duration::from_secs(10), || saved.exists().then_some(()))
+        .expect("Shift+C saves box-camera.sc next to the scene");
+    xdotool(&display, &["key", "shift+c"]).expect("key C");
+    let again = dir.path().join("box-camera-2.sc");
+    wait_for(Duration::from_secs(10), || again.exists().then_some(()))
+        .expect("a second Shift+C saves box-camera-2.sc");
+    xdotool(&display, &["key", "f"]).expect("key f");
+    let full = read_written(&dir.path().join("box-001.png"));
+    xdotool(&display, &["key", "w"]).expect("key w");
+    let plain = read_written(&dir.path().join("box-002.tiff"));
+    quit(&display, &mut program);
+    let mut stdout = String::new();
+    use std::io::Read;
+    program
+        .0
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
+
+    // The printed options and block, and the saved file, are one camera.
+    let options = stdout
+        .lines()
+        .skip_while(|l| *l != "camera, as options:")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no camera printed: {stdout}"))
+        .trim()
+        .to_string();
+    assert!(
+        options.starts_with("--eye ") && options.ends_with("--size 160x120"),
+        "{options}"
+    );
+    assert!(stdout.contains("camera\n  eye "), "{stdout}");
+    assert!(
+        stdout.contains(&format!("wrote {}", saved.display())),
+        "{stdout}"
+    );
+    let info = common::run_in(
+        dir.path(),
+        &["box.sc", "--camera", saved.to_str().unwrap(), "--info"],
+    );
+    let info = String::from_utf8(info.stdout).unwrap();
+    assert!(
+        info.contains(&format!("camera (from the file): {options}\n")),
+        "{options}\n{info}"
+    );
+    let words: Vec<&str> = options.split_whitespace().collect();
+    let mut args = vec!["box.sc", "--info"];
+    args.extend_from_slice(&words);
+    let info = common::run_in(dir.path(), &args);
+    let info = String::from_utf8(info.stdout).unwrap();
+    assert!(
+        info.contains(&format!("): {options}\n")),
+        "{options}\n{info}"
+    );
+
+    // `f`: the window's size, the same picture as `w`'s but for its edges.
+    assert_eq!((full.width(), full.height()), (160, 120));
+    let diffs: Vec<i32> = full
+        .as_raw()
+        .iter()
+        .zip(plain.as_raw())
+        .map(|(&a, &b)| (i32::from(a) - i32::from(b)).abs())
+        .collect();
+    let changed = diffs.iter().filter(|&&d| d > 0).count();
+    let mean = diffs.iter().sum::<i32>() as f64 / diffs.len() as f64;
+    assert!(
+        changed > 100,
+        "f drew the same pixels as w ({changed} differ)"
+    );
+    assert!(
+        mean < 6.0,
+        "f's picture is not w's view: mean difference {mean}"
+    );
 }

@@ -391,7 +391,7 @@ pub fn run_prepared(
     // Not when nothing emits: the load warning has said why already.
     let dark =
         render::PictureCoverage::of(drawn.rasterizer.frame(), drawn.rasterizer.front_faces())
-            .dark_warning()
+            .dark_warning_with(|| prepared.scene.eye_outside_lights(view.eye()))
             .filter(|_| prepared.scene.emits())
             .map(|w| format!("warning: {w}"));
     if let Some(line) = &dark {
@@ -402,8 +402,17 @@ pub fn run_prepared(
         return Err(written.interrupted(config, totals.steps, true));
     }
     let t = Instant::now();
-    // Resolved once, so the picture and the exported colours agree.
-    let exposure = config.exposure.resolve(frame);
+    // Resolved once, so the picture and the exported colours agree; with
+    // the ambient term shown (--ambient), as the window does.
+    let exposure = match config.exposure {
+        Exposure::Auto if session.options().ambient && totals.steps > 0 => {
+            let (w, h) = render::exposure_probe_size(view.width(), view.height());
+            let probe = View::with_size(&prepared.scene.camera, w, h)?;
+            let mut alone = Rasterizer::new();
+            render::auto_exposure_beside(frame, alone.render(mesh, &solved.radiosity, &probe)?)
+        }
+        exposure => exposure.resolve(frame),
+    };
     if cancel.is_set() {
         return Err(written.interrupted(config, totals.steps, true));
     }
@@ -501,24 +510,23 @@ fn draw(
     cancel: &Cancel,
 ) -> Result<Drawn, RunError> {
     // Rendered at `aa × aa` samples a pixel, averaged to the picture.
-    let aa = antialias::factor_for(view.width(), view.height(), config.aa);
+    let camera = crate::camera::Camera {
+        width: view.width(),
+        height: view.height(),
+        ..prepared.scene.camera
+    };
     let mut rasterizer = Rasterizer::new();
-    if aa > 1 {
-        let fine = View::with_size(
-            &prepared.scene.camera,
-            view.width() * aa,
-            view.height() * aa,
-        )?;
-        rasterizer.render_cancellable(mesh, shown, &fine, cancel)?;
-    } else {
-        rasterizer.render_cancellable(mesh, shown, view, cancel)?;
-    }
-    cancel.check().map_err(RenderError::Cancelled)?;
-    let downsampled = (aa > 1).then(|| antialias::downsample(rasterizer.frame(), aa));
+    let drawn =
+        antialias::draw(&mut rasterizer, mesh, shown, &camera, config.aa, cancel).map_err(|e| {
+            match e {
+                antialias::DrawError::View(e) => RunError::View(e),
+                antialias::DrawError::Render(e) => RunError::Render(e),
+            }
+        })?;
     Ok(Drawn {
         rasterizer,
-        aa,
-        downsampled,
+        aa: drawn.aa,
+        downsampled: drawn.downsampled,
     })
 }
 

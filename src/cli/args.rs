@@ -6,8 +6,8 @@
 //! line `-h` shows, the whole comment is what `--help` shows.
 
 use super::values::{
-    parse_emit, parse_hemicube_res, parse_ies, parse_shooter_samples, parse_size, parse_sky,
-    parse_workplane,
+    parse_emit, parse_eye, parse_fov, parse_hemicube_res, parse_ies, parse_look_at,
+    parse_shooter_samples, parse_size, parse_sky, parse_up, parse_workplane,
 };
 use crate::color::Rgb;
 use crate::config;
@@ -446,6 +446,49 @@ pub struct Args {
     /// Default: the largest value, rounded up to 1, 2 or 5 times a power of 10.
     #[arg(long, value_name = "V")]
     pub(crate) falsecolor_max: Option<f64>,
+
+    // The camera from the command line and --info: kept together.
+    /// Camera position X,Y,Z in scene units (as Radiance's -vp).
+    ///
+    /// Replaces the eye of the scene's camera (its own, --camera's or the
+    /// automatic one) and keeps the rest: with --eye alone the camera
+    /// still looks at the same point. The window's `c` key prints the
+    /// current camera as these options.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_eye, allow_hyphen_values = true)]
+    pub(crate) eye: Option<glam::Vec3>,
+
+    /// The point the camera looks at, X,Y,Z in scene units.
+    ///
+    /// Radiance's -vd gives a direction instead: the look-at point is the
+    /// eye plus that direction.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_look_at, allow_hyphen_values = true)]
+    pub(crate) look_at: Option<glam::Vec3>,
+
+    /// The camera's up direction X,Y,Z (as Radiance's -vu).
+    ///
+    /// Need not be at right angles to the view, nor of unit length, but
+    /// must not be parallel to it. Default: the scene camera's (0,1,0 for
+    /// the automatic camera).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_up, allow_hyphen_values = true)]
+    pub(crate) up: Option<glam::Vec3>,
+
+    /// Vertical field of view in degrees, more than 0 and below 180.
+    ///
+    /// As Radiance's -vv (its -vh is the horizontal one).
+    #[arg(long, value_name = "DEG", value_parser = parse_fov, allow_hyphen_values = true)]
+    pub(crate) fov: Option<f32>,
+
+    /// Describe the scene and exit, without solving.
+    ///
+    /// Prints its materials, OBJ objects and groups, what emits, the
+    /// bounds, the camera (as --eye ... options), the default --lenmax,
+    /// the estimated element count and the warnings of loading, after
+    /// --emit, --sky and the sides options are applied.
+    #[arg(long, conflicts_with_all = [
+        "output", "export", "log", "plot", "stats", "checkpoint", "resume",
+        "falsecolor", "workplane", "illuminance_at", "mesh_lines", "no_window",
+    ])]
+    pub(crate) info: bool,
 }
 
 /// `--max-memory`: a size ([`crate::budget::parse_bytes`]) of at least

@@ -10,12 +10,14 @@
 
 use super::args::Args;
 use crate::budget::MemoryBudget;
+use crate::camera::{Camera, CameraOverride};
 use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
 use crate::render::Exposure;
 use crate::scene::Sides;
 use crate::solver::{Approximations, Heuristic, SolverOptions};
+use glam::Vec3;
 use std::num::NonZeroUsize;
 use std::time::Duration;
 
@@ -43,6 +45,9 @@ pub enum Mode {
     /// refuses), say why and run as [`Mode::Batch`] instead, writing
     /// `<scene>.png` in the current directory.
     Window,
+    /// `--info`: load the scene, apply the options that change it, print
+    /// what it holds and exit, without meshing or solving.
+    Info,
 }
 
 /// Everything one invocation of the program needs, validated.
@@ -103,6 +108,42 @@ pub enum UsageError {
     /// `--falsecolor-max` is not a positive finite number.
     #[error("--falsecolor-max must be a positive number, got {0}")]
     FalsecolorMax(f64),
+    /// `--eye`, `--look-at` and `--up` make no camera whatever the scene
+    /// (the eye on the look-at point, up along the view).
+    #[error("{0}")]
+    Camera(#[from] crate::camera::OverrideError),
+}
+
+/// The camera parts given on the command line, checked where they
+/// decide the camera alone: `--eye` and `--look-at` together, and with
+/// them `--up`. What they make with the scene's camera is checked once it
+/// is loaded ([`CameraOverride::apply`]).
+fn camera_override(args: &Args) -> Result<CameraOverride, UsageError> {
+    let given = CameraOverride {
+        eye: args.eye,
+        lookat: args.look_at,
+        up: args.up,
+        fov_deg: args.fov,
+    };
+    if let (Some(eye), Some(lookat)) = (given.eye, given.lookat) {
+        // Any up across the view stands for one not given.
+        let view = (lookat - eye).normalize_or_zero();
+        let across = if view.cross(Vec3::Y).length() > 0.5 {
+            Vec3::Y
+        } else {
+            Vec3::X
+        };
+        let probe = Camera {
+            eye,
+            lookat,
+            up: across,
+            fov_y: crate::camera::DEFAULT_FOV_DEG.to_radians(),
+            width: 1,
+            height: 1,
+        };
+        given.apply(&probe)?;
+    }
+    Ok(given)
 }
 
 /// The photometric options as given, before they become a
@@ -240,6 +281,7 @@ impl TryFrom<Args> for Invocation {
             falsecolor_max: args.falsecolor_max,
         };
         let approximations = approximations(&args);
+        let camera_override = camera_override(&args)?;
         let config = RunConfig {
             scene: args.scene.map_or(SceneSource::Bundled, SceneSource::File),
             output: args.output,
@@ -262,6 +304,7 @@ impl TryFrom<Args> for Invocation {
             exposure,
             stats: args.stats,
             camera: args.camera,
+            camera_override,
             export: args.export,
             log: args.log,
             plot: args.plot,
@@ -293,7 +336,9 @@ impl TryFrom<Args> for Invocation {
             sky: args.sky,
             photometry: photometry(&args_photometry),
         };
-        let mode = if args.no_window
+        let mode = if args.info {
+            Mode::Info
+        } else if args.no_window
             || config.output.is_some()
             || config.wants_batch_outputs()
             || config.checkpoint.is_some()

@@ -4,7 +4,7 @@
 //! (exit code 2) naming the option.
 
 use crate::color::Rgb;
-use crate::scene::MAX_EMISSION;
+use crate::scene::{MAX_COORDINATE, MAX_EMISSION};
 use crate::solver::hemicube::HemicubeRes;
 use crate::solver::ShooterSamples;
 
@@ -49,6 +49,26 @@ pub enum ValueError {
     /// and a spacing `> 0`, both finite.
     #[error("--workplane must look like 0.8 or 0.8,0.25 (a height >= 0, a spacing > 0, in scene units), got `{0}`")]
     Workplane(String),
+    /// `--eye` or `--look-at` is not a point `X,Y,Z`: three finite
+    /// numbers, each at most [`MAX_COORDINATE`] in magnitude.
+    #[error(
+        "{option} must be a point X,Y,Z like 1.5,1.6,-2 (three numbers, each at most \
+         {max:e} in magnitude), got `{text}`",
+        max = MAX_COORDINATE
+    )]
+    Point {
+        /// The option, as spelled on the command line.
+        option: &'static str,
+        /// The value given.
+        text: String,
+    },
+    /// `--up` is not a direction `X,Y,Z`: a point (as `--eye`) that is
+    /// not all zero.
+    #[error("--up must be a direction X,Y,Z like 0,1,0 (three numbers, not all zero), got `{0}`")]
+    Up(String),
+    /// `--fov` is not a number of degrees strictly between 0 and 180.
+    #[error("--fov must be a vertical field of view in degrees, more than 0 and less than 180, got `{0}`")]
+    Fov(String),
 }
 
 /// Parses `--hemicube-res`: pixels across a hemicube's top face, an even
@@ -85,6 +105,59 @@ pub fn parse_workplane(text: &str) -> Result<(f32, Option<f32>), ValueError> {
         return Err(bad());
     }
     Ok((height, spacing))
+}
+
+/// Three numbers `X,Y,Z` (spaces around them allowed), each finite and at
+/// most [`MAX_COORDINATE`] in magnitude, read as `f64` and rounded to
+/// `f32` as a `.sc` file's are, so that the same text gives the same
+/// camera either way; `None` otherwise.
+fn parse_triple(text: &str) -> Option<glam::Vec3> {
+    let values = text
+        .split(',')
+        .map(|c| match c.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() && x.abs() <= MAX_COORDINATE => Some(x),
+            _ => None,
+        })
+        .collect::<Option<Vec<f64>>>()?;
+    match values[..] {
+        [x, y, z] => Some(glam::DVec3::new(x, y, z).as_vec3()),
+        _ => None,
+    }
+}
+
+/// Parses `--eye`: a point `X,Y,Z` in scene units (see [`parse_triple`]).
+pub fn parse_eye(text: &str) -> Result<glam::Vec3, ValueError> {
+    parse_triple(text).ok_or_else(|| ValueError::Point {
+        option: "--eye",
+        text: text.to_string(),
+    })
+}
+
+/// Parses `--look-at`: a point `X,Y,Z` in scene units (see
+/// [`parse_eye`]).
+pub fn parse_look_at(text: &str) -> Result<glam::Vec3, ValueError> {
+    parse_triple(text).ok_or_else(|| ValueError::Point {
+        option: "--look-at",
+        text: text.to_string(),
+    })
+}
+
+/// Parses `--up`: a direction `X,Y,Z`, as [`parse_eye`] but not zero
+/// (in `f32`).
+pub fn parse_up(text: &str) -> Result<glam::Vec3, ValueError> {
+    parse_triple(text)
+        .filter(|v| *v != glam::Vec3::ZERO)
+        .ok_or_else(|| ValueError::Up(text.to_string()))
+}
+
+/// Parses `--fov`: degrees, read as a `.sc` file's `fov` is (an `f32`),
+/// strictly between 0 and 180, and so that their radians are too.
+pub fn parse_fov(text: &str) -> Result<f32, ValueError> {
+    let deg = text.trim().parse::<f64>().ok().map(|d| d as f32);
+    match deg {
+        Some(d) if d > 0.0 && d < 180.0 && d.to_radians() > 0.0 => Ok(d),
+        _ => Err(ValueError::Fov(text.to_string())),
+    }
 }
 
 /// Parses `--size`: `WxH` (or `WXH`), width and height in pixels, both
@@ -229,6 +302,44 @@ mod tests {
             "--sky must look like 1 or 0.8,0.9,1.2 (a radiosity per channel, \
              from 0 to 1e20), got `-1`"
         );
+    }
+
+    #[test]
+    fn camera_points_are_three_finite_numbers() {
+        assert_eq!(parse_eye("1.5,1.6,-2"), Ok(glam::Vec3::new(1.5, 1.6, -2.0)));
+        assert_eq!(
+            parse_look_at(" 0, 1e3 ,0"),
+            Ok(glam::Vec3::new(0.0, 1000.0, 0.0))
+        );
+        assert_eq!(parse_up("0,0,-1"), Ok(glam::Vec3::NEG_Z));
+        for bad in [
+            "", "1,2", "1,2,3,4", "a,b,c", "nan,0,0", "inf,0,0", "1e13,0,0", "1;2;3",
+        ] {
+            assert!(parse_eye(bad).is_err(), "{bad}");
+            assert!(parse_up(bad).is_err(), "{bad}");
+        }
+        assert_eq!(
+            parse_eye("1,2").unwrap_err().to_string(),
+            "--eye must be a point X,Y,Z like 1.5,1.6,-2 (three numbers, each at most 1e12 \
+             in magnitude), got `1,2`"
+        );
+        assert_eq!(
+            parse_up("0,0,0").unwrap_err().to_string(),
+            "--up must be a direction X,Y,Z like 0,1,0 (three numbers, not all zero), got `0,0,0`"
+        );
+        // A component below f32's range rounds to zero: no direction.
+        assert!(parse_up("1e-50,0,0").is_err());
+    }
+
+    #[test]
+    fn the_field_of_view_is_strictly_between_0_and_180_degrees() {
+        assert_eq!(parse_fov("45"), Ok(45.0));
+        assert_eq!(parse_fov("179.9"), Ok(179.9));
+        for bad in ["0", "180", "-10", "200", "nan", "inf", "1e-50", "wide", ""] {
+            assert_eq!(parse_fov(bad), Err(ValueError::Fov(bad.into())), "{bad}");
+        }
+        // A value that rounds to 180 in f32 is 180.
+        assert!(parse_fov("179.999999999").is_err());
     }
 
     #[test]

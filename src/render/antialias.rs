@@ -9,7 +9,65 @@
 //! pixel counts as covered when any of its samples is, and its back-face
 //! fraction ([`Frame::back`]) is the fraction of its samples on back faces.
 
-use super::raster::Frame;
+use super::raster::{Frame, Rasterizer, RenderError};
+use super::view::{View, ViewError};
+use crate::camera::Camera;
+use crate::cancel::Cancel;
+use crate::color::Rgb;
+use crate::mesh::Mesh;
+
+/// Why [`draw`] could not make its picture.
+#[derive(Debug, thiserror::Error)]
+pub enum DrawError {
+    /// The camera, or the sampled picture's size, is unusable.
+    #[error("{0}")]
+    View(#[from] ViewError),
+    /// Rendering failed or was cancelled.
+    #[error("{0}")]
+    Render(#[from] RenderError),
+}
+
+/// A picture [`draw`] made: its samples are in the rasterizer.
+#[derive(Clone, Debug)]
+pub struct Drawn {
+    /// Samples a pixel along each side actually used ([`factor_for`]).
+    pub aa: u32,
+    /// The sampled frame averaged to the camera's size; `None` when `aa`
+    /// is 1 (the rasterizer's frame is the picture).
+    pub downsampled: Option<Frame>,
+}
+
+impl Drawn {
+    /// The picture's linear frame at the camera's size, from the
+    /// `rasterizer` that drew it.
+    pub fn frame<'a>(&'a self, rasterizer: &'a Rasterizer) -> &'a Frame {
+        self.downsampled.as_ref().unwrap_or(rasterizer.frame())
+    }
+}
+
+/// Draws `radiosity` (per vertex of `mesh`) through `camera` at its
+/// picture size with `aa × aa` samples a pixel (fewer for a very large
+/// picture, [`factor_for`]), averaged in linear radiosity: the one way
+/// antialiased pictures are made, by the batch run and by the window's
+/// full-quality key. The samples stay in `rasterizer` (its depths and
+/// front faces at the sampled size); stops with
+/// [`RenderError::Cancelled`] once `cancel` is set.
+pub fn draw(
+    rasterizer: &mut Rasterizer,
+    mesh: &Mesh,
+    radiosity: &[Rgb],
+    camera: &Camera,
+    aa: u32,
+    cancel: &Cancel,
+) -> Result<Drawn, DrawError> {
+    let (width, height) = (camera.width, camera.height);
+    let aa = factor_for(width, height, aa);
+    let view = View::with_size(camera, width * aa, height * aa)?;
+    rasterizer.render_cancellable(mesh, radiosity, &view, cancel)?;
+    cancel.check().map_err(RenderError::Cancelled)?;
+    let downsampled = (aa > 1).then(|| downsample(rasterizer.frame(), aa));
+    Ok(Drawn { aa, downsampled })
+}
 
 /// Default samples per pixel side for written pictures (`--aa`): 9 samples
 /// a pixel make edges smooth; `table_chair`'s picture (30,000 triangles)

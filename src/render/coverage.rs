@@ -4,9 +4,12 @@
 //!
 //! Polygons are one-sided, so a picture can come out black for reasons the
 //! picture itself cannot tell a user: the camera stands outside a closed
-//! room (every wall shows its back), nothing in the scene emits (every
-//! front face is unlit), or the camera looks past the scene. The counts
-//! tell them apart, so the warning can name the likely reason.
+//! room (every wall shows its back, or its unlit outside), the lights do
+//! not reach what is seen, or the camera looks past the scene. The counts
+//! tell most of them apart; whether the eye stands outside the room that
+//! holds the lights is asked of the scene by the caller
+//! ([`PictureCoverage::dark_warning_with`]). A scene where nothing emits
+//! gets no such warning: loading has said so already.
 
 use super::raster::Frame;
 
@@ -61,23 +64,41 @@ impl PictureCoverage {
     /// The warning for a picture more than [`DARK_PICTURE_FRACTION`] dark,
     /// one line without the `warning: ` prefix, naming the likely reason
     /// from the largest of the three kinds of dark pixel; `None` for a
-    /// picture worth looking at (or one with no pixels).
+    /// picture worth looking at (or one with no pixels). See
+    /// [`PictureCoverage::dark_warning_with`] for the reason the pixels
+    /// cannot tell.
     pub fn dark_warning(&self) -> Option<String> {
+        self.dark_warning_with(|| false)
+    }
+
+    /// [`PictureCoverage::dark_warning`], asking `eye_outside_lights`
+    /// (only when the picture is dark) whether the camera stands outside
+    /// a closed surface that holds the lights
+    /// ([`crate::scene::Scene::eye_outside_lights`]): then that is the
+    /// reason, whatever the pixels show (the unlit outside of the room,
+    /// background around it, or the backs of its walls).
+    pub fn dark_warning_with(&self, eye_outside_lights: impl FnOnce() -> bool) -> Option<String> {
         if self.pixels == 0 || (self.dark() as f64) <= DARK_PICTURE_FRACTION * self.pixels as f64 {
             return None;
         }
         let percent = |n: usize| 100.0 * n as f64 / self.pixels as f64;
-        let reason = if self.back_faces >= self.background && self.back_faces >= self.unlit_front {
+        let reason = if eye_outside_lights() {
+            "the camera stands outside the closed surface that holds the lights (a room seen \
+             from outside); put the eye inside with --eye X,Y,Z and --look-at X,Y,Z, or \
+             --camera FILE.sc"
+                .to_string()
+        } else if self.back_faces >= self.background && self.back_faces >= self.unlit_front {
             format!(
                 "{:.0}% of it shows the backs of polygons, which receive no light and are \
-                 drawn in dim blue-grey stripes (polygons are one-sided): the camera is probably outside a closed room, or the faces \
-                 point away from it; put the eye inside with --camera FILE.sc",
+                 drawn in dim blue-grey stripes (polygons are one-sided): the camera is probably \
+                 outside a closed room, or the faces point away from it; put the eye inside with \
+                 --eye X,Y,Z and --look-at X,Y,Z, or --camera FILE.sc",
                 percent(self.back_faces)
             )
         } else if self.unlit_front >= self.background {
             format!(
-                "{:.0}% of it shows front faces that receive no light: does anything in the \
-                 scene emit (Ke in an MTL file, k_emission in a .sc file)?",
+                "{:.0}% of it shows front faces that receive no light: the lights do not reach \
+                 what the camera sees (they may be hidden from it, or in another room)",
                 percent(self.unlit_front)
             )
         } else {
@@ -151,8 +172,32 @@ mod tests {
         );
         let unlit = warning(0, 60, 10).unwrap();
         assert!(unlit.contains("no light"), "{unlit}");
+        assert!(unlit.contains("the lights do not reach"), "{unlit}");
         let past = warning(1, 10, 10).unwrap();
         assert!(past.contains("background"), "{past}");
         assert!(!back.contains('\n'));
+    }
+
+    #[test]
+    fn an_eye_outside_the_lights_is_the_reason_whatever_the_pixels() {
+        for (lit, unlit, back) in [(0, 0, 0), (1, 60, 10), (2, 10, 80)] {
+            let (f, front) = frame(lit, unlit, back);
+            let c = PictureCoverage::of(&f, &front);
+            let w = c.dark_warning_with(|| true).unwrap();
+            assert!(
+                w.contains("the camera stands outside the closed surface that holds the lights"),
+                "{w}"
+            );
+            assert_eq!(c.dark_warning_with(|| false), c.dark_warning());
+        }
+        // A lit picture asks nothing.
+        let (f, front) = frame(100, 0, 0);
+        let asked = std::cell::Cell::new(false);
+        let none = PictureCoverage::of(&f, &front).dark_warning_with(|| {
+            asked.set(true);
+            true
+        });
+        assert_eq!(none, None);
+        assert!(!asked.get());
     }
 }

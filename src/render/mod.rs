@@ -41,8 +41,9 @@ pub use coverage::{PictureCoverage, DARK_PICTURE_FRACTION};
 pub use overlay::{draw_mesh_edges, LinePalette, MESH_COLOR, MESH_COLOR_ON_LIGHT, MESH_LINES};
 pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
 pub use tonemap::{
-    auto_exposure, back_face_color, srgb8, srgb_encode, to_srgb8, Exposure, BACK_FACE_COLORS,
-    BACK_FACE_STRIPE,
+    auto_exposure, auto_exposure_beside, back_face_color, exposure_probe_size, srgb8, srgb_encode,
+    to_srgb8, Exposure, BACK_FACE_COLORS, BACK_FACE_STRIPE, EXPOSURE_PROBE_SIDE,
+    UNLIT_EXPOSURE_SHARE,
 };
 pub use view::{View, ViewError};
 

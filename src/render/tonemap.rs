@@ -59,6 +59,61 @@ impl Exposure {
 /// used instead; if the frame has no covered pixel with a positive finite
 /// luminance, the result is [`FALLBACK_EXPOSURE`]. Always finite and `> 0`.
 pub fn auto_exposure(frame: &Frame) -> f32 {
+    lit_exposure(frame).unwrap_or(FALLBACK_EXPOSURE)
+}
+
+/// How much darker than [`auto_exposure`] a picture that shows the ambient
+/// term is exposed when nothing in its view has any solved light
+/// (dimensionless: a sixteenth, four stops): the unlit surfaces show their
+/// share of the ambient estimate dimly, so the shapes stay visible to
+/// steer by, never as a bright picture.
+pub const UNLIT_EXPOSURE_SHARE: f32 = 0.0625;
+
+/// The longest side, in pixels, of the picture of the solution alone that
+/// [`auto_exposure_beside`] measures: its statistics need no more, and it
+/// costs a sixteenth of a 640-pixel window.
+pub const EXPOSURE_PROBE_SIDE: u32 = 160;
+
+/// The size of the solution's picture for [`auto_exposure_beside`] of a
+/// `width × height` picture: the same shape, its longest side at most
+/// [`EXPOSURE_PROBE_SIDE`], each side at least 1.
+pub fn exposure_probe_size(width: u32, height: u32) -> (u32, u32) {
+    let longest = width.max(height).max(1);
+    if longest <= EXPOSURE_PROBE_SIDE {
+        return (width.max(1), height.max(1));
+    }
+    let scale = |side: u32| {
+        ((u64::from(side) * u64::from(EXPOSURE_PROBE_SIDE)).div_ceil(u64::from(longest)) as u32)
+            .max(1)
+    };
+    (scale(width), scale(height))
+}
+
+/// The automatic exposure of a picture `shown` that adds the ambient term
+/// ([`crate::solver::Progressive::ambient`]) to the solution, given the
+/// picture of the same view of the solution alone, `solution` (any size,
+/// [`exposure_probe_size`]): [`auto_exposure`] of `shown`, but never more
+/// than that of `solution`, and [`UNLIT_EXPOSURE_SHARE`] of it when no
+/// pixel of `solution` holds light.
+///
+/// The ambient term estimates what is still to come, spread evenly over
+/// every surface; it may brighten a picture, but it must not set its
+/// exposure: seen from outside a room lit from within, the walls hold
+/// nothing but the ambient term, and exposing for it scaled a dim estimate
+/// up thousands of times into a bright, flat picture. Where the solution
+/// has light in view, its own exposure is the larger one (the ambient only
+/// adds), so the rule changes nothing there.
+pub fn auto_exposure_beside(shown: &Frame, solution: &Frame) -> f32 {
+    let exposure = auto_exposure(shown);
+    match lit_exposure(solution) {
+        Some(lit) => exposure.min(lit),
+        None => exposure * UNLIT_EXPOSURE_SHARE,
+    }
+}
+
+/// [`auto_exposure`] without its fallback: `None` when no covered pixel
+/// (back faces not counted) has a positive finite luminance.
+fn lit_exposure(frame: &Frame) -> Option<f32> {
     // Read twice or three times rather than collected: a frame has about a
     // million pixels, and the selection needs only one bucket of them.
     // A few work items a thread: each carries a table of bucket counts.
@@ -86,24 +141,18 @@ pub fn auto_exposure(frame: &Frame) -> f32 {
                     .filter(|l| l.is_finite())
             })
     };
-    let Some(at_rank) = nth_smallest(luminances, |n| {
+    let at_rank = nth_smallest(luminances, |n| {
         // Nearest-rank percentile: the smallest value with at least that
         // fraction of the pixels at or below it.
         ((AUTO_PERCENTILE * n as f64).ceil() as usize).clamp(1, n) - 1
-    }) else {
-        return FALLBACK_EXPOSURE;
-    };
+    })?;
     let reference = if at_rank > 0.0 {
         at_rank
     } else {
         luminances().reduce(|| 0.0, f64::max)
     };
     let exposure = (AUTO_TARGET / reference) as f32;
-    if reference > 0.0 && exposure.is_finite() && exposure > 0.0 {
-        exposure
-    } else {
-        FALLBACK_EXPOSURE
-    }
+    (reference > 0.0 && exposure.is_finite() && exposure > 0.0).then_some(exposure)
 }
 
 /// Fewest pixels per parallel work item of [`auto_exposure`].

@@ -44,9 +44,25 @@
 //!   up +y, the wider field of view [`ROOM_FOV_DEG`] and the default
 //!   picture size.
 //!
+//! Where a face and its back copy (or a face written twice, once each
+//! way) lie in one plane, a ray sees the side that faces it.
+//!
+//! **Rooms that hold the lights.** The loaders frame a scene before
+//! `--emit` and the repair passes, when an OBJ room modelled with its
+//! faces pointing out (a scaled cube in Blender) shows only back faces
+//! from inside and is framed from outside, where its outer walls get no
+//! light. Once the lights are set and the back copies made, the run asks
+//! [`Scene::frame_inside_lights`]: when the rays from one of the lights
+//! ([`LIGHTS_PROBED`] at most, the most powerful) nearly all hit a surface
+//! and those from the automatic eye do not, the eye stands outside the
+//! closed surface that holds the lights, and the scene is framed again:
+//! its back copies now face in, so it is a room, seen from inside. The
+//! same test names that reason when a picture comes out dark
+//! ([`Scene::eye_outside_lights`]).
+//!
 //! An explicit camera (in the file, or `--camera`) never comes here.
 
-use super::{polygon_bounds, Polygon};
+use super::{polygon_bounds, Polygon, Scene};
 use crate::camera::{Camera, DEFAULT_SIZE};
 use glam::{DVec3, Vec3};
 
@@ -268,11 +284,17 @@ fn nearest_hit(polygons: &[Polygon], origin: DVec3, dir: DVec3, edge_tol: f64) -
         let Some(t) = ray_polygon_hit(p, origin, dir, edge_tol) else {
             continue;
         };
-        if best.is_none_or(|b| t < b.t) {
-            best = Some(Hit {
-                t,
-                front: p.normal.as_dvec3().dot(dir) < 0.0,
-            });
+        let front = p.normal.as_dvec3().dot(dir) < 0.0;
+        // A face and its back copy (or a face written twice, once each
+        // way) lie in one plane: within the tolerance, the side facing the
+        // ray is the one seen.
+        let nearer = match best {
+            None => true,
+            Some(b) if (t - b.t).abs() <= edge_tol && front != b.front => front,
+            Some(b) => t < b.t,
+        };
+        if nearer {
+            best = Some(Hit { t, front });
         }
     }
     best
@@ -395,6 +417,98 @@ fn room_camera(polygons: &[Polygon], lo: Vec3, hi: Vec3) -> Option<Camera> {
         height: DEFAULT_SIZE.1,
     };
     camera.check().ok().map(|_| camera)
+}
+
+/// How far in front of an emitting polygon the point that stands for its
+/// light lies, as a fraction of the scene's diagonal (dimensionless):
+/// off the polygon's plane, so that its own rays do not graze it, and
+/// still inside whatever holds the lamp.
+pub const LIGHT_POINT_OFFSET: f64 = 1e-4;
+
+/// At most this many emitting polygons, the most powerful first, are asked
+/// whether a closed surface holds them: each costs one survey of
+/// [`FRAMING_RAYS`] rays against every polygon.
+pub const LIGHTS_PROBED: usize = 4;
+
+/// Whether most rays from `point` hit some polygon, from either side:
+/// at least [`ROOM_MIN_FRONT_FRACTION`] of them, as for a room. Stops at
+/// the first miss too many.
+fn enclosed(polygons: &[Polygon], point: DVec3, edge_tol: f64) -> bool {
+    let max_miss = FRAMING_RAYS - front_rays_needed();
+    let mut misses = 0;
+    for d in directions() {
+        if nearest_hit(polygons, point, d, edge_tol).is_none() {
+            misses += 1;
+            if misses > max_miss {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+impl Scene {
+    /// The points that stand for the scene's lights: in front of the
+    /// centre of each emitting polygon (the sky's facets left out), by
+    /// [`LIGHT_POINT_OFFSET`], the [`LIGHTS_PROBED`] most powerful ones.
+    fn light_points(&self) -> Vec<DVec3> {
+        let diagonal = f64::from(self.extent()).max(f64::MIN_POSITIVE);
+        let mut lights: Vec<(f64, DVec3)> = self
+            .polygons
+            .iter()
+            .filter(|p| !p.surface.sky)
+            .filter_map(|p| {
+                let power = self.materials[p.material.index()].emission().luminance() * p.area;
+                let centre = p.vertices.iter().map(|v| v.as_dvec3()).sum::<DVec3>()
+                    / p.vertices.len().max(1) as f64;
+                let point = centre + p.normal.as_dvec3() * LIGHT_POINT_OFFSET * diagonal;
+                (power > 0.0 && point.is_finite()).then_some((power, point))
+            })
+            .collect();
+        lights.sort_by(|a, b| b.0.total_cmp(&a.0));
+        lights.truncate(LIGHTS_PROBED);
+        lights.into_iter().map(|(_, point)| point).collect()
+    }
+
+    /// True when `eye` stands outside a closed surface that holds the
+    /// lights: the rays from some light (a point just in front of one of
+    /// the [`LIGHTS_PROBED`] most powerful emitting polygons) nearly
+    /// all hit a surface (as a room's do, [`ROOM_MIN_FRONT_FRACTION`]) and
+    /// those from the eye do not. A camera there sees the unlit outside of
+    /// the room, or nothing.
+    pub fn eye_outside_lights(&self, eye: Vec3) -> bool {
+        let (lo, hi) = self.bounds();
+        let edge_tol = RAY_EDGE_TOLERANCE * (hi - lo).as_dvec3().length();
+        let polygons = &self.polygons;
+        let lights = self.light_points();
+        !lights.is_empty()
+            && !enclosed(polygons, eye.as_dvec3(), edge_tol)
+            && lights.iter().any(|&l| enclosed(polygons, l, edge_tol))
+    }
+
+    /// Frames the camera again ([`frame_camera`]) when it was framed
+    /// automatically and stands outside a closed surface that holds the
+    /// lights ([`Scene::eye_outside_lights`]); true when the camera moved.
+    ///
+    /// For the scene after the repair passes: a room modelled with its
+    /// faces pointing out (a scaled cube in Blender) is only a room once
+    /// its faces have their back copies facing in, and only the lights,
+    /// set by `--emit`, say that its inside is what is to be seen (a
+    /// closed car body, or a house seen from the street, with no light
+    /// inside, keeps the camera outside).
+    pub fn frame_inside_lights(&mut self) -> bool {
+        if self.camera_source != super::CameraSource::AutoFramed
+            || !self.eye_outside_lights(self.camera.eye)
+        {
+            return false;
+        }
+        let camera = frame_camera(&self.polygons);
+        if camera == self.camera || self.eye_outside_lights(camera.eye) {
+            return false;
+        }
+        self.camera = camera;
+        true
+    }
 }
 
 #[cfg(test)]

@@ -2,6 +2,13 @@
 //! a point (the surface under the cursor, or the look-at point), move
 //! towards a point and stop in front of it, walk, and reset. Pure geometry
 //! on a [`Camera`], so it is tested without a window.
+//!
+//! Orbiting is scaled to the scene ([`CameraControl::orbit_per_pixel`]):
+//! around an object seen from outside, a drag across a 640-pixel window
+//! turns the eye by about 290°; inside a room (the eye within the scene's
+//! bounds, [`CameraControl::within`]) the eye moves by a fixed share of the
+//! room's size per pixel, and an orbit stops short of the room's walls,
+//! floor and ceiling rather than take the eye out of the room.
 
 use crate::scene::Camera;
 use glam::{Quat, Vec3};
@@ -15,20 +22,90 @@ pub const MAX_DISTANCE_FACTOR: f32 = 50.0;
 /// direction when orbiting, so the view never flips over the pole.
 pub const POLE_MARGIN: f32 = 0.02;
 
+/// Radians of orbit per pixel of drag around an object seen from outside
+/// (and the most anywhere).
+pub const ORBIT_PER_PIXEL: f32 = 0.008;
+
+/// Inside a room, how far the eye moves per pixel of orbit drag, as a
+/// fraction of the room's smallest side (usually its height): on the
+/// bundled `rtable` (3 high) around a point of the table top 2.5 away, a
+/// 200-pixel drag turns the eye by about 40°, where [`ORBIT_PER_PIXEL`]
+/// would turn it by 92° and lift it through the ceiling.
+pub const ROOM_ORBIT_TRAVEL_PER_PIXEL: f32 = 0.003;
+
+/// How close an orbit inside a room lets the eye come to the room's
+/// bounds, as a fraction of their smallest side: it stops there, inside.
+pub const ROOM_WALL_MARGIN: f32 = 0.02;
+
+/// Halvings of an orbit that would leave the room, to find how much of it
+/// keeps the eye inside (the last one is `2^-16` of the drag).
+const ORBIT_CLAMP_STEPS: u32 = 16;
+
 /// The window's camera: starts as the scene's camera and moves with input.
 ///
 /// Invariants: `eye != lookat`; the view direction is never parallel to
-/// `up`; `up`, the field of view and the picture size never change.
+/// `up`; `up`, the field of view and the picture size never change; an
+/// orbit that starts with the eye inside the room ([`CameraControl::within`])
+/// ends with it inside.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraControl {
     home: Camera,
     camera: Camera,
+    /// The scene's bounds `(min, max)` in scene units, when known.
+    room: Option<(Vec3, Vec3)>,
 }
 
 impl CameraControl {
     /// Controls starting at (and resetting to) `home`.
     pub fn new(home: Camera) -> Self {
-        CameraControl { home, camera: home }
+        CameraControl {
+            home,
+            camera: home,
+            room: None,
+        }
+    }
+
+    /// The same controls, told the scene's bounds `lo..hi` (scene units):
+    /// with the eye inside them the scene is a room, and orbits are scaled
+    /// and kept inside it.
+    pub fn within(mut self, lo: Vec3, hi: Vec3) -> Self {
+        let ok = lo.is_finite() && hi.is_finite() && (hi - lo).min_element() > 0.0;
+        self.room = ok.then_some((lo, hi));
+        self
+    }
+
+    /// The room the eye stands in, shrunk by the margin it keeps from the
+    /// walls: the scene's bounds less [`ROOM_WALL_MARGIN`] (or, for an eye
+    /// already nearer a wall, the bounds themselves); `None` when the eye
+    /// is outside the bounds or they are unknown.
+    fn room_around_eye(&self) -> Option<(Vec3, Vec3)> {
+        let (lo, hi) = self.room?;
+        let eye = self.camera.eye;
+        let inside = |(a, b): (Vec3, Vec3)| eye.cmpgt(a).all() && eye.cmplt(b).all();
+        let margin = Vec3::splat(ROOM_WALL_MARGIN * (hi - lo).min_element());
+        let shrunk = (lo + margin, hi - margin);
+        if inside(shrunk) {
+            Some(shrunk)
+        } else {
+            inside((lo, hi)).then_some((lo, hi))
+        }
+    }
+
+    /// Radians of orbit per pixel of drag around `pivot` (scene units):
+    /// [`ORBIT_PER_PIXEL`], or inside a room less, so that the eye moves
+    /// [`ROOM_ORBIT_TRAVEL_PER_PIXEL`] of the room's smallest side per
+    /// pixel at its distance from the pivot.
+    pub fn orbit_per_pixel(&self, pivot: Vec3) -> f32 {
+        let Some((lo, hi)) = self.room.filter(|_| self.room_around_eye().is_some()) else {
+            return ORBIT_PER_PIXEL;
+        };
+        let radius = self.camera.eye.distance(pivot);
+        let scaled = ROOM_ORBIT_TRAVEL_PER_PIXEL * (hi - lo).min_element() / radius;
+        if scaled.is_finite() {
+            scaled.min(ORBIT_PER_PIXEL)
+        } else {
+            ORBIT_PER_PIXEL
+        }
     }
 
     /// The current camera.
@@ -69,17 +146,39 @@ impl CameraControl {
     /// turns about the camera's own right axis, so the view never rolls).
     /// A pitch that would tilt the view direction past straight down or up
     /// stops at [`POLE_MARGIN`]; non-finite input changes nothing.
+    ///
+    /// With the eye inside a room ([`CameraControl::within`]), the orbit
+    /// goes only as far as keeps the eye [`ROOM_WALL_MARGIN`] inside it.
     pub fn orbit_about(&mut self, pivot: Vec3, yaw: f32, pitch: f32) {
         if !pivot.is_finite() {
             return;
         }
-        let view = self.camera.lookat - self.camera.eye;
-        let Some(rotation) = orbit_rotation(view, self.camera.up, yaw, pitch) else {
-            return;
+        let room = self.room_around_eye();
+        let turned = |share: f32| {
+            let view = self.camera.lookat - self.camera.eye;
+            let rotation = orbit_rotation(view, self.camera.up, yaw * share, pitch * share)?;
+            let eye = pivot + rotation * (self.camera.eye - pivot);
+            let lookat = pivot + rotation * (self.camera.lookat - pivot);
+            let stays = room.is_none_or(|(lo, hi)| eye.cmpgt(lo).all() && eye.cmplt(hi).all());
+            (eye.is_finite() && lookat.is_finite() && stays).then_some((eye, lookat))
         };
-        let eye = pivot + rotation * (self.camera.eye - pivot);
-        let lookat = pivot + rotation * (self.camera.lookat - pivot);
-        if eye.is_finite() && lookat.is_finite() {
+        let mut best = turned(1.0);
+        if best.is_none() && room.is_some() {
+            // The largest share of the orbit found, by halving, that keeps
+            // the eye in the room.
+            let (mut inside, mut outside) = (0.0, 1.0);
+            for _ in 0..ORBIT_CLAMP_STEPS {
+                let mid = 0.5 * (inside + outside);
+                match turned(mid) {
+                    Some(found) => {
+                        inside = mid;
+                        best = Some(found);
+                    }
+                    None => outside = mid,
+                }
+            }
+        }
+        if let Some((eye, lookat)) = best {
             self.camera.eye = eye;
             self.camera.lookat = lookat;
         }
@@ -381,6 +480,83 @@ mod tests {
         c.orbit_about(Vec3::NAN, 0.1, 0.1);
         c.orbit_about(pivot, f32::INFINITY, 0.1);
         assert_eq!(*c.camera(), before);
+    }
+
+    /// The bundled `rtable`'s camera, in its room 5 × 3 × 5.
+    fn rtable() -> (Camera, Vec3, Vec3) {
+        let scene = crate::scene::parse_str(crate::config::BUNDLED_SCENE, "rtable.sc").unwrap();
+        let (lo, hi) = scene.bounds();
+        assert_eq!((lo, hi), (Vec3::ZERO, Vec3::new(5.0, 3.0, 5.0)));
+        (scene.camera, lo, hi)
+    }
+
+    #[test]
+    fn a_200_pixel_drag_around_the_table_top_stays_in_the_room() {
+        let (home, lo, hi) = rtable();
+        // Points of the table top (y 0.78, x 1.7..3.3, z 2.2..3.4), as
+        // picked under the cursor.
+        for pivot in [
+            Vec3::new(2.5, 0.78, 2.8),
+            Vec3::new(1.8, 0.78, 2.3),
+            Vec3::new(3.2, 0.78, 3.3),
+        ] {
+            for (dx, dy) in [
+                (200.0, 0.0),
+                (-200.0, 0.0),
+                (0.0, 200.0),
+                (0.0, -200.0),
+                (141.0, 141.0),
+                (-141.0, 141.0),
+            ] {
+                let mut c = CameraControl::new(home).within(lo, hi);
+                // As the window applies a drag: a few pixels a frame.
+                for _ in 0..20 {
+                    let k = c.orbit_per_pixel(pivot);
+                    c.orbit_about(pivot, -dx / 20.0 * k, dy / 20.0 * k);
+                }
+                let eye = c.camera().eye;
+                assert!(
+                    eye.cmpgt(lo).all() && eye.cmplt(hi).all(),
+                    "{pivot} ({dx}, {dy}): the eye left the room: {eye}"
+                );
+                // It still turned, and kept its distance to the pivot.
+                assert_ne!(eye, home.eye);
+                let d = home.eye.distance(pivot);
+                assert!((eye.distance(pivot) - d).abs() < 1e-3 * d);
+            }
+        }
+    }
+
+    #[test]
+    fn orbit_speed_is_scaled_to_the_room_and_unchanged_around_objects() {
+        let (home, lo, hi) = rtable();
+        let pivot = Vec3::new(2.5, 0.78, 2.8);
+        let c = CameraControl::new(home).within(lo, hi);
+        let k = c.orbit_per_pixel(pivot);
+        // The eye moves the stated share of the room's height per pixel.
+        let travel = k * home.eye.distance(pivot);
+        assert!(
+            (travel - ROOM_ORBIT_TRAVEL_PER_PIXEL * 3.0).abs() < 1e-6,
+            "{travel}"
+        );
+        assert!(k < ORBIT_PER_PIXEL);
+        // Without bounds, or from outside them, the object speed.
+        assert_eq!(
+            CameraControl::new(home).orbit_per_pixel(pivot),
+            ORBIT_PER_PIXEL
+        );
+        let outside = Camera {
+            eye: Vec3::new(2.5, 1.5, -8.0),
+            ..home
+        };
+        let c = CameraControl::new(outside).within(lo, hi);
+        assert_eq!(c.orbit_per_pixel(pivot), ORBIT_PER_PIXEL);
+        // From outside, an orbit is not held back by the bounds.
+        let mut free = c;
+        free.orbit_about(pivot, 1.5, 0.0);
+        let mut unbounded = CameraControl::new(outside);
+        unbounded.orbit_about(pivot, 1.5, 0.0);
+        assert_eq!(free.camera(), unbounded.camera());
     }
 
     #[test]

@@ -22,21 +22,27 @@
 //! every other surface with the ambient term ([`crate::solver::first_look`]),
 //! never a black picture.
 //!
-//! A small state panel ([`render::text::draw_panel`]) in the top-left
-//! corner shows the step, unshot power, rays per second, whether the solve
-//! converged, the navigation mode and "h: help"; `i` hides it. It is drawn
-//! on the screen only: `w` writes the picture without it, `p` writes the
-//! screen as shown, panel included.
+//! A small state panel ([`render::text::draw_panel`], its lines from
+//! [`panel`]) in the top-left corner shows the step ("starting" before the
+//! first), unshot power, rays per second, whether the solve converged, the
+//! exposure, the mesh, the navigation mode and the keys, what `w` asks in
+//! the terminal, and what the last key did (a file written, the camera
+//! printed); `i` hides it. It is drawn on the screen only: `w` writes the
+//! picture without it, `p` writes the screen as shown, panel included.
 //!
-//! Keys: `q`/Escape quit · `w` write the picture as TIFF · `p` write the
-//! screen · space pause or resume · `+`/`-` exposure · `m` element mesh ·
-//! `i` state panel · `r` reset the camera · `o` left-drag mode · `h` help ·
-//! arrows and `a`/`d` (or Shift+W/A/S/D) walk · `PageUp`/`PageDown` up and
-//! down. Mouse: left-drag looks around (or, after `o`, orbits around the
-//! surface point under the cursor), right-drag or the wheel moves towards
-//! or away from the surface under the cursor, stopping in front of it.
+//! Keys: `q`/Escape quit · `w` write the picture as TIFF · `f` write the
+//! view at full quality (`--aa` samples a pixel) as PNG · `p` write the
+//! screen · `c` print the camera as options and as a `.sc` block ·
+//! Shift+C save it as `<scene>-camera.sc` next to the scene · space pause
+//! or resume · `+`/`-` exposure · `m` element mesh · `i` state panel · `r`
+//! reset the camera · `o` left-drag mode · `h` help · arrows and `a`/`d`
+//! (or Shift+W/A/S/D) walk · `PageUp`/`PageDown` up and down. Mouse:
+//! left-drag looks around (or, after `o`, orbits around the surface point
+//! under the cursor), right-drag or the wheel moves towards or away from
+//! the surface under the cursor, stopping in front of it.
 
 pub mod controls;
+pub mod panel;
 pub mod pointer;
 
 use crate::color::Rgb;
@@ -44,7 +50,7 @@ use crate::config::RunConfig;
 use crate::mesh::MeshRef;
 use crate::output;
 use crate::prepare::Prepared;
-use crate::render::{self, Exposure, Rasterizer, View};
+use crate::render::{self, antialias, Exposure, Rasterizer, View};
 use crate::session::{Event, Session, SessionOptions};
 use crate::solver::StopReason;
 use controls::CameraControl;
@@ -53,7 +59,7 @@ use image::RgbImage;
 use minifb::{InputCallback, Key, MouseButton, MouseMode, Window, WindowOptions};
 use pointer::{Buttons, Pointer};
 use std::io::{BufRead, IsTerminal, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -69,8 +75,7 @@ pub const FRAME_INTERVAL: Duration = Duration::from_millis(16);
 /// a new solution once this many times its last drawing's time has
 /// passed.
 const PUBLISH_SHARE: u32 = 4;
-/// Radians of orbit per pixel of mouse drag.
-pub const ORBIT_PER_PIXEL: f32 = 0.008;
+pub use controls::ORBIT_PER_PIXEL;
 
 /// Radians the view turns per pixel of left-drag when looking around: a
 /// drag across a 640-pixel window turns it by about 100 degrees.
@@ -118,6 +123,9 @@ pub const KEY_HELP: &str = "\
 keys:
   q, Escape        quit
   w                write the picture as TIFF (asks for a name on a terminal)
+  f                write the view at full quality (--aa samples a pixel) as PNG
+  c                print the camera as --eye ... options and as a .sc block
+  Shift+C          save the camera as <scene>-camera.sc next to the scene
   space            pause / resume the solver
   + / -            exposure up / down (a third of a stop)
   m                show / hide the element mesh
@@ -179,6 +187,10 @@ struct Progress<'p> {
     /// publication.
     mesh: Option<MeshRef<'p>>,
     radiosity: Vec<Rgb>,
+    /// The solution alone (without the ambient term) when
+    /// [`Progress::radiosity`] shows the ambient term, published with it
+    /// from the first step on; empty before, and without the ambient term.
+    solution: Vec<Rgb>,
     step: u64,
     unshot_fraction: f64,
     rays: u64,
@@ -219,7 +231,10 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
     )
     .map_err(|e| ViewerError::CannotOpen(format!("cannot open a window: {e}")))?;
     let presses = Arc::new(Mutex::new(Vec::new()));
-    window.set_input_callback(Box::new(KeyPresses(Arc::clone(&presses))));
+    window.set_input_callback(Box::new(KeyPresses {
+        queue: Arc::clone(&presses),
+        shift: [false; 2],
+    }));
 
     let progress = Mutex::new(Progress::default());
     let control = Control {
@@ -232,9 +247,21 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
         let mut ui = Ui {
             prepared,
             window: &mut window,
-            camera: CameraControl::new(home),
+            camera: {
+                let (lo, hi) = prepared.scene.bounds();
+                CameraControl::new(home).within(lo, hi)
+            },
             exposure: config.exposure,
             exposure_scale: 1.0,
+            exposure_used: 1.0,
+            aa: config.aa,
+            camera_dir: match &config.scene {
+                crate::config::SceneSource::File(path) => {
+                    path.parent().map(Path::to_path_buf).unwrap_or_default()
+                }
+                crate::config::SceneSource::Bundled => PathBuf::new(),
+            },
+            message: None,
             show_mesh: false,
             show_panel: true,
             stem: stem.clone(),
@@ -247,6 +274,8 @@ pub fn run(prepared: &Prepared, config: &RunConfig) -> Result<(), ViewerError> {
             writes: Vec::new(),
             buffer: vec![0; w * h],
             radiosity: Vec::new(),
+            solution: Vec::new(),
+            probe: Rasterizer::new(),
             mesh: None,
             pointer: Pointer::default(),
             written: 0,
@@ -348,6 +377,9 @@ fn solve_in_background<'p>(
                 if session.pass() == 1 && due {
                     let t = Instant::now();
                     session.shown(&mut p.radiosity);
+                    if session.options().ambient {
+                        session.solution(&mut p.solution);
+                    }
                     publishing = t.elapsed();
                     published = Instant::now();
                 }
@@ -359,6 +391,9 @@ fn solve_in_background<'p>(
             Ok(Event::Stopped(reason)) => {
                 stopped = Some(reason);
                 session.shown(&mut p.radiosity);
+                if session.options().ambient && session.totals().steps > 0 {
+                    session.solution(&mut p.solution);
+                }
                 p.mesh = Some(session.mesh_ref());
             }
             Ok(Event::Refined(_)) => {
@@ -397,6 +432,16 @@ struct Ui<'a> {
     camera: CameraControl,
     exposure: Exposure,
     exposure_scale: f32,
+    /// The factor the picture on screen was drawn with: the automatic or
+    /// given exposure times `exposure_scale`.
+    exposure_used: f32,
+    /// Samples per pixel side of the full-quality picture (`f`, `--aa`).
+    aa: u32,
+    /// Where Shift+C saves the camera: the scene's folder (the current
+    /// one for the bundled scene).
+    camera_dir: PathBuf,
+    /// What the last key did, and when, for the panel.
+    message: Option<(String, Instant)>,
     show_mesh: bool,
     /// Whether the state panel is drawn on the screen (`i`).
     show_panel: bool,
@@ -418,6 +463,12 @@ struct Ui<'a> {
     writes: Vec<Writing>,
     buffer: Vec<u32>,
     radiosity: Vec<Rgb>,
+    /// The solution without the ambient term, per vertex of the same mesh
+    /// (see [`Progress::solution`]), for the exposure.
+    solution: Vec<Rgb>,
+    /// Draws the solution alone, small, for the automatic exposure
+    /// ([`render::auto_exposure_beside`]).
+    probe: Rasterizer,
     /// The mesh [`Ui::radiosity`] belongs to (`None`: nothing published
     /// yet).
     mesh: Option<MeshRef<'a>>,
@@ -426,10 +477,10 @@ struct Ui<'a> {
     written: u32,
     /// What a left-drag does; `o` switches.
     navigation: Navigation,
-    presses: Arc<Mutex<Vec<Key>>>,
+    presses: Arc<Mutex<Vec<Press>>>,
     /// A `w` waiting for its file name from the terminal, with the picture
-    /// as it was when `w` was pressed.
-    pending_name: Option<(std::sync::mpsc::Receiver<PathBuf>, RgbImage)>,
+    /// as it was when `w` was pressed and the name Enter gives.
+    pending_name: Option<(std::sync::mpsc::Receiver<PathBuf>, RgbImage, PathBuf)>,
 }
 
 /// A picture a key asked to write.
@@ -439,21 +490,36 @@ enum Writing {
     Picture,
     /// The screen as shown (`p`): the picture with the state panel.
     Screen,
+    /// The view at full quality (`f`): `--aa` samples a pixel.
+    FullQuality,
 }
 
-/// Collects every key press as it arrives. Polling the key state once a
-/// frame would miss a tap shorter than a frame; the callback sees each
-/// press event (auto-repeats included).
-struct KeyPresses(Arc<Mutex<Vec<Key>>>);
+/// A key press, and whether a Shift key was down when it came.
+type Press = (Key, bool);
+
+/// Collects every key press as it arrives, with the Shift state of that
+/// moment. Polling the key state once a frame would miss a tap shorter
+/// than a frame (and a Shift released before the frame that reads the
+/// key); the callback sees each press event (auto-repeats included).
+struct KeyPresses {
+    queue: Arc<Mutex<Vec<Press>>>,
+    /// Which Shift keys are down: left, right.
+    shift: [bool; 2],
+}
 
 impl InputCallback for KeyPresses {
     fn add_char(&mut self, _uni_char: u32) {}
 
     fn set_key_state(&mut self, key: Key, down: bool) {
-        if down {
-            if let Ok(mut q) = self.0.lock() {
-                q.push(key);
+        match key {
+            Key::LeftShift => self.shift[0] = down,
+            Key::RightShift => self.shift[1] = down,
+            _ if down => {
+                if let Ok(mut q) = self.queue.lock() {
+                    q.push((key, self.shift[0] || self.shift[1]));
+                }
             }
+            _ => {}
         }
     }
 }
@@ -471,12 +537,12 @@ impl<'a> Ui<'a> {
         let mut title = String::new();
         let emits = self.prepared.scene.emits();
         while self.window.is_open() {
-            let keys: Vec<Key> = self
+            let keys: Vec<Press> = self
                 .presses
                 .lock()
                 .map(|mut q| std::mem::take(&mut *q))
                 .unwrap_or_default();
-            if keys.contains(&Key::Q) || keys.contains(&Key::Escape) {
+            if keys.iter().any(|(k, _)| matches!(k, Key::Q | Key::Escape)) {
                 break;
             }
             dirty |= self.handle_keys(&keys, control);
@@ -507,6 +573,7 @@ impl<'a> Ui<'a> {
                 let t = Instant::now();
                 if let Ok(p) = progress.lock() {
                     self.radiosity.clone_from(&p.radiosity);
+                    self.solution.clone_from(&p.solution);
                     self.mesh.clone_from(&p.mesh);
                 }
                 shown_version = version;
@@ -515,30 +582,20 @@ impl<'a> Ui<'a> {
                 draw_cost = t.elapsed();
                 dirty = false;
             }
-            let state = match stopped {
-                // Nothing was solved: the load warning said why.
-                Some(_) if !emits => " · nothing emits".into(),
-                Some(StopReason::Converged) if pass.0 > 1 => {
-                    format!(" · converged after {} refinements", pass.0 - 1)
-                }
-                Some(StopReason::Converged) => " · converged".into(),
-                Some(StopReason::MaxSteps) => " · step limit".into(),
-                None if control.paused.load(Ordering::Relaxed) => " · paused".into(),
-                None => String::new(),
+            let solve = panel::SolveState {
+                step,
+                unshot,
+                mrays_per_second: if solving > 0.0 {
+                    rays as f64 / solving / 1e6
+                } else {
+                    0.0
+                },
+                stopped,
+                emits,
+                paused: control.paused.load(Ordering::Relaxed),
+                pass,
             };
-            let rate = if solving > 0.0 {
-                rays as f64 / solving / 1e6
-            } else {
-                0.0
-            };
-            let refining = match pass {
-                (1, _) | (_, 0) => String::new(),
-                (k, levels) => format!("refinement {}/{levels} · ", k - 1),
-            };
-            let status = format!(
-                "{refining}step {step} · unshot {:.3}% · {rate:.1} Mrays/s{state}",
-                unshot * 100.0,
-            );
+            let status = panel::status(&solve);
             let new_title = format!(
                 "radiosity — {} — {status} · {} · h: help",
                 self.stem,
@@ -549,10 +606,7 @@ impl<'a> Ui<'a> {
                 title = new_title;
             }
             let panel = if self.show_panel {
-                vec![
-                    status.trim_start_matches(" · ").to_string(),
-                    format!("{} · i: hide · h: help", self.navigation.name()),
-                ]
+                self.panel_lines(status)
             } else {
                 Vec::new()
             };
@@ -566,6 +620,7 @@ impl<'a> Ui<'a> {
                 match write {
                     Writing::Picture => self.write_picture(),
                     Writing::Screen => self.write_screen(),
+                    Writing::FullQuality => self.write_full_quality(),
                 }
             }
             let (w, h) = (
@@ -584,25 +639,27 @@ impl<'a> Ui<'a> {
     /// picture and the window buffer.
     fn draw(&mut self) -> Result<(), ViewerError> {
         let view = View::new(self.camera.camera())?;
-        let published = self
-            .mesh
-            .as_deref()
-            .filter(|m| self.radiosity.len() == m.vertex_count());
-        let (mesh, radiosity) = match published {
-            Some(mesh) => (mesh, &self.radiosity),
-            // Before the solver thread's first publication (building the
-            // solver can take a while on a large model): the emitters and
-            // the ambient term, never a black window.
-            None => {
-                let prepared = self.prepared;
-                let look = self.first_look.get_or_insert_with(|| {
-                    crate::solver::first_look(&prepared.scene, &prepared.mesh)
-                });
-                (&prepared.mesh, &*look)
-            }
-        };
+        let (mesh, radiosity) = shown(
+            self.prepared,
+            self.mesh.as_deref(),
+            &self.radiosity,
+            &mut self.first_look,
+        );
         let frame = self.rasterizer.render(mesh, radiosity, &view)?;
-        let exposure = self.exposure.resolve(frame) * self.exposure_scale;
+        // Once light has been shot, the ambient term brightens the picture
+        // but does not set its exposure (before, it is all there is).
+        let beside = self.solution.len() == radiosity.len();
+        let exposure = match self.exposure {
+            Exposure::Auto if beside => {
+                let camera = self.camera.camera();
+                let (pw, ph) = render::exposure_probe_size(view.width(), view.height());
+                let probe = View::with_size(camera, pw, ph)?;
+                let alone = self.probe.render(mesh, &self.solution, &probe)?;
+                render::auto_exposure_beside(frame, alone)
+            }
+            exposure => exposure.resolve(frame),
+        } * self.exposure_scale;
+        self.exposure_used = exposure;
         self.picture = render::to_srgb8(frame, exposure);
         if self.show_mesh {
             render::draw_mesh_edges(
@@ -614,6 +671,55 @@ impl<'a> Ui<'a> {
             );
         }
         Ok(())
+    }
+
+    /// The panel's lines (see [`panel`]): `status`, the exposure and the
+    /// mesh, the keys, and `w`'s question in the terminal while it waits
+    /// or else what the last key did, for [`MESSAGE_SHOWN`].
+    fn panel_lines(&self, status: String) -> Vec<String> {
+        let elements = self
+            .mesh
+            .as_deref()
+            .map_or(self.prepared.mesh.elements.len(), |m| m.elements.len());
+        let mut lines = vec![
+            status,
+            format!(
+                "{} · {}",
+                panel::exposure(
+                    self.exposure_used,
+                    self.exposure == Exposure::Auto,
+                    self.exposure_scale,
+                ),
+                panel::mesh(elements, self.show_mesh)
+            ),
+            panel::keys(self.navigation),
+        ];
+        // One line more at most: `w`'s question while it waits, else what
+        // the last key did.
+        if let Some((_, _, default)) = &self.pending_name {
+            lines.push(panel::prompt(default));
+        } else if let Some((message, since)) = &self.message {
+            if since.elapsed() < MESSAGE_SHOWN {
+                lines.push(message.clone());
+            }
+        }
+        lines
+    }
+
+    /// Says `message` in the panel, and shows it at once (before a write
+    /// that keeps the window busy).
+    fn say(&mut self, message: String, now: bool) {
+        self.message = Some((message, Instant::now()));
+        if now && self.show_panel {
+            let status = self.panel.first().cloned().unwrap_or_default();
+            self.panel = self.panel_lines(status);
+            self.compose();
+            let (w, h) = (
+                self.picture.width() as usize,
+                self.picture.height() as usize,
+            );
+            let _ = self.window.update_with_buffer(&self.buffer, w, h);
+        }
     }
 
     /// The screen from the picture and the state panel, into the window
@@ -667,13 +773,17 @@ impl<'a> Ui<'a> {
     }
 
     /// Applies key presses; true when the picture must be redrawn.
-    fn handle_keys(&mut self, keys: &[Key], control: &Control) -> bool {
-        let shift =
+    fn handle_keys(&mut self, keys: &[Press], control: &Control) -> bool {
+        let held =
             self.window.is_key_down(Key::LeftShift) || self.window.is_key_down(Key::RightShift);
         let mut dirty = false;
-        for key in keys {
+        for &(key, shifted) in keys {
+            let shift = shifted || held;
             match key {
                 Key::W if !shift => self.writes.push(Writing::Picture),
+                Key::F => self.writes.push(Writing::FullQuality),
+                Key::C if shift => self.save_camera(),
+                Key::C => self.print_camera(),
                 Key::Space => {
                     let paused = !control.paused.load(Ordering::Relaxed);
                     control.paused.store(paused, Ordering::Relaxed);
@@ -769,8 +879,8 @@ impl<'a> Ui<'a> {
                 self.camera.look(-dx * LOOK_PER_PIXEL, -dy * LOOK_PER_PIXEL);
             } else if motion.buttons.left {
                 let pivot = self.pivot.unwrap_or(self.camera.camera().lookat);
-                self.camera
-                    .orbit_about(pivot, -dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
+                let k = self.camera.orbit_per_pixel(pivot);
+                self.camera.orbit_about(pivot, -dx * k, dy * k);
             } else if let Some(target) = self.pivot {
                 // Drag up moves towards the point, down away.
                 let stop = self.zoom_stop();
@@ -784,7 +894,7 @@ impl<'a> Ui<'a> {
     /// Writes the screen as shown (the picture with the state panel) as
     /// TIFF under the next automatic name.
     fn write_screen(&mut self) {
-        let name = self.next_auto_name();
+        let name = self.next_auto_name("tiff");
         self.save(&name, &self.screen.clone());
     }
 
@@ -793,7 +903,7 @@ impl<'a> Ui<'a> {
     /// drawing while the user types; the picture is the one on screen when
     /// `w` was pressed. Otherwise it picks `<scene>-NNN.tiff`.
     fn write_picture(&mut self) {
-        let default = self.next_auto_name();
+        let default = self.next_auto_name("tiff");
         if !std::io::stdin().is_terminal() {
             self.save(&default, &self.picture.clone());
             return;
@@ -804,25 +914,122 @@ impl<'a> Ui<'a> {
         eprint!("write picture to [{}]: ", default.display());
         let _ = std::io::stderr().flush();
         let (send, receive) = std::sync::mpsc::channel();
+        let enter = default.clone();
         std::thread::spawn(move || {
             let mut line = String::new();
             let name = match std::io::stdin().lock().read_line(&mut line) {
                 Ok(_) if !line.trim().is_empty() => PathBuf::from(line.trim()),
-                _ => default,
+                _ => enter,
             };
             let _ = send.send(name);
         });
-        self.pending_name = Some((receive, self.picture.clone()));
+        self.pending_name = Some((receive, self.picture.clone(), default));
+    }
+
+    /// Writes the view on screen at full quality: `--aa` × `--aa` samples
+    /// a pixel at the window's size (`--size`), averaged as the batch run
+    /// does ([`antialias::draw`]), with the exposure on screen and the mesh
+    /// when it is shown, as PNG under the next automatic name. The panel
+    /// says it is writing, then what it wrote.
+    fn write_full_quality(&mut self) {
+        let name = self.next_auto_name("png");
+        let camera = *self.camera.camera();
+        let aa = antialias::factor_for(camera.width, camera.height, self.aa);
+        self.say(
+            format!("writing {} ({aa}×{aa} samples a pixel) …", name.display()),
+            true,
+        );
+        let (mesh, radiosity) = shown(
+            self.prepared,
+            self.mesh.as_deref(),
+            &self.radiosity,
+            &mut self.first_look,
+        );
+        let mut rasterizer = Rasterizer::new();
+        let picture = antialias::draw(
+            &mut rasterizer,
+            mesh,
+            radiosity,
+            &camera,
+            self.aa,
+            &crate::cancel::Cancel::never(),
+        )
+        .map_err(|e| e.to_string())
+        .and_then(|drawn| {
+            let mut picture = render::to_srgb8(drawn.frame(&rasterizer), self.exposure_used);
+            if self.show_mesh {
+                let view = View::new(&camera).map_err(|e| e.to_string())?;
+                let depth = antialias::nearest_depth(
+                    rasterizer.inv_depth(),
+                    camera.width * drawn.aa,
+                    drawn.aa,
+                );
+                render::draw_mesh_edges(&mut picture, mesh, &view, &depth, render::MESH_LINES);
+            }
+            Ok(picture)
+        });
+        match picture {
+            Ok(picture) => {
+                if self.save(&name, &picture) {
+                    self.say(
+                        format!("wrote {} ({aa}×{aa} samples a pixel)", name.display()),
+                        false,
+                    );
+                }
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                self.say(format!("could not draw {}: {e}", name.display()), false);
+            }
+        }
+    }
+
+    /// Prints the camera on the terminal as command-line options and as a
+    /// `.sc` camera block (`c`).
+    fn print_camera(&mut self) {
+        let camera = self.camera.camera();
+        println!(
+            "camera, as options:\n  {}\nas a .sc camera block (for --camera FILE.sc):\n{}",
+            crate::camera::options_text(camera),
+            crate::camera::sc_block(camera)
+        );
+        self.say(
+            "camera printed in the terminal (Shift+C saves it)".to_string(),
+            false,
+        );
+    }
+
+    /// Saves the camera as a `.sc` camera file next to the scene, under the
+    /// first free name ([`free_camera_path`]), never over a file (Shift+C).
+    fn save_camera(&mut self) {
+        let path = free_camera_path(&self.camera_dir, &self.stem);
+        let camera = self.camera.camera();
+        let text = format!(
+            "# A camera saved in the window: render it with --camera {}\n# or with {}\n{}",
+            path.display(),
+            crate::camera::options_text(camera),
+            crate::camera::sc_block(camera)
+        );
+        match output::write_atomically(&path, |w| w.write_all(text.as_bytes())) {
+            Ok(()) => {
+                println!("wrote {}", path.display());
+                self.say(format!("wrote {}", path.display()), false);
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                self.say(format!("could not write {}", path.display()), false);
+            }
+        }
     }
 
     /// Finishes a write whose name was typed on the terminal.
     fn finish_pending_write(&mut self) {
-        let Some((receive, _)) = &self.pending_name else {
+        let Some((receive, _, _)) = &self.pending_name else {
             return;
         };
         match receive.try_recv() {
             Ok(path) => {
-                if let Some((_, picture)) = self.pending_name.take() {
+                if let Some((_, picture, _)) = self.pending_name.take() {
                     self.save(&path, &picture);
                 }
             }
@@ -831,28 +1038,88 @@ impl<'a> Ui<'a> {
         }
     }
 
-    fn save(&mut self, path: &std::path::Path, picture: &RgbImage) {
+    /// Writes `picture` to `path`, says so on the terminal and in the
+    /// panel; true when it was written.
+    fn save(&mut self, path: &Path, picture: &RgbImage) -> bool {
         match output::write_rgb8(path, picture) {
             Ok(()) => {
                 self.written += 1;
                 println!("wrote {}", path.display());
+                self.say(format!("wrote {}", path.display()), false);
+                true
             }
-            Err(e) => eprintln!("error: {e}"),
+            Err(e) => {
+                eprintln!("error: {e}");
+                self.say(format!("could not write {}: {e}", path.display()), false);
+                false
+            }
         }
     }
 
-    /// The first `<scene>-NNN.tiff` (NNN from 001) that does not exist.
-    fn next_auto_name(&self) -> PathBuf {
+    /// The first `<scene>-NNN.EXT` (NNN from 001) that does not exist.
+    fn next_auto_name(&self, ext: &str) -> PathBuf {
         (self.written + 1..)
-            .map(|n| PathBuf::from(format!("{}-{n:03}.tiff", self.stem)))
+            .map(|n| PathBuf::from(format!("{}-{n:03}.{ext}", self.stem)))
             .find(|p| !p.exists())
-            .unwrap_or_else(|| PathBuf::from(format!("{}.tiff", self.stem)))
+            .unwrap_or_else(|| PathBuf::from(format!("{}.{ext}", self.stem)))
     }
+}
+
+/// How long the panel shows what the last key did.
+pub const MESSAGE_SHOWN: Duration = Duration::from_secs(10);
+
+/// The mesh and per-vertex radiosity the window shows: the solver's
+/// latest publication (`mesh` with `radiosity`), or before it the first
+/// look (the emitters and the ambient term, made once into `first_look`),
+/// never a black window.
+fn shown<'s>(
+    prepared: &'s Prepared,
+    mesh: Option<&'s crate::mesh::Mesh>,
+    radiosity: &'s [Rgb],
+    first_look: &'s mut Option<Vec<Rgb>>,
+) -> (&'s crate::mesh::Mesh, &'s [Rgb]) {
+    match mesh.filter(|m| radiosity.len() == m.vertex_count()) {
+        Some(mesh) => (mesh, radiosity),
+        None => {
+            let look = first_look
+                .get_or_insert_with(|| crate::solver::first_look(&prepared.scene, &prepared.mesh));
+            (&prepared.mesh, look)
+        }
+    }
+}
+
+/// Where Shift+C saves the camera: `DIR/<stem>-camera.sc`, or the first of
+/// `DIR/<stem>-camera-2.sc`, `-3`, ... that does not exist.
+pub fn free_camera_path(dir: &Path, stem: &str) -> PathBuf {
+    std::iter::once(dir.join(format!("{stem}-camera.sc")))
+        .chain((2u32..).map(|n| dir.join(format!("{stem}-camera-{n}.sc"))))
+        .find(|p| !p.exists())
+        .unwrap_or_else(|| dir.join(format!("{stem}-camera.sc")))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_camera_is_saved_under_a_free_name_next_to_the_scene() {
+        let dir = tempfile::tempdir().unwrap();
+        let first = free_camera_path(dir.path(), "room");
+        assert_eq!(first, dir.path().join("room-camera.sc"));
+        std::fs::write(&first, "x").unwrap();
+        let second = free_camera_path(dir.path(), "room");
+        assert_eq!(second, dir.path().join("room-camera-2.sc"));
+        std::fs::write(&second, "x").unwrap();
+        assert_eq!(
+            free_camera_path(dir.path(), "room"),
+            dir.path().join("room-camera-3.sc")
+        );
+        // The bundled scene's camera goes to the current folder.
+        assert_eq!(
+            free_camera_path(Path::new(""), "rtable-test-none"),
+            PathBuf::from("rtable-test-none-camera.sc")
+        );
+    }
 
     #[test]
     fn the_closing_summary_says_how_far_the_solve_got() {

@@ -446,3 +446,133 @@ fn photometric_options_reach_the_config() {
         Err(UsageError::FalsecolorMax(0.0))
     );
 }
+
+/// Cameras as the window leaves them: rounding noise in every field,
+/// negative and tiny and large coordinates, fields of view from degrees.
+fn cameras_to_print() -> Vec<Camera> {
+    let mut orbited = crate::viewer::controls::CameraControl::new(Camera {
+        eye: Vec3::new(2.5, 1.7, 0.35),
+        lookat: Vec3::new(2.5, 0.75, 3.0),
+        up: Vec3::Y,
+        fov_y: 55f32.to_radians(),
+        width: 640,
+        height: 480,
+    });
+    orbited.orbit_about(Vec3::new(1.0, 0.5, 2.0), 0.37, -0.11);
+    orbited.walk(0.013, 0.0, 0.2);
+    vec![
+        *orbited.camera(),
+        Camera {
+            eye: Vec3::new(-0.1 - 0.2, 1e-7, -3.4e11),
+            lookat: Vec3::new(1.0 / 3.0, -2.0 / 7.0, 1e11),
+            up: Vec3::new(0.01, -1.0, 0.003),
+            fov_y: crate::scene::ROOM_FOV_DEG.to_radians(),
+            width: 1,
+            height: 8192,
+        },
+        crate::scene::frame_camera(&crate::testutil::cuboid(
+            [0.0, 0.0, 0.0],
+            [6.0, 2.7, 4.0],
+            true,
+        )),
+    ]
+}
+
+#[test]
+fn a_printed_camera_block_reads_back_as_the_same_camera() {
+    for camera in cameras_to_print() {
+        let text = crate::camera::sc_block(&camera);
+        let back = crate::scene::parse_camera_str(&text, "printed.sc").expect("the block parses");
+        assert_eq!(back, camera, "{text}");
+    }
+}
+
+#[test]
+fn printed_camera_options_read_back_as_the_same_camera() {
+    // Whatever the scene's camera was, the options replace all of it.
+    let scene_camera = Camera::frame(Vec3::ZERO, Vec3::ONE);
+    for camera in cameras_to_print() {
+        let text = crate::camera::options_text(&camera);
+        let words: Vec<&str> = text.split_whitespace().collect();
+        let config = config(&words);
+        let (width, height) = config.size.expect("--size is printed");
+        let back = config
+            .camera_override
+            .apply(&scene_camera)
+            .expect("a usable camera");
+        assert_eq!(
+            Camera {
+                width,
+                height,
+                ..back
+            },
+            camera,
+            "{text}"
+        );
+    }
+}
+
+#[test]
+fn camera_options_reach_the_config_and_say_what_is_wrong() {
+    let c = config(&["--eye", "-1,2,-3.5", "--fov", "30"]);
+    assert_eq!(
+        c.camera_override,
+        crate::camera::CameraOverride {
+            eye: Some(Vec3::new(-1.0, 2.0, -3.5)),
+            fov_deg: Some(30.0),
+            ..Default::default()
+        }
+    );
+    assert!(config(&[]).camera_override.is_empty());
+    let same = invocation(&["--eye", "1,2,3", "--look-at", "1,2,3"]).unwrap_err();
+    assert_eq!(
+        same.to_string(),
+        "--eye 1,2,3 and --look-at 1,2,3 are the same point: the camera has no view direction"
+    );
+    let parallel =
+        invocation(&["--eye", "0,0,0", "--look-at", "0,5,0", "--up", "0,-2,0"]).unwrap_err();
+    assert!(
+        parallel
+            .to_string()
+            .starts_with("--up 0,-2,0 is parallel to the view direction"),
+        "{parallel}"
+    );
+    // Looking straight down with no --up given is for the scene to judge.
+    assert!(invocation(&["--eye", "0,5,0", "--look-at", "0,0,0"]).is_ok());
+    for (args, message) in [
+        (
+            &["--fov", "180"][..],
+            "--fov must be a vertical field of view",
+        ),
+        (&["--eye", "1,2"][..], "--eye must be a point X,Y,Z"),
+        (
+            &["--look-at", "1,nan,2"][..],
+            "--look-at must be a point X,Y,Z",
+        ),
+        (&["--up", "0,0,0"][..], "--up must be a direction X,Y,Z"),
+    ] {
+        let e = parse(args).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert!(e.to_string().contains(message), "{args:?}: {e}");
+    }
+}
+
+#[test]
+fn info_describes_without_a_window_and_writes_nothing() {
+    assert_eq!(invocation(&["--info"]).unwrap().mode, Mode::Info);
+    assert_eq!(
+        invocation(&["x.obj", "--info", "--emit", "Lamp=3"])
+            .unwrap()
+            .mode,
+        Mode::Info
+    );
+    for clash in [
+        &["-o", "x.png"][..],
+        &["--export", "x.glb"],
+        &["--no-window"],
+    ] {
+        let mut args = vec!["--info"];
+        args.extend_from_slice(clash);
+        assert!(parse(&args).is_err(), "{clash:?}");
+    }
+}

@@ -206,3 +206,72 @@ fn to_srgb8_keeps_size_and_order() {
     assert_eq!(img.get_pixel(0, 1).0, [0, 0, 255]);
     assert_eq!(img.get_pixel(1, 1).0, [188, 188, 188]);
 }
+
+/// A frame of `n` covered pixels, each `[v, v, v]` for `v` from `values`
+/// taken in turn.
+fn covered(values: &[f32], n: usize) -> Frame {
+    let v: Vec<f32> = values.iter().copied().cycle().take(n).collect();
+    frame(&v, &vec![true; n])
+}
+
+#[test]
+fn the_ambient_term_never_sets_the_exposure_of_an_unlit_view() {
+    // Seen from outside a room lit from within: the walls hold only the
+    // ambient term, a dim estimate (2e-4), and the solution shows nothing.
+    let shown = covered(&[2e-4, 2.5e-4, 3e-4], 300);
+    let alone = covered(&[0.0], 300);
+    let plain = auto_exposure(&shown);
+    let k = auto_exposure_beside(&shown, &alone);
+    assert!(
+        (k - plain * UNLIT_EXPOSURE_SHARE).abs() <= EXPOSURE_TOLERANCE * k,
+        "{k}"
+    );
+    // Exposed for itself, the ambient estimate filled the picture (the
+    // 95th percentile at 0.9, 8-bit 243); now it stays dim.
+    assert_eq!(srgb8(3e-4, plain), srgb8(0.9, 1.0));
+    assert!(srgb8(3e-4, k) < 80, "{}", srgb8(3e-4, k));
+}
+
+#[test]
+fn where_the_solution_has_light_the_rule_changes_nothing() {
+    // The solution lit everywhere in view, the ambient term on top: the
+    // picture's own automatic exposure is the smaller, and kept.
+    let solution: Vec<f32> = (0..200).map(|i| 0.5 + i as f32 * 0.01).collect();
+    let shown: Vec<f32> = solution.iter().map(|v| v + 0.2).collect();
+    let all = vec![true; 200];
+    let (shown, solution) = (frame(&shown, &all), frame(&solution, &all));
+    assert_eq!(
+        auto_exposure_beside(&shown, &solution),
+        auto_exposure(&shown)
+    );
+    // A small solution picture (the probe) measures the same.
+    assert_eq!(
+        auto_exposure_beside(&shown, &covered(&[0.5, 1.0, 2.0], 12)),
+        auto_exposure(&shown)
+    );
+}
+
+#[test]
+fn a_bright_lamp_alone_in_an_unlit_view_sets_the_exposure() {
+    // A few lamp pixels lit by the solution, the rest ambient only: the
+    // exposure is the lamp's (its brightest pixel), not the ambient's.
+    let mut shown = vec![1e-3f32; 100];
+    let mut solution = vec![0.0f32; 100];
+    for k in 0..3 {
+        shown[k] = 50.0;
+        solution[k] = 50.0;
+    }
+    let all = vec![true; 100];
+    let k = auto_exposure_beside(&frame(&shown, &all), &frame(&solution, &all));
+    assert!((k - 0.9 / 50.0).abs() <= EXPOSURE_TOLERANCE * k, "{k}");
+}
+
+#[test]
+fn the_exposure_probe_keeps_the_shape_and_is_small() {
+    assert_eq!(exposure_probe_size(640, 480), (160, 120));
+    assert_eq!(exposure_probe_size(100, 50), (100, 50));
+    assert_eq!(exposure_probe_size(10000, 1), (160, 1));
+    assert_eq!(exposure_probe_size(0, 0), (1, 1));
+    let (w, h) = exposure_probe_size(1920, 1080);
+    assert!(w == EXPOSURE_PROBE_SIDE && h == 90, "{w}x{h}");
+}
