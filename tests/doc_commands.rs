@@ -6,7 +6,8 @@
 //! from `tests/models/` for `room.glb`, `house.glb` and `cornell.obj`),
 //! must exit 0 and write every file it names; where the docs show what a
 //! command prints (a plain code block right after it), each shown line
-//! must be printed exactly.
+//! must be printed exactly, and where a table row gives a command's mesh
+//! (`| 14,206 vertices |`), `--stats` must count as many.
 //!
 //! Real models are solved for a few steps only (`--max-steps` is added);
 //! the bundled `.sc` scenes run to convergence, as the docs say.
@@ -23,6 +24,9 @@ struct Documented {
     line: usize,
     command: String,
     prints: Vec<String>,
+    /// The element vertices a table row gives beside the command
+    /// (`| 14,206 vertices |`), checked against `--stats`.
+    vertices: Option<u64>,
 }
 
 const DOCS: [&str; 2] = ["README.md", "docs/guide.md"];
@@ -81,6 +85,7 @@ fn commands_of(file: &'static str) -> Vec<Documented> {
                     line,
                     command,
                     prints: if single { prints.clone() } else { Vec::new() },
+                    vertices: None,
                 });
             }
             continue;
@@ -93,6 +98,7 @@ fn commands_of(file: &'static str) -> Vec<Documented> {
                     line: k + 1,
                     command: span.to_string(),
                     prints: Vec::new(),
+                    vertices: vertices_in_row(line),
                 });
             }
         }
@@ -109,6 +115,14 @@ fn is_inline_command(span: &str) -> bool {
         && words
             .next()
             .is_some_and(|w| w.starts_with('-') || w.contains('.'))
+}
+
+/// `N` of a table row's `| N vertices |` cell.
+fn vertices_in_row(line: &str) -> Option<u64> {
+    line.split('|')
+        .map(str::trim)
+        .find_map(|cell| cell.strip_suffix(" vertices"))
+        .and_then(|n| n.replace(',', "").parse().ok())
 }
 
 /// The line without a trailing shell comment.
@@ -324,6 +338,7 @@ fn the_docs_show_commands_to_run() {
     let all: Vec<Documented> = DOCS.iter().flat_map(|f| commands_of(f)).collect();
     assert!(all.len() >= 15, "{all:#?}");
     assert!(all.iter().any(|d| !d.prints.is_empty()), "{all:#?}");
+    assert!(all.iter().any(|d| d.vertices.is_some()), "{all:#?}");
 }
 
 #[test]
