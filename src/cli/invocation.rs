@@ -167,6 +167,8 @@ fn photometry(a: &PhotometryArgs) -> PhotometryConfig {
                 spacing,
                 csv: with(".csv"),
                 png: with(".png"),
+                scale: a.falsecolor_scale,
+                max: a.falsecolor_max,
             }
         }),
         falsecolor: a.falsecolor.clone().map(|path| FalsecolorConfig {
