@@ -265,3 +265,48 @@ fn negative_values_get_the_range_message() {
         assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
     }
 }
+
+/// A file that cannot be read is `FILE: error: cannot read: REASON`,
+/// with no line and column (there is no text to point into), whichever
+/// option names it; exit code 2 and nothing written.
+#[test]
+fn a_missing_file_is_reported_without_a_position() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    let cornell = cornell.to_str().unwrap();
+    let office = scene("office.sc");
+    let office = office.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["nosuch.sc"], "nosuch.sc"),
+        (&["nosuch.obj"], "nosuch.obj"),
+        (&["nosuch.glb"], "nosuch.glb"),
+        (&[cornell, "--camera", "nocam.sc"], "nocam.sc"),
+        (
+            &[office, "--units", "m", "--ies", "luminaire=nosuch.ies"],
+            "nosuch.ies",
+        ),
+        (
+            &[
+                cornell,
+                "--illuminance-at",
+                "nop.csv",
+                "--illuminance-out",
+                "e.csv",
+            ],
+            "nop.csv",
+        ),
+        (&[cornell, "--resume", "no.ckpt"], "no.ckpt"),
+    ];
+    for (args, file) in cases {
+        let mut all = args.to_vec();
+        all.extend(["-o", "out.png", "-q", "--max-steps", "1"]);
+        let out = run_in(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end(),
+            format!("{file}: error: cannot read: No such file or directory (os error 2)"),
+            "{args:?}"
+        );
+        assert!(listing(dir.path()).is_empty(), "{args:?}");
+    }
+}

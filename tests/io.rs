@@ -1028,7 +1028,7 @@ fn batch_outputs_are_checked_before_solving() {
         ),
         (
             vec!["--camera", "missing.sc"],
-            "missing.sc:1:1: error: cannot read file",
+            "missing.sc: error: cannot read: ",
         ),
     ] {
         let mut all = vec![cornell, "-o", "x.png", "-q"];

@@ -200,15 +200,17 @@ impl RunError {
         }
     }
 
-    /// True when the message already carries its own position and kind
-    /// (`FILE:LINE:COL: error: ...`, or the interruption notice), so it is
-    /// printed without an `error: ` prefix.
+    /// True when the message already carries its own file and kind
+    /// (`FILE:LINE:COL: error: ...`, `FILE: error: cannot read: ...`, or
+    /// the interruption notice), so it is printed without an `error: `
+    /// prefix.
     pub fn is_self_describing(&self) -> bool {
         matches!(
             self,
             RunError::Prepare(PrepareError::Load(_))
                 | RunError::Prepare(PrepareError::Ies(_))
                 | RunError::Points(_)
+                | RunError::Checkpoint(CheckpointError::Read { .. })
                 | RunError::Interrupted { .. }
         )
     }

@@ -13,7 +13,7 @@
 //! starting with `#` are skipped, and so is a UTF-8 byte order mark.
 //! Blanks around values are allowed.
 
-use super::input::{read_file, InputError, InputKind};
+use super::input::{read_file, InputKind};
 use crate::scene::error::fmt_num;
 use crate::scene::MAX_COORDINATE;
 use glam::{DVec3, Vec3};
@@ -21,7 +21,7 @@ use std::path::Path;
 
 /// Why a points file could not be read: `FILE:LINE:COLUMN: error: ...`.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: error: {message}")]
+#[error("{}", crate::scene::error::positioned(file, *line, *column, "error", message))]
 pub struct PointsError {
     /// The file as named by the user.
     pub file: String,
@@ -45,15 +45,10 @@ pub fn load_points(path: &Path) -> Result<Vec<MeasurementPoint>, PointsError> {
         column: 0,
         message,
     };
-    let (bytes, _) = read_file(path, InputKind::Points).map_err(|e| {
-        cannot(match e {
-            InputError::Io { error, .. } => format!("cannot read the points file: {error}"),
-            refused => refused.to_string(),
-        })
-    })?;
-    let text = String::from_utf8(bytes).map_err(|_| {
-        cannot("cannot read the points file: stream did not contain valid UTF-8".to_string())
-    })?;
+    let (bytes, _) = read_file(path, InputKind::Points)
+        .map_err(|e| cannot(crate::scene::error::unreadable(&e)))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| cannot("cannot read: stream did not contain valid UTF-8".to_string()))?;
     parse_points(&text, &name)
 }
 
