@@ -310,3 +310,37 @@ fn a_missing_file_is_reported_without_a_position() {
         assert!(listing(dir.path()).is_empty(), "{args:?}");
     }
 }
+
+/// Without a display the run says it writes a file instead of opening a
+/// window only once the scene has loaded: a scene with errors gets its
+/// errors alone, not a promise of a picture that is never written.
+#[test]
+fn no_promise_of_a_picture_before_the_scene_has_loaded() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "broken.sc", "camera\n  eye 0 0\nend\nbogus\n");
+    let out = run_in(dir.path(), &["broken.sc"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(!err.contains("instead"), "{err}");
+    assert!(err.starts_with("broken.sc:"), "{err}");
+    assert_eq!(listing(dir.path()), ["broken.sc"]);
+    // A scene that loads still says it, and writes the picture.
+    let cornell = scene("cornell.sc");
+    let out = run_in(
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--max-steps",
+            "1",
+            "--lenmax",
+            "100",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("writing cornell.png in the current directory instead"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(dir.path().join("cornell.png").exists());
+}

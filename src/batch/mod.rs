@@ -293,15 +293,21 @@ pub struct RunStats {
 /// a Ctrl-C handler, say) with [`RunError::Interrupted`], writing nothing
 /// more but the checkpoint.
 pub fn run(config: &RunConfig, cancel: &Cancel) -> Result<RunStats, RunError> {
+    let prepared = prepare(config, cancel)?;
+    run_prepared(config, &prepared, cancel)
+}
+
+/// The first half of [`run`]: checks the outputs, then loads, splits and
+/// meshes the scene ([`prepare::prepare_cancellable`]), stopping with
+/// [`RunError::Interrupted`] once `cancel` is set. [`run_prepared`] is
+/// the second.
+pub fn prepare(config: &RunConfig, cancel: &Cancel) -> Result<Prepared, RunError> {
     check_outputs(config)?;
     remove_stale_temporaries(config);
-    let prepared = match prepare::prepare_cancellable(config, cancel) {
-        Err(PrepareError::Interrupted(_)) => {
-            return Err(Written::default().interrupted(config, 0, false))
-        }
-        prepared => prepared?,
-    };
-    run_prepared(config, &prepared, cancel)
+    match prepare::prepare_cancellable(config, cancel) {
+        Err(PrepareError::Interrupted(_)) => Err(Written::default().interrupted(config, 0, false)),
+        prepared => Ok(prepared?),
+    }
 }
 
 /// Removes the temporaries a killed run left in the folders `config`
