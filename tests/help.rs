@@ -344,3 +344,64 @@ fn no_promise_of_a_picture_before_the_scene_has_loaded() {
     );
     assert!(dir.path().join("cornell.png").exists());
 }
+
+/// Each output's format message lists the formats that output accepts,
+/// and only those.
+#[test]
+fn a_format_message_lists_only_what_the_option_accepts() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    let cornell = cornell.to_str().unwrap();
+    let eight_bit = ".png, .tif or .tiff";
+    let cases: &[(&[&str], &str, String)] = &[
+        (
+            &["-o", "x.jpg"],
+            "x.jpg",
+            "unknown extension .jpg; supported picture formats are .png, .tif, .tiff, .exr, \
+             .pfm, .hdr"
+                .into(),
+        ),
+        (
+            &["--falsecolor", "fc.exr"],
+            "fc.exr",
+            format!("--falsecolor writes an 8-bit picture: use {eight_bit}"),
+        ),
+        (
+            &["--falsecolor", "fc.jpg"],
+            "fc.jpg",
+            format!(
+                "unknown extension .jpg; --falsecolor writes an 8-bit picture: use {eight_bit}"
+            ),
+        ),
+        (
+            &["--plot", "p.hdr"],
+            "p.hdr",
+            format!("a plot is an 8-bit picture: use {eight_bit}"),
+        ),
+        (
+            &["--mesh-lines", "-o", "m.pfm"],
+            "m.pfm",
+            format!("--mesh-lines draws on 8-bit pictures: use {eight_bit}"),
+        ),
+        (
+            &["--export", "m.obj"],
+            "m.obj",
+            "unknown extension .obj; supported mesh formats are .glb, .ply".into(),
+        ),
+    ];
+    for (args, file, reason) in cases {
+        let mut all = vec![cornell, "-q"];
+        all.extend_from_slice(args);
+        if !args.contains(&"-o") {
+            all.extend(["-o", "x.png"]);
+        }
+        let out = run_in(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end(),
+            format!("error: cannot write {file}: {reason}"),
+            "{args:?}"
+        );
+    }
+    assert!(listing(dir.path()).is_empty());
+}

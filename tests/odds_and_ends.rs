@@ -1,0 +1,73 @@
+//! What a user hits in a first hour beyond help and errors: `.hdr`
+//! pictures, `--threshold 0`, `--exposure` in stops, the warning when
+//! `--sky` cannot reach a closed room.
+
+mod common;
+
+use common::*;
+
+/// A `.pfm`'s pixels, top row first, three floats each.
+fn read_pfm(path: &std::path::Path) -> (u32, u32, Vec<[f32; 3]>) {
+    let bytes = std::fs::read(path).unwrap();
+    let text_end = bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, &b)| b == b'\n')
+        .nth(2)
+        .unwrap()
+        .0;
+    let header = String::from_utf8_lossy(&bytes[..text_end]).into_owned();
+    let mut words = header.split_whitespace().skip(1);
+    let w: u32 = words.next().unwrap().parse().unwrap();
+    let h: u32 = words.next().unwrap().parse().unwrap();
+    let floats: Vec<f32> = bytes[text_end + 1..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    let rows: Vec<&[f32]> = floats.chunks_exact(3 * w as usize).collect();
+    let pixels = rows
+        .iter()
+        .rev()
+        .flat_map(|r| r.chunks_exact(3).map(|p| [p[0], p[1], p[2]]))
+        .collect();
+    (w, h, pixels)
+}
+
+/// `-o X.hdr` writes a Radiance RGBE picture of the same linear values
+/// as `-o X.pfm`, to RGBE's precision (within a 128th of each pixel's
+/// largest channel).
+#[test]
+fn hdr_pictures_hold_the_pfm_values_to_rgbe_precision() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    for out in ["a.hdr", "a.pfm"] {
+        let run = run_in(
+            dir.path(),
+            &[
+                cornell.to_str().unwrap(),
+                "-o",
+                out,
+                "--lenmax",
+                "60",
+                "--max-steps",
+                "10",
+                "--size",
+                "40x30",
+                "-q",
+            ],
+        );
+        assert!(run.status.success(), "{out}: {}", stderr(&run));
+    }
+    let hdr = image::open(dir.path().join("a.hdr")).unwrap().into_rgb32f();
+    let (w, h, pfm) = read_pfm(&dir.path().join("a.pfm"));
+    assert_eq!(hdr.dimensions(), (w, h));
+    let mut lit = 0;
+    for (got, want) in hdr.pixels().zip(&pfm) {
+        let largest = want.iter().copied().fold(0.0f32, f32::max);
+        lit += usize::from(largest > 0.0);
+        for (g, v) in got.0.iter().zip(want) {
+            assert!((g - v).abs() <= largest / 128.0, "{:?} for {want:?}", got.0);
+        }
+    }
+    assert!(lit > pfm.len() / 2, "only {lit} lit pixels");
+}
