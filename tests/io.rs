@@ -748,8 +748,6 @@ fn exported_obj_round_trips_through_the_program() {
             "20",
             "--size",
             "64x64",
-            "--exposure",
-            "1",
             "--export",
             "baked.glb",
             "-q",

@@ -71,3 +71,62 @@ fn hdr_pictures_hold_the_pfm_values_to_rgbe_precision() {
     }
     assert!(lit > pfm.len() / 2, "only {lit} lit pixels");
 }
+
+/// `--exposure` counts stops from the automatic exposure: 0 is the
+/// automatic picture bit for bit, +2 four times the factor (a brighter
+/// picture), -1 half of it; the summary and `--stats` give the automatic
+/// value and the stops.
+#[test]
+fn exposure_is_in_stops_from_the_automatic_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    let run = |name: &str, stops: Option<&str>| {
+        let png = format!("{name}.png");
+        let json = format!("{name}.json");
+        let mut args = vec![
+            cornell.to_str().unwrap(),
+            "-o",
+            &png,
+            "--stats",
+            &json,
+            "--lenmax",
+            "60",
+            "--max-steps",
+            "20",
+            "--size",
+            "48x48",
+        ];
+        if let Some(stops) = stops {
+            args.extend(["--exposure", stops]);
+        }
+        let out = run_in(dir.path(), &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let stats = read_json(dir.path(), &json);
+        let picture = image::open(dir.path().join(&png)).unwrap().to_rgb8();
+        let mean = picture.pixels().map(|p| f64::from(p.0[1])).sum::<f64>()
+            / f64::from(picture.width() * picture.height());
+        (stderr(&out), stats, picture, mean)
+    };
+    let (said, auto, picture, mean) = run("auto", None);
+    let factor = auto["exposure"].as_f64().unwrap();
+    assert_eq!(auto["auto_exposure"].as_f64(), Some(factor));
+    assert_eq!(auto["exposure_stops"].as_f64(), Some(0.0));
+    assert!(said.contains(", exposure "), "{said}");
+    assert!(said.contains(" (automatic) → auto.png"), "{said}");
+
+    let (_, zero, same, _) = run("zero", Some("0"));
+    assert_eq!(zero["exposure"].as_f64(), Some(factor));
+    assert!(same == picture, "--exposure 0 is the automatic picture");
+
+    let (said, up, _, brighter) = run("up", Some("2"));
+    assert_eq!(up["auto_exposure"].as_f64(), Some(factor));
+    let four = up["exposure"].as_f64().unwrap() / factor;
+    assert!((four - 4.0).abs() < 1e-6, "{four}");
+    assert!(said.contains("+2 stops) → up.png"), "{said}");
+    assert!(brighter > mean * 1.3, "{brighter} against {mean}");
+
+    let (_, down, _, darker) = run("down", Some("-1"));
+    let half = down["exposure"].as_f64().unwrap() / factor;
+    assert!((half - 0.5).abs() < 1e-6, "{half}");
+    assert!(darker < mean, "{darker} against {mean}");
+}

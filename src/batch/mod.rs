@@ -265,8 +265,13 @@ pub struct RunStats {
     /// Unshot power left as a fraction of the emitted power.
     pub unshot_fraction: f64,
     /// The exposure the 8-bit picture and the exported display colours
-    /// used (dimensionless): the given one, or the automatic one.
+    /// used (dimensionless): `auto_exposure × 2^exposure_stops`.
     pub exposure: f32,
+    /// The picture's automatic exposure (dimensionless): the factor that
+    /// maps its 95th-percentile luminance to 0.9 ([`render::auto_exposure`]).
+    pub auto_exposure: f32,
+    /// The stops `--exposure` gave from the automatic exposure (0 without).
+    pub exposure_stops: f32,
     /// True when the threshold was reached and every point settled
     /// ([`crate::solver::SolverOptions::settle`]); false at the step limit, and
     /// false when nothing emits (`nothing_emits`): then nothing was
@@ -411,7 +416,8 @@ pub fn run_prepared(
     }
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree.
-    let exposure = config.exposure.resolve(frame);
+    let auto = render::auto_exposure(frame);
+    let exposure = (config.exposure.with_auto(auto), auto);
     if cancel.is_set() {
         return Err(written.interrupted(config, totals.steps, true));
     }
@@ -422,7 +428,7 @@ pub fn run_prepared(
         solved: &solved,
         drawn: &drawn,
         view: &view,
-        exposure,
+        exposure: exposure.0,
         points: points.as_deref(),
     };
     let wrote = output::cancelling_writes(cancel, || {
@@ -646,13 +652,14 @@ fn write_plot(
 /// The figures of a finished run: what was solved and written, with the
 /// `dark` picture warning if there was one; `seconds.write` is left for
 /// the caller to fill.
+/// `exposure` is the factor used and the automatic one.
 fn run_stats(
     config: &RunConfig,
     prepared: &Prepared,
     session: &Session,
     mesh: &crate::mesh::Mesh,
     dark: Option<String>,
-    exposure: f32,
+    (exposure, auto): (f32, f32),
     seconds: PhaseSeconds,
 ) -> RunStats {
     let totals = session.totals();
@@ -691,6 +698,8 @@ fn run_stats(
         },
         unshot_fraction: session.unshot_fraction(),
         exposure,
+        auto_exposure: auto,
+        exposure_stops: config.exposure.stops(auto),
         converged: session.converged() && prepared.scene.emits(),
         nothing_emits: !prepared.scene.emits(),
         adaptive: if config.adaptive.is_some() {
@@ -858,12 +867,31 @@ pub fn summary(stats: &RunStats) -> String {
         None => String::new(),
     };
     format!(
-        "{}{sky}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {written}",
+        "{}{sky}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{}, {} → {written}",
         stats.scene,
         stats.seconds.solve,
         stats.rays as f64 / 1e6,
         stats.unshot_fraction * 100.0,
         if stats.converged { "" } else { " (step limit)" },
+        exposure_text(stats.exposure, stats.auto_exposure, stats.exposure_stops),
+    )
+}
+
+/// The exposure as the summary line says it: `exposure 2.42 (automatic)`,
+/// or with the stops given, `exposure 9.67 (automatic 2.42, +2 stops)`;
+/// three significant digits.
+fn exposure_text(exposure: f32, auto: f32, stops: f32) -> String {
+    let num = |x: f32| crate::scene::fmt_num(f64::from(x));
+    if stops == 0.0 {
+        return format!("exposure {} (automatic)", num(exposure));
+    }
+    let unit = if stops.abs() == 1.0 { "stop" } else { "stops" };
+    let sign = if stops > 0.0 { "+" } else { "" };
+    format!(
+        "exposure {} (automatic {}, {sign}{} {unit})",
+        num(exposure),
+        num(auto),
+        num(stops)
     )
 }
 
@@ -891,6 +919,22 @@ mod tests {
 
     fn paths(names: &[&str]) -> Vec<PathBuf> {
         names.iter().map(PathBuf::from).collect()
+    }
+
+    #[test]
+    fn the_summary_gives_the_exposure_and_the_automatic_one() {
+        assert_eq!(
+            exposure_text(2.4168, 2.4168, 0.0),
+            "exposure 2.42 (automatic)"
+        );
+        assert_eq!(
+            exposure_text(9.6672, 2.4168, 2.0),
+            "exposure 9.67 (automatic 2.42, +2 stops)"
+        );
+        assert_eq!(
+            exposure_text(1.2084, 2.4168, -1.0),
+            "exposure 1.21 (automatic 2.42, -1 stop)"
+        );
     }
 
     #[test]

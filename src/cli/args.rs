@@ -258,10 +258,14 @@ pub struct Args {
     #[arg(help_heading = heading::PICTURE)]
     pub(crate) size: Option<(u32, u32)>,
 
-    /// Exposure multiplier for 8-bit pictures.
+    /// Exposure in stops from the automatic one (+1 is twice as bright).
     ///
-    /// Default: automatic (the 95th-percentile luminance maps to 0.9).
-    #[arg(long, value_name = "X")]
+    /// 8-bit pictures and exported colours are scaled by the automatic
+    /// exposure (the 95th-percentile luminance maps to 0.9) times
+    /// 2^STOPS, as the window's + and - keys and Radiance's `pfilt -e +2`
+    /// count; 0 is the automatic exposure, the default. The summary line
+    /// and --stats give the automatic value. From -40 to 40.
+    #[arg(long, value_name = "STOPS")]
     #[arg(help_heading = heading::PICTURE)]
     pub(crate) exposure: Option<f32>,
 

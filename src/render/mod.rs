@@ -42,7 +42,7 @@ pub use overlay::{draw_mesh_edges, LinePalette, MESH_COLOR, MESH_COLOR_ON_LIGHT,
 pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
 pub use tonemap::{
     auto_exposure, back_face_color, srgb8, srgb_encode, to_srgb8, Exposure, BACK_FACE_COLORS,
-    BACK_FACE_STRIPE,
+    BACK_FACE_STRIPE, MAX_EXPOSURE_STOPS,
 };
 pub use view::{View, ViewError};
 

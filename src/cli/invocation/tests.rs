@@ -132,7 +132,7 @@ fn every_option_reaches_the_config() {
     );
     assert_eq!(c.size, Some((32, 24)));
     assert_eq!(c.aa, 5);
-    assert_eq!(c.exposure, Exposure::Fixed(2.0));
+    assert_eq!(c.exposure, Exposure::Stops(2.0));
     assert_eq!(c.stats, Some(PathBuf::from("s.json")));
     assert_eq!(c.camera, Some(PathBuf::from("cam.sc")));
     assert_eq!(c.export, Some(PathBuf::from("m.ply")));
@@ -282,9 +282,10 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
             "--adaptive-levels must be between 1 and 6, got 0",
         ),
         (
-            &["--exposure", "0"],
-            UsageError::Exposure(0.0),
-            "--exposure must be a positive number, got 0",
+            &["--exposure", "40.5"],
+            UsageError::Exposure(40.5),
+            "--exposure must be a number of stops from -40 to 40 (0 is the automatic exposure, \
+             +1 twice as bright), got 40.5",
         ),
         (
             &["--threads", "0"],
@@ -304,6 +305,10 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
         assert_eq!(&e, error, "{args:?}");
         assert!(e.to_string().starts_with(message), "{args:?}: {e}");
     }
+    assert!(matches!(
+        invocation(&["--exposure", "nan"]),
+        Err(UsageError::Exposure(x)) if x.is_nan()
+    ));
     let over = (mesh::MAX_ADDRESSABLE_ELEMENTS + 1).to_string();
     assert!(matches!(
         invocation(&["--max-elements", &over]),
@@ -341,6 +346,26 @@ fn adaptive_options_reach_the_config_only_with_adaptive() {
     // Without --adaptive they are refused by clap, not ignored.
     assert!(parse(&["--adaptive-levels", "3"]).is_err());
     assert!(parse(&["--adaptive", "--checkpoint", "c.bin"]).is_err());
+}
+
+/// `--exposure` counts stops from the automatic exposure: 0 is the
+/// automatic one, negative values darken.
+#[test]
+fn exposure_is_in_stops() {
+    assert_eq!(config(&[]).exposure, Exposure::Auto);
+    assert_eq!(config(&["--exposure", "0"]).exposure, Exposure::Stops(0.0));
+    assert_eq!(
+        config(&["--exposure", "-2"]).exposure,
+        Exposure::Stops(-2.0)
+    );
+    assert_eq!(
+        config(&["--exposure", "+1.5"]).exposure,
+        Exposure::Stops(1.5)
+    );
+    assert_eq!(
+        config(&["--exposure", "40"]).exposure,
+        Exposure::Stops(40.0)
+    );
 }
 
 #[test]
