@@ -130,3 +130,42 @@ fn exposure_is_in_stops_from_the_automatic_one() {
     assert!((half - 0.5).abs() < 1e-6, "{half}");
     assert!(darker < mean, "{darker} against {mean}");
 }
+
+/// `--sky` on a closed room (rtable: its camera sees no opening, and the
+/// sky's light lights nothing inside) gets one warning saying so, even
+/// with `-q`, also in `--stats`; the open Cornell box (no front wall)
+/// gets none, nor does the room without a sky.
+#[test]
+fn a_sky_that_cannot_reach_a_closed_room_is_said_once() {
+    let warning = "warning: --sky: no sky light reaches the scene (it is closed)";
+    let dir = tempfile::tempdir().unwrap();
+    let run = |scene_name: &str, lenmax: &str, sky: bool| {
+        let scene = scene(scene_name);
+        let mut args = vec![
+            scene.to_str().unwrap().to_string(),
+            "-o".into(),
+            "out.png".into(),
+            "--stats".into(),
+            "stats.json".into(),
+            "--lenmax".into(),
+            lenmax.into(),
+            "--size".into(),
+            "32x24".into(),
+            "-q".into(),
+        ];
+        if sky {
+            args.extend(["--sky".into(), "1".into()]);
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = run_in(dir.path(), &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let stats = read_json(dir.path(), "stats.json");
+        let in_stats = stats["warnings"]
+            .as_array()
+            .is_some_and(|w| w.iter().any(|w| w.as_str().unwrap().starts_with(warning)));
+        (stderr(&out).matches(warning).count(), in_stats)
+    };
+    assert_eq!(run("rtable.sc", "1", true), (1, true));
+    assert_eq!(run("rtable.sc", "1", false), (0, false));
+    assert_eq!(run("cornell.sc", "60", true), (0, false));
+}

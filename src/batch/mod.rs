@@ -34,6 +34,7 @@ pub mod failure;
 pub mod outputs;
 pub mod photometry;
 pub mod progress;
+pub mod sky_watch;
 
 pub use checkpoint::CheckpointError;
 pub use outputs::{check_outputs, check_outputs_against};
@@ -51,6 +52,7 @@ use crate::solver::checkpoint::fingerprint;
 use crate::solver::SolverError;
 use progress::Progress;
 use serde::Serialize;
+use sky_watch::SkyWatch;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -228,9 +230,10 @@ pub struct RunStats {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub also_written: Vec<String>,
     /// The warnings said on loading, as printed (`FILE:LINE:COL: warning:
-    /// ...`), then the one about a (nearly) black picture
-    /// ([`render::PictureCoverage::dark_warning`]) if it was said; empty
-    /// (and not written) when there were none.
+    /// ...`), then the one about a sky that lights nothing
+    /// ([`sky_watch::SKY_BLOCKED`]) and the one about a (nearly) black
+    /// picture ([`render::PictureCoverage::dark_warning`]) if they were
+    /// said; empty (and not written) when there were none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
     /// Scene polygons (after splitting along intersections; the sky's
@@ -349,6 +352,9 @@ struct Solved<'p> {
     radiosity: Vec<crate::color::Rgb>,
     shown: Vec<crate::color::Rgb>,
     records: Vec<StepRecord>,
+    /// The warnings the solve said ([`sky_watch::SKY_BLOCKED`]), as
+    /// printed.
+    warnings: Vec<String>,
 }
 
 /// [`run`] from a prepared scene: solve, render, write.
@@ -433,7 +439,8 @@ pub fn run_prepared(
     };
     let wrote = output::cancelling_writes(cancel, || {
         results.write(&mut written, cancel)?;
-        let mut stats = run_stats(config, prepared, &session, mesh, dark, exposure, seconds);
+        let said = solved.warnings.iter().cloned().chain(dark).collect();
+        let mut stats = run_stats(config, prepared, &session, mesh, said, exposure, seconds);
         stats.seconds.write = t.elapsed().as_secs_f64();
         if let Some(path) = &config.stats {
             cancel.check()?;
@@ -650,15 +657,15 @@ fn write_plot(
 }
 
 /// The figures of a finished run: what was solved and written, with the
-/// `dark` picture warning if there was one; `seconds.write` is left for
-/// the caller to fill.
+/// warnings `said` while solving and drawing (the sky that lights nothing,
+/// the dark picture); `seconds.write` is left for the caller to fill.
 /// `exposure` is the factor used and the automatic one.
 fn run_stats(
     config: &RunConfig,
     prepared: &Prepared,
     session: &Session,
     mesh: &crate::mesh::Mesh,
-    dark: Option<String>,
+    said: Vec<String>,
     (exposure, auto): (f32, f32),
     seconds: PhaseSeconds,
 ) -> RunStats {
@@ -675,7 +682,7 @@ fn run_stats(
             .warnings
             .iter()
             .map(|w| w.to_string())
-            .chain(dark)
+            .chain(said)
             .collect(),
         polygons: prepared
             .scene
@@ -746,6 +753,17 @@ fn solve<'p>(
     let mut progress = Progress::new(config.progress, config.solver.threshold);
     let mut last_save = Instant::now();
     let start = Instant::now();
+    // A resumed solve's sky may have shot already: it is not watched.
+    let mut sky_watch = SkyWatch::new(
+        &prepared.scene,
+        session.mesh(),
+        session.radiosity(),
+        prepared.visibility(),
+    )
+    .filter(|_| config.resume.is_none());
+    // Said whatever -q says, as the load warnings.
+    let sky_blocked = || format!("warning: {}", sky_watch::SKY_BLOCKED);
+    let mut warnings = Vec::new();
     loop {
         if cancel.is_set() {
             progress.clear();
@@ -777,10 +795,23 @@ fn solve<'p>(
                     save(session, &records)?;
                     last_save = Instant::now();
                 }
+                if let Some(watch) = &mut sky_watch {
+                    if let Some(blocked) = watch.step(&report, session.mesh(), session.radiosity())
+                    {
+                        sky_watch = None;
+                        if blocked {
+                            progress.say(&sky_blocked());
+                            warnings.push(sky_blocked());
+                        }
+                    }
+                }
                 progress.step(&report, session.solver().rays());
             }
             Event::Step(_) | Event::Stopped(_) | Event::Cancelled => {}
             Event::Refined(report) => {
+                // The sky shoots in the first pass; the watch does not
+                // follow the mesh to the next.
+                sky_watch = None;
                 // A bar of its own for each pass, under the line saying
                 // what the last pass did.
                 progress.clear();
@@ -802,6 +833,11 @@ fn solve<'p>(
         }
     }
     progress.clear();
+    // A sky much weaker than the lamps may be left partly unshot.
+    if sky_watch.is_some_and(|watch| watch.finish()) {
+        eprintln!("{}", sky_blocked());
+        warnings.push(sky_blocked());
+    }
     if config.progress && config.adaptive.is_some() {
         say_pass(session, None);
     }
@@ -816,6 +852,7 @@ fn solve<'p>(
         radiosity,
         shown,
         records,
+        warnings,
     })
 }
 

@@ -84,7 +84,7 @@ pub fn parse() -> Result<Args, clap::Error> {
 
 /// Parses `args` (the program's name first) with [`command`]'s help,
 /// refusing an option given without the one it needs
-/// ([`super::needs`]).
+/// (the table in `cli/needs.rs`).
 pub fn parse_from<I, T>(args: I) -> Result<Args, clap::Error>
 where
     I: IntoIterator<Item = T>,
