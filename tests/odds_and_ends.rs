@@ -169,3 +169,107 @@ fn a_sky_that_cannot_reach_a_closed_room_is_said_once() {
     assert_eq!(run("rtable.sc", "1", false), (0, false));
     assert_eq!(run("cornell.sc", "60", true), (0, false));
 }
+
+/// Whether `name` (a file in the repository's top folder) matches the
+/// `.gitignore` pattern `pattern` (`*` wildcards, an optional leading `/`).
+fn glob(pattern: &str, name: &str) -> bool {
+    let pattern = pattern.trim_start_matches('/');
+    if pattern.contains('/') {
+        return false;
+    }
+    let parts: Vec<&str> = pattern.split('*').collect();
+    let (first, last) = (parts[0], parts[parts.len() - 1]);
+    if parts.len() == 1 {
+        return name == pattern;
+    }
+    if !name.starts_with(first) || !name[first.len()..].ends_with(last) {
+        return false;
+    }
+    let mut rest = &name[first.len()..name.len() - last.len()];
+    for middle in &parts[1..parts.len() - 1] {
+        match rest.find(middle) {
+            Some(at) => rest = &rest[at + middle.len()..],
+            None => return false,
+        }
+    }
+    true
+}
+
+/// Whether the repository's `.gitignore` ignores `name` in its top folder.
+fn ignored(name: &str) -> bool {
+    let text = std::fs::read_to_string(root().join(".gitignore")).unwrap();
+    let mut ignored = false;
+    for line in text.lines().map(str::trim) {
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        match line.strip_prefix('!') {
+            Some(p) if glob(p, name) => ignored = false,
+            None if glob(line, name) => ignored = true,
+            _ => {}
+        }
+    }
+    ignored
+}
+
+/// Every file a run writes under its default name, and the outputs the
+/// guide's commands name, are ignored by git: running the program in the
+/// repository leaves `git status` clean.
+#[test]
+fn the_gitignore_covers_what_the_program_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let office = scene("office.sc");
+    // Without -o or --workplane-out: the picture and the work plane under
+    // their default names.
+    let out = run_in(
+        dir.path(),
+        &[
+            office.to_str().unwrap(),
+            "--no-window",
+            "--units",
+            "m",
+            "--workplane",
+            "0.8",
+            "--lenmax",
+            "1",
+            "--max-steps",
+            "2",
+            "--size",
+            "32x24",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut written = listing(dir.path());
+    assert_eq!(
+        written,
+        ["office-workplane.csv", "office-workplane.png", "office.png"]
+    );
+    // The window's w and p pictures (viewer::next_auto_name), a killed
+    // run's temporary (output::Temporary), and what the guide's commands
+    // write under names of their own.
+    written.extend(
+        [
+            "office-001.tiff",
+            "office.tiff",
+            ".radiosity-1234-a1b2c3",
+            "room.exr",
+            "room.pfm",
+            "room.hdr",
+            "room.tif",
+            "big.ckpt",
+            "room.glb",
+            "room.ply",
+            "stats.json",
+            "steps.csv",
+            "lux.csv",
+        ]
+        .map(String::from),
+    );
+    for name in &written {
+        assert!(ignored(name), "{name} is not ignored");
+    }
+    for kept in ["Cargo.toml", "README.md", "room.sc", "room.obj", "room.mtl"] {
+        assert!(!ignored(kept), "{kept} is ignored");
+    }
+}
