@@ -163,7 +163,7 @@ fn missing_scene_file_is_refused() {
     let out = run_in(dir.path(), &["nowhere.sc", "-o", "out.png"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(
-        stderr(&out).contains("nowhere.sc:1:1: error:"),
+        stderr(&out).starts_with("nowhere.sc: error: cannot read: "),
         "{}",
         stderr(&out)
     );

@@ -30,7 +30,7 @@ pub const EXIT_CODES: &str =
 pub mod heading {
     /// The scene and how its files are read.
     pub const INPUT: &str = "Input";
-    /// The files a run writes besides pictures' looks.
+    /// The files a run writes, and what it says while it runs.
     pub const OUTPUT: &str = "Output";
     /// The mesh, the solver and its limits.
     pub const SOLVER: &str = "Mesh and solver";
@@ -64,11 +64,11 @@ pub struct Args {
     #[arg(help_heading = heading::INPUT, display_order = 0)]
     pub(crate) scene: Option<PathBuf>,
 
-    /// Picture to write: .png or .tif/.tiff, .exr or .pfm.
+    /// Picture to write: .png or .tif/.tiff, .exr, .pfm or .hdr.
     ///
     /// .png and .tif/.tiff are 8-bit and tone-mapped; .exr and .pfm hold
-    /// 32-bit float linear radiosity. Default: <scene-name>.png in the
-    /// current directory.
+    /// 32-bit float linear radiosity, .hdr (Radiance RGBE) the same to
+    /// about 1 %. Default: <scene-name>.png in the current directory.
     #[arg(short, long, value_name = "FILE")]
     #[arg(help_heading = heading::OUTPUT)]
     pub(crate) output: Option<PathBuf>,
@@ -238,7 +238,7 @@ pub struct Args {
     /// Samples per pixel side for written pictures (1 to 8).
     ///
     /// The picture is rendered at N × N samples a pixel and averaged in
-    /// linear radiosity, so polygon edges are smooth; .exr and .pfm keep
+    /// linear radiosity, so polygon edges are smooth; .exr, .pfm and .hdr keep
     /// the averaged linear values. 1 draws one sample a pixel, as the
     /// window does. Very large pictures use fewer samples (at most 64 M).
     #[arg(long, value_name = "N", default_value_t = antialias::DEFAULT_AA,
