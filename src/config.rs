@@ -178,6 +178,12 @@ pub struct WorkplaneConfig {
     pub csv: PathBuf,
     /// The plan to write (`PREFIX.png`).
     pub png: PathBuf,
+    /// The plan's false-colour scale (`--falsecolor-scale`).
+    pub scale: crate::render::falsecolor::Scale,
+    /// The value the plan shows red (`--falsecolor-max`), in lux with a
+    /// unit, else in the scene's radiosity units; `None` for the largest,
+    /// rounded up.
+    pub max: Option<f64>,
 }
 
 /// A false-colour picture of the view to write.

@@ -25,7 +25,7 @@ pub fn run(
 ) -> Result<Option<RunStats>, RunError> {
     let config = &invocation.config;
     match invocation.mode {
-        Mode::Batch => batch(config, None, cancel, arm_cancel),
+        Mode::Batch => batch(config, None, cancel, arm_cancel, || {}),
         Mode::Info => {
             print!("{}", crate::info::describe(config)?);
             Ok(None)
@@ -41,11 +41,12 @@ pub fn run(
                 }
             };
             if let Err(why) = viewer::display_available() {
-                // Bad outputs are refused before the notice, which would
-                // otherwise promise a file that is never written.
-                batch::check_outputs(config)?;
-                fallback(&why.to_string());
-                return batch(config, None, cancel, arm_cancel);
+                // Said once the scene has loaded: bad outputs and a scene
+                // that does not load are refused before it, as the notice
+                // would promise a file that is never written.
+                return batch(config, None, cancel, arm_cancel, || {
+                    fallback(&why.to_string())
+                });
             }
             // The window's first frame needs no BVH: the solver's thread
             // builds it.
@@ -53,8 +54,9 @@ pub fn run(
             match viewer::run(&prepared, config) {
                 Ok(()) => Ok(None),
                 Err(ViewerError::CannotOpen(why)) => {
-                    fallback(&why);
-                    batch(config, Some(&prepared), cancel, arm_cancel)
+                    batch(config, Some(&prepared), cancel, arm_cancel, || {
+                        fallback(&why)
+                    })
                 }
                 Err(ViewerError::View(e)) => Err(RunError::View(e)),
                 Err(ViewerError::Render(e)) => Err(RunError::Render(e)),
@@ -65,16 +67,23 @@ pub fn run(
 
 /// The batch run, from the scene or from a scene already `prepared` for a
 /// window that could not open: the one place a run is made cancellable.
+/// `loaded` is called once the scene is prepared, before the solve.
 fn batch(
     config: &RunConfig,
     prepared: Option<&Prepared>,
     cancel: &Cancel,
     arm_cancel: impl FnOnce(),
+    loaded: impl FnOnce(),
 ) -> Result<Option<RunStats>, RunError> {
     arm_cancel();
-    match prepared {
-        None => batch::run(config, cancel),
-        Some(prepared) => batch::run_prepared(config, prepared, cancel),
-    }
-    .map(Some)
+    let owned;
+    let prepared = match prepared {
+        Some(prepared) => prepared,
+        None => {
+            owned = batch::prepare(config, cancel)?;
+            &owned
+        }
+    };
+    loaded();
+    batch::run_prepared(config, prepared, cancel).map(Some)
 }

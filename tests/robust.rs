@@ -310,14 +310,20 @@ fn outputs_never_clobber_the_input_or_each_other() {
         ),
         (
             &["-o", "out.png", "--resume", "nothing.ckpt"],
-            "cannot read checkpoint nothing.ckpt",
+            "nothing.ckpt: error: cannot read: ",
         ),
         (
             &["-o", "out.png", "--max-elements", "0"],
             "--max-elements must be",
         ),
         (
-            &["-o", "out.png", "--checkpoint-every=-1"],
+            &[
+                "-o",
+                "out.png",
+                "--checkpoint",
+                "c.ckpt",
+                "--checkpoint-every=-1",
+            ],
             "--checkpoint-every must be",
         ),
     ];

@@ -19,8 +19,9 @@ use std::path::{Path, PathBuf};
 /// Why a checkpoint could not be read or used. Every message names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
-    /// The file could not be read.
-    #[error("cannot read checkpoint {}: {error}", path.display())]
+    /// The file could not be read: `FILE: error: cannot read: REASON`, as
+    /// for every input file that cannot be read.
+    #[error("{}: error: cannot read: {error}", path.display())]
     Read {
         /// The checkpoint file.
         path: PathBuf,
@@ -228,7 +229,10 @@ mod tests {
             assert!(e.to_string().contains(option), "{option} missing: {e}");
         }
         let e = load(&dir.path().join("missing"), 7).unwrap_err();
-        assert!(e.to_string().contains("cannot read checkpoint"), "{e}");
+        assert!(
+            e.to_string().contains("missing: error: cannot read: "),
+            "{e}"
+        );
     }
 
     #[test]

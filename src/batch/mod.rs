@@ -34,6 +34,7 @@ pub mod failure;
 pub mod outputs;
 pub mod photometry;
 pub mod progress;
+pub mod sky_watch;
 
 pub use checkpoint::CheckpointError;
 pub use outputs::{check_outputs, check_outputs_against};
@@ -51,6 +52,7 @@ use crate::solver::checkpoint::fingerprint;
 use crate::solver::SolverError;
 use progress::Progress;
 use serde::Serialize;
+use sky_watch::SkyWatch;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -200,15 +202,17 @@ impl RunError {
         }
     }
 
-    /// True when the message already carries its own position and kind
-    /// (`FILE:LINE:COL: error: ...`, or the interruption notice), so it is
-    /// printed without an `error: ` prefix.
+    /// True when the message already carries its own file and kind
+    /// (`FILE:LINE:COL: error: ...`, `FILE: error: cannot read: ...`, or
+    /// the interruption notice), so it is printed without an `error: `
+    /// prefix.
     pub fn is_self_describing(&self) -> bool {
         matches!(
             self,
             RunError::Prepare(PrepareError::Load(_))
                 | RunError::Prepare(PrepareError::Ies(_))
                 | RunError::Points(_)
+                | RunError::Checkpoint(CheckpointError::Read { .. })
                 | RunError::Interrupted { .. }
         )
     }
@@ -226,9 +230,10 @@ pub struct RunStats {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub also_written: Vec<String>,
     /// The warnings said on loading, as printed (`FILE:LINE:COL: warning:
-    /// ...`), then the one about a (nearly) black picture
-    /// ([`render::PictureCoverage::dark_warning`]) if it was said; empty
-    /// (and not written) when there were none.
+    /// ...`), then the one about a sky that lights nothing
+    /// ([`sky_watch::SKY_BLOCKED`]) and the one about a (nearly) black
+    /// picture ([`render::PictureCoverage::dark_warning`]) if they were
+    /// said; empty (and not written) when there were none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
     /// Scene polygons (after splitting along intersections; the sky's
@@ -263,8 +268,13 @@ pub struct RunStats {
     /// Unshot power left as a fraction of the emitted power.
     pub unshot_fraction: f64,
     /// The exposure the 8-bit picture and the exported display colours
-    /// used (dimensionless): the given one, or the automatic one.
+    /// used (dimensionless): `auto_exposure × 2^exposure_stops`.
     pub exposure: f32,
+    /// The picture's automatic exposure (dimensionless): the factor that
+    /// maps its 95th-percentile luminance to 0.9 ([`render::auto_exposure`]).
+    pub auto_exposure: f32,
+    /// The stops `--exposure` gave from the automatic exposure (0 without).
+    pub exposure_stops: f32,
     /// True when the threshold was reached and every point settled
     /// ([`crate::solver::SolverOptions::settle`]); false at the step limit, and
     /// false when nothing emits (`nothing_emits`): then nothing was
@@ -291,15 +301,21 @@ pub struct RunStats {
 /// a Ctrl-C handler, say) with [`RunError::Interrupted`], writing nothing
 /// more but the checkpoint.
 pub fn run(config: &RunConfig, cancel: &Cancel) -> Result<RunStats, RunError> {
+    let prepared = prepare(config, cancel)?;
+    run_prepared(config, &prepared, cancel)
+}
+
+/// The first half of [`run`]: checks the outputs, then loads, splits and
+/// meshes the scene ([`prepare::prepare_cancellable`]), stopping with
+/// [`RunError::Interrupted`] once `cancel` is set. [`run_prepared`] is
+/// the second.
+pub fn prepare(config: &RunConfig, cancel: &Cancel) -> Result<Prepared, RunError> {
     check_outputs(config)?;
     remove_stale_temporaries(config);
-    let prepared = match prepare::prepare_cancellable(config, cancel) {
-        Err(PrepareError::Interrupted(_)) => {
-            return Err(Written::default().interrupted(config, 0, false))
-        }
-        prepared => prepared?,
-    };
-    run_prepared(config, &prepared, cancel)
+    match prepare::prepare_cancellable(config, cancel) {
+        Err(PrepareError::Interrupted(_)) => Err(Written::default().interrupted(config, 0, false)),
+        prepared => Ok(prepared?),
+    }
 }
 
 /// Removes the temporaries a killed run left in the folders `config`
@@ -336,6 +352,9 @@ struct Solved<'p> {
     radiosity: Vec<crate::color::Rgb>,
     shown: Vec<crate::color::Rgb>,
     records: Vec<StepRecord>,
+    /// The warnings the solve said ([`sky_watch::SKY_BLOCKED`]), as
+    /// printed.
+    warnings: Vec<String>,
 }
 
 /// [`run`] from a prepared scene: solve, render, write.
@@ -403,16 +422,17 @@ pub fn run_prepared(
     }
     let t = Instant::now();
     // Resolved once, so the picture and the exported colours agree; with
-    // the ambient term shown (--ambient), as the window does.
-    let exposure = match config.exposure {
-        Exposure::Auto if session.options().ambient && totals.steps > 0 => {
-            let (w, h) = render::exposure_probe_size(view.width(), view.height());
-            let probe = View::with_size(&prepared.scene.camera, w, h)?;
-            let mut alone = Rasterizer::new();
-            render::auto_exposure_beside(frame, alone.render(mesh, &solved.radiosity, &probe)?)
-        }
-        exposure => exposure.resolve(frame),
+    // the ambient term shown (--ambient), as the window does, the
+    // automatic exposure is at most the solution's own.
+    let auto = if session.options().ambient && totals.steps > 0 {
+        let (w, h) = render::exposure_probe_size(view.width(), view.height());
+        let probe = View::with_size(&prepared.scene.camera, w, h)?;
+        let mut alone = Rasterizer::new();
+        render::auto_exposure_beside(frame, alone.render(mesh, &solved.radiosity, &probe)?)
+    } else {
+        render::auto_exposure(frame)
     };
+    let exposure = (config.exposure.with_auto(auto), auto);
     if cancel.is_set() {
         return Err(written.interrupted(config, totals.steps, true));
     }
@@ -423,12 +443,13 @@ pub fn run_prepared(
         solved: &solved,
         drawn: &drawn,
         view: &view,
-        exposure,
+        exposure: exposure.0,
         points: points.as_deref(),
     };
     let wrote = output::cancelling_writes(cancel, || {
         results.write(&mut written, cancel)?;
-        let mut stats = run_stats(config, prepared, &session, mesh, dark, exposure, seconds);
+        let said = solved.warnings.iter().cloned().chain(dark).collect();
+        let mut stats = run_stats(config, prepared, &session, mesh, said, exposure, seconds);
         stats.seconds.write = t.elapsed().as_secs_f64();
         if let Some(path) = &config.stats {
             cancel.check()?;
@@ -644,15 +665,16 @@ fn write_plot(
 }
 
 /// The figures of a finished run: what was solved and written, with the
-/// `dark` picture warning if there was one; `seconds.write` is left for
-/// the caller to fill.
+/// warnings `said` while solving and drawing (the sky that lights nothing,
+/// the dark picture); `seconds.write` is left for the caller to fill.
+/// `exposure` is the factor used and the automatic one.
 fn run_stats(
     config: &RunConfig,
     prepared: &Prepared,
     session: &Session,
     mesh: &crate::mesh::Mesh,
-    dark: Option<String>,
-    exposure: f32,
+    said: Vec<String>,
+    (exposure, auto): (f32, f32),
     seconds: PhaseSeconds,
 ) -> RunStats {
     let totals = session.totals();
@@ -668,7 +690,7 @@ fn run_stats(
             .warnings
             .iter()
             .map(|w| w.to_string())
-            .chain(dark)
+            .chain(said)
             .collect(),
         polygons: prepared
             .scene
@@ -691,6 +713,8 @@ fn run_stats(
         },
         unshot_fraction: session.unshot_fraction(),
         exposure,
+        auto_exposure: auto,
+        exposure_stops: config.exposure.stops(auto),
         converged: session.converged() && prepared.scene.emits(),
         nothing_emits: !prepared.scene.emits(),
         adaptive: if config.adaptive.is_some() {
@@ -737,6 +761,17 @@ fn solve<'p>(
     let mut progress = Progress::new(config.progress, config.solver.threshold);
     let mut last_save = Instant::now();
     let start = Instant::now();
+    // A resumed solve's sky may have shot already: it is not watched.
+    let mut sky_watch = SkyWatch::new(
+        &prepared.scene,
+        session.mesh(),
+        session.radiosity(),
+        prepared.visibility(),
+    )
+    .filter(|_| config.resume.is_none());
+    // Said whatever -q says, as the load warnings.
+    let sky_blocked = || format!("warning: {}", sky_watch::SKY_BLOCKED);
+    let mut warnings = Vec::new();
     loop {
         if cancel.is_set() {
             progress.clear();
@@ -768,10 +803,23 @@ fn solve<'p>(
                     save(session, &records)?;
                     last_save = Instant::now();
                 }
+                if let Some(watch) = &mut sky_watch {
+                    if let Some(blocked) = watch.step(&report, session.mesh(), session.radiosity())
+                    {
+                        sky_watch = None;
+                        if blocked {
+                            progress.say(&sky_blocked());
+                            warnings.push(sky_blocked());
+                        }
+                    }
+                }
                 progress.step(&report, session.solver().rays());
             }
             Event::Step(_) | Event::Stopped(_) | Event::Cancelled => {}
             Event::Refined(report) => {
+                // The sky shoots in the first pass; the watch does not
+                // follow the mesh to the next.
+                sky_watch = None;
                 // A bar of its own for each pass, under the line saying
                 // what the last pass did.
                 progress.clear();
@@ -793,6 +841,11 @@ fn solve<'p>(
         }
     }
     progress.clear();
+    // A sky much weaker than the lamps may be left partly unshot.
+    if sky_watch.is_some_and(|watch| watch.finish()) {
+        eprintln!("{}", sky_blocked());
+        warnings.push(sky_blocked());
+    }
     if config.progress && config.adaptive.is_some() {
         say_pass(session, None);
     }
@@ -807,6 +860,7 @@ fn solve<'p>(
         radiosity,
         shown,
         records,
+        warnings,
     })
 }
 
@@ -858,12 +912,31 @@ pub fn summary(stats: &RunStats) -> String {
         None => String::new(),
     };
     format!(
-        "{}{sky}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{} → {written}",
+        "{}{sky}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{}, {} → {written}",
         stats.scene,
         stats.seconds.solve,
         stats.rays as f64 / 1e6,
         stats.unshot_fraction * 100.0,
         if stats.converged { "" } else { " (step limit)" },
+        exposure_text(stats.exposure, stats.auto_exposure, stats.exposure_stops),
+    )
+}
+
+/// The exposure as the summary line says it: `exposure 2.42 (automatic)`,
+/// or with the stops given, `exposure 9.67 (automatic 2.42, +2 stops)`;
+/// three significant digits.
+fn exposure_text(exposure: f32, auto: f32, stops: f32) -> String {
+    let num = |x: f32| crate::scene::fmt_num(f64::from(x));
+    if stops == 0.0 {
+        return format!("exposure {} (automatic)", num(exposure));
+    }
+    let unit = if stops.abs() == 1.0 { "stop" } else { "stops" };
+    let sign = if stops > 0.0 { "+" } else { "" };
+    format!(
+        "exposure {} (automatic {}, {sign}{} {unit})",
+        num(exposure),
+        num(auto),
+        num(stops)
     )
 }
 
@@ -891,6 +964,22 @@ mod tests {
 
     fn paths(names: &[&str]) -> Vec<PathBuf> {
         names.iter().map(PathBuf::from).collect()
+    }
+
+    #[test]
+    fn the_summary_gives_the_exposure_and_the_automatic_one() {
+        assert_eq!(
+            exposure_text(2.4168, 2.4168, 0.0),
+            "exposure 2.42 (automatic)"
+        );
+        assert_eq!(
+            exposure_text(9.6672, 2.4168, 2.0),
+            "exposure 9.67 (automatic 2.42, +2 stops)"
+        );
+        assert_eq!(
+            exposure_text(1.2084, 2.4168, -1.0),
+            "exposure 1.21 (automatic 2.42, -1 stop)"
+        );
     }
 
     #[test]

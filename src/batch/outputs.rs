@@ -25,28 +25,23 @@ use std::path::{Path, PathBuf};
 /// [`check_outputs_against`] once loaded.
 pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     let output = config.output_path();
-    let format = PictureFormat::from_path(&output).map_err(RunError::BadOutput)?;
-    if config.mesh_lines && matches!(format, PictureFormat::Exr | PictureFormat::Pfm) {
-        return Err(RunError::BadOutput(OutputError::UnknownFormat {
-            path: output,
-            reason: "mesh lines are drawn on 8-bit pictures: use .png, .tif or .tiff".into(),
-        }));
+    if config.mesh_lines {
+        PictureFormat::eight_bit(&output, "--mesh-lines draws on 8-bit pictures")
+    } else {
+        PictureFormat::from_path(&output)
     }
+    .map_err(RunError::BadOutput)?;
     if let Some(export) = &config.export {
         MeshFormat::from_path(export).map_err(RunError::BadOutput)?;
     }
     if let Some(plot) = &config.plot {
         convergence::check_plot_path(plot).map_err(RunError::BadOutput)?;
     }
-    // False-colour pictures and plans are 8-bit, as the plot is.
-    let photometry = &config.photometry;
-    for picture in photometry
-        .falsecolor
-        .iter()
-        .map(|f| &f.path)
-        .chain(photometry.workplane.iter().map(|w| &w.png))
-    {
-        convergence::check_plot_path(picture).map_err(RunError::BadOutput)?;
+    // False-colour pictures and plans are 8-bit, as the plot is (the
+    // plan is always PREFIX.png).
+    if let Some(f) = &config.photometry.falsecolor {
+        PictureFormat::eight_bit(&f.path, "--falsecolor writes an 8-bit picture")
+            .map_err(RunError::BadOutput)?;
     }
     let named = named_inputs(config);
     check_against(config, &named.files())?;

@@ -112,10 +112,7 @@ pub(super) fn write(
             grid.spacing,
             t.elapsed().as_secs_f64()
         ));
-        let (scale, max) = p
-            .falsecolor
-            .as_ref()
-            .map_or((falsecolor::Scale::Log, None), |f| (f.scale, f.max));
+        let (scale, max) = (w.scale, w.max);
         let behind: Vec<bool> = grid
             .points
             .iter()

@@ -78,6 +78,11 @@ impl Progress {
         ));
     }
 
+    /// Prints `line` on stderr above the bar, which stays.
+    pub fn say(&self, line: &str) {
+        self.bar.suspend(|| eprintln!("{line}"));
+    }
+
     /// Removes the bar from the terminal.
     pub fn clear(&self) {
         self.bar.finish_and_clear();

@@ -24,6 +24,28 @@ pub const EXIT_CODES: &str =
     "Exit codes: 0 success, 1 a result could not be written, 2 bad input or usage, \
      130 interrupted (Ctrl-C; the message names the files written).";
 
+/// The headings `-h` and `--help` group the options under, in the order
+/// their first option is declared (clap shows headings in that order).
+/// Every option has one; a unit test keeps it so.
+pub mod heading {
+    /// The scene and how its files are read.
+    pub const INPUT: &str = "Input";
+    /// The files a run writes, and what it says while it runs.
+    pub const OUTPUT: &str = "Output";
+    /// The mesh, the solver and its limits.
+    pub const SOLVER: &str = "Mesh and solver";
+    /// Where the camera stands and how the picture is drawn.
+    pub const PICTURE: &str = "Camera and picture";
+    /// What emits light besides the scene's own emitters.
+    pub const LIGHT: &str = "Light";
+    /// The window.
+    pub const WINDOW: &str = "Window";
+    /// Checkpoints of long solves.
+    pub const LONG: &str = "Long solves";
+    /// Physical units, measurements and false colour.
+    pub const PHOTOMETRY: &str = "Photometry";
+}
+
 /// Progressive-refinement radiosity renderer (ray-traced form factors after
 /// Wallace, Elmquist and Haines 1989).
 ///
@@ -34,19 +56,21 @@ pub const EXIT_CODES: &str =
 // placeholder, not an HTML tag.
 #[allow(rustdoc::invalid_html_tags)]
 #[derive(clap::Parser, Clone, Debug, PartialEq)]
-#[command(name = "radiosity", version, about, after_help = EXIT_CODES)]
+#[command(name = "radiosity", version, about, allow_negative_numbers = true)]
 pub struct Args {
     /// Scene file: .sc, .obj (with its MTL materials), .gltf or .glb (glTF 2).
     ///
     /// Without it, the bundled scenes/rtable.sc.
+    #[arg(help_heading = heading::INPUT, display_order = 0)]
     pub(crate) scene: Option<PathBuf>,
 
-    /// Picture to write: .png or .tif/.tiff, .exr or .pfm.
+    /// Picture to write: .png or .tif/.tiff, .exr, .pfm or .hdr.
     ///
     /// .png and .tif/.tiff are 8-bit and tone-mapped; .exr and .pfm hold
-    /// 32-bit float linear radiosity. Default: <scene-name>.png in the
-    /// current directory.
+    /// 32-bit float linear radiosity, .hdr (Radiance RGBE) the same to
+    /// about 1 %. Default: <scene-name>.png in the current directory.
     #[arg(short, long, value_name = "FILE")]
+    #[arg(help_heading = heading::OUTPUT)]
     pub(crate) output: Option<PathBuf>,
 
     /// Longest element edge, in scene units.
@@ -55,6 +79,7 @@ pub struct Args {
     /// that mesh would have more than about 400,000 vertices (a line then
     /// says which lenmax was chosen).
     #[arg(long, value_name = "L")]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) lenmax: Option<f32>,
 
     /// Inset of boundary vertices, as a fraction of an element edge.
@@ -62,6 +87,7 @@ pub struct Args {
     /// Boundary vertices are evaluated this far inside their polygon, so
     /// room corners do not come out dark; 0 disables it.
     #[arg(long, value_name = "F", default_value_t = DEFAULT_INSET)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) inset: f32,
 
     /// Stop when the unshot power falls below this fraction of the emitted
@@ -71,6 +97,7 @@ pub struct Args {
     /// (the unshot power is exactly zero; the run then ends as converged,
     /// exit 0). Without --max-steps that can take many thousands of steps.
     #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) threshold: f64,
 
     /// Past the threshold, go on until every point has settled.
@@ -81,14 +108,17 @@ pub struct Args {
     /// scene's power but most of the pocket's own; the threshold alone
     /// would leave such places too dark. 0 stops at the threshold alone.
     #[arg(long, value_name = "F", default_value_t = DEFAULT_SETTLE)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) settle: f64,
 
     /// Stop after this many shooting steps at most.
     #[arg(long, value_name = "N")]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) max_steps: Option<u64>,
 
     /// Form factor estimate.
     #[arg(long, value_name = "METHOD", value_enum, default_value_t = FormFactorMethod::Wallace)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) form_factor: FormFactorMethod,
 
     /// Shooter sample points per shooter: at most N, or `all`.
@@ -102,6 +132,7 @@ pub struct Args {
     // The literal is crate::solver::tuning::DEFAULT_SHOOTER_SAMPLES (ShooterSamples has no
     // Display for `default_value_t`); a unit test keeps the two equal.
     #[arg(long, value_name = "N|all", default_value = "64", value_parser = parse_shooter_samples)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) shooter_samples: ShooterSamples,
 
     /// Pixels across a hemicube's top face (--form-factor hemicube).
@@ -111,12 +142,14 @@ pub struct Args {
     // The literal is crate::solver::tuning::DEFAULT_HEMICUBE_RES; a unit test
     // keeps the two equal.
     #[arg(long, value_name = "N", default_value = "128", value_parser = parse_hemicube_res)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) hemicube_res: HemicubeRes,
 
     /// Use the disc approximation however near the receiver.
     // The long help quotes tuning constants: it is written from them in
     // `cli/help.rs`.
     #[arg(long)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) no_near_field: bool,
 
     /// Test shadow rays against the whole scene (slower, same result).
@@ -124,24 +157,28 @@ pub struct Args {
     /// By default a shadow ray is tested only against the polygons in the
     /// shaft between shooter and receiver; this is for comparison.
     #[arg(long)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) no_shaft_culling: bool,
 
     /// Shoot every polygon alone (the solver without clusters).
     // The long help quotes tuning constants: it is written from them in
     // `cli/help.rs`.
     #[arg(long)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) no_clustering: bool,
 
     /// Evaluate every receiving vertex exactly, in every step.
     // The long help quotes tuning constants: it is written from them in
     // `cli/help.rs`.
     #[arg(long)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) exact_receivers: bool,
 
     /// Shoot exactly the unshot light, never more.
     // The long help quotes tuning constants: it is written from them in
     // `cli/help.rs`.
     #[arg(long)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) no_overshoot: bool,
 
     /// Turn these heuristics of the solver off (comma-separated).
@@ -153,6 +190,7 @@ pub struct Args {
     /// gives what each costs
     /// and buys.
     #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) without: Vec<Heuristic>,
 
     /// Solve with no heuristic: the brute-force twin (slow).
@@ -162,10 +200,12 @@ pub struct Args {
     /// shadow rays, each tested against the whole scene. The exact near
     /// field and settling stay.
     #[arg(long)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) exact: bool,
 
     /// Where unshot radiosity is kept between shooting steps.
     #[arg(long, value_name = "SCHEME", value_enum, default_value_t = UnshotScheme::Vertex)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) unshot: UnshotScheme,
 
     /// Refine the mesh where the light changes sharply, and go on solving.
@@ -177,49 +217,61 @@ pub struct Args {
     /// to --adaptive-levels times. Sharpens shadow boundaries where the
     /// regular mesh blurs them.
     #[arg(long, conflicts_with_all = ["checkpoint", "resume"])]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive: bool,
 
     /// Relative luminance difference that splits an element (--adaptive).
     ///
     /// An element is split when its vertex luminances differ by more than
     /// this fraction of the largest of them.
-    #[arg(long, value_name = "T", default_value_t = refine::DEFAULT_THRESHOLD, requires = "adaptive")]
+    #[arg(long, value_name = "T", default_value_t = refine::DEFAULT_THRESHOLD)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive_threshold: f64,
 
     /// Split each initial element at most this many times (--adaptive).
     ///
     /// Each split halves the element's edges.
-    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS, requires = "adaptive")]
+    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive_levels: u32,
 
     /// Samples per pixel side for written pictures (1 to 8).
     ///
     /// The picture is rendered at N × N samples a pixel and averaged in
-    /// linear radiosity, so polygon edges are smooth; .exr and .pfm keep
+    /// linear radiosity, so polygon edges are smooth; .exr, .pfm and .hdr keep
     /// the averaged linear values. 1 draws one sample a pixel, as the
     /// window does. Very large pictures use fewer samples (at most 64 M).
     #[arg(long, value_name = "N", default_value_t = antialias::DEFAULT_AA,
           value_parser = clap::value_parser!(u32).range(1..=antialias::MAX_AA as i64))]
+    #[arg(help_heading = heading::PICTURE)]
     pub(crate) aa: u32,
 
     /// Draw the element mesh over the written picture.
     ///
     /// As the window's `m` key does; 8-bit pictures only (.png or .tiff).
     #[arg(long)]
+    #[arg(help_heading = heading::PICTURE)]
     pub(crate) mesh_lines: bool,
 
     /// Picture size in pixels, overriding the scene's camera.
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
+    #[arg(help_heading = heading::PICTURE)]
     pub(crate) size: Option<(u32, u32)>,
 
-    /// Exposure multiplier for 8-bit pictures.
+    /// Exposure in stops from the automatic one (+1 is twice as bright).
     ///
-    /// Default: automatic (the 95th-percentile luminance maps to 0.9).
-    #[arg(long, value_name = "X")]
+    /// 8-bit pictures and exported colours are scaled by the automatic
+    /// exposure (the 95th-percentile luminance maps to 0.9) times
+    /// 2^STOPS, as the window's + and - keys and Radiance's `pfilt -e +2`
+    /// count; 0 is the automatic exposure, the default. The summary line
+    /// and --stats give the automatic value. From -40 to 40.
+    #[arg(long, value_name = "STOPS")]
+    #[arg(help_heading = heading::PICTURE)]
     pub(crate) exposure: Option<f32>,
 
     /// Write counts and seconds per phase as JSON to this file.
     #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = heading::OUTPUT)]
     pub(crate) stats: Option<PathBuf>,
 
     /// Make a material, OBJ object or group emit light (repeatable).
@@ -233,6 +285,7 @@ pub struct Args {
     /// when nothing emits, a warning names what looks like a lamp. An
     /// unknown NAME is an error listing the names there are.
     #[arg(long, value_name = "NAME=VALUE", value_parser = parse_emit)]
+    #[arg(help_heading = heading::LIGHT)]
     pub(crate) emit: Vec<(String, Rgb)>,
 
     /// Every polygon reflects and emits from its front only.
@@ -241,6 +294,7 @@ pub struct Args {
     /// and emits on its own, as Blender shades them); glTF follows each
     /// material's doubleSided; .sc polygons are one-sided.
     #[arg(long, conflicts_with = "two_sided")]
+    #[arg(help_heading = heading::INPUT)]
     pub(crate) one_sided: bool,
 
     /// Every polygon is two-sided.
@@ -248,6 +302,7 @@ pub struct Args {
     /// Each side receives, reflects and emits on its own, with its own
     /// radiosity (the default for OBJ faces).
     #[arg(long)]
+    #[arg(help_heading = heading::INPUT)]
     pub(crate) two_sided: bool,
     /// Light the scene from all around with a uniform sky.
     ///
@@ -256,7 +311,8 @@ pub struct Args {
     /// through every opening; closed rooms stay dark inside. An unoccluded
     /// floor of reflectance rho under a sky V comes out rho * V. The sky is
     /// not drawn and not exported: the picture's background stays black.
-    #[arg(long, value_name = "VALUE", value_parser = parse_sky)]
+    #[arg(long, value_name = "VALUE", value_parser = parse_sky, allow_hyphen_values = true)]
+    #[arg(help_heading = heading::LIGHT)]
     pub(crate) sky: Option<Rgb>,
 
     /// Take the camera from this .sc file.
@@ -265,6 +321,7 @@ pub struct Args {
     /// also overrides a .sc scene's camera). Without it an .obj scene is
     /// framed automatically.
     #[arg(long, value_name = "FILE.sc")]
+    #[arg(help_heading = heading::PICTURE)]
     pub(crate) camera: Option<PathBuf>,
 
     /// Write the solved element mesh (.glb or .ply).
@@ -275,6 +332,7 @@ pub struct Args {
     /// little-endian (float radiosity and 8-bit colour per vertex). Runs
     /// in batch mode, as -o does.
     #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = heading::OUTPUT)]
     pub(crate) export: Option<PathBuf>,
 
     /// Write one CSV row per shooting step.
@@ -282,6 +340,7 @@ pub struct Args {
     /// Columns: step, shooter, unshot fraction, rays, seconds. Runs in batch
     /// mode, as -o does.
     #[arg(long, value_name = "FILE.csv")]
+    #[arg(help_heading = heading::OUTPUT)]
     pub(crate) log: Option<PathBuf>,
 
     /// Plot the unshot fraction per step as a PNG.
@@ -289,18 +348,21 @@ pub struct Args {
     /// The unshot fraction against the step, on a log axis. Runs in batch
     /// mode, as -o does.
     #[arg(long, value_name = "FILE.png")]
+    #[arg(help_heading = heading::OUTPUT)]
     pub(crate) plot: Option<PathBuf>,
 
     /// Worker threads for the solver and renderer.
     ///
     /// Default: all cores.
     #[arg(long, value_name = "N")]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) threads: Option<usize>,
 
     /// Do not open a window even when a display is available.
     ///
     /// Solve and write the picture, as with -o.
     #[arg(long)]
+    #[arg(help_heading = heading::WINDOW)]
     pub(crate) no_window: bool,
 
     /// Show the ambient term on top of the solution.
@@ -310,10 +372,12 @@ pub struct Args {
     /// pictures from being too dark, fades as the solve converges and never
     /// enters the solution. Default: on in the window, off for files.
     #[arg(long, conflicts_with = "no_ambient")]
+    #[arg(help_heading = heading::WINDOW)]
     pub(crate) ambient: bool,
 
     /// Never show the ambient term (see --ambient).
     #[arg(long)]
+    #[arg(help_heading = heading::WINDOW)]
     pub(crate) no_ambient: bool,
 
     /// Refuse meshes with more elements than this.
@@ -322,6 +386,7 @@ pub struct Args {
     /// --lenmax fits. The default allows meshes of up to about 12 GB
     /// (estimated), which --max-memory may refuse first.
     #[arg(long, value_name = "N", default_value_t = config::DEFAULT_MAX_ELEMENTS)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) max_elements: u64,
 
     /// Refuse scenes whose estimated memory is over this many bytes.
@@ -335,6 +400,7 @@ pub struct Args {
     /// memory available now and half the address-space limit (ulimit
     /// -v); 4G where these cannot be read.
     #[arg(long, value_name = "BYTES", value_parser = parse_max_memory)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) max_memory: Option<u64>,
 
     /// Save the solver state to this file, to resume it later.
@@ -343,10 +409,12 @@ pub struct Args {
     /// end, so an interrupted solve can be resumed. Implies a batch run (no
     /// window).
     #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = heading::LONG)]
     pub(crate) checkpoint: Option<PathBuf>,
 
     /// Seconds between checkpoints.
     #[arg(long, value_name = "SECS", default_value_t = config::DEFAULT_CHECKPOINT_EVERY.as_secs_f64())]
+    #[arg(help_heading = heading::LONG)]
     pub(crate) checkpoint_every: f64,
 
     /// Continue the solve saved in this checkpoint.
@@ -354,6 +422,7 @@ pub struct Args {
     /// Give the same scene and mesh and form-factor options; the result is
     /// that of an uninterrupted run. Implies a batch run (no window).
     #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = heading::LONG)]
     pub(crate) resume: Option<PathBuf>,
 
     /// Let a model read files outside its folder.
@@ -363,10 +432,12 @@ pub struct Args {
     /// that is an absolute path or climbs out with `..` is refused, so a
     /// downloaded model cannot read other files of the machine.
     #[arg(long)]
+    #[arg(help_heading = heading::INPUT)]
     pub(crate) allow_outside_paths: bool,
 
     /// No progress bar and no summary line.
     #[arg(short, long)]
+    #[arg(help_heading = heading::OUTPUT)]
     pub(crate) quiet: bool,
 
     /// What one scene unit is, for photometric results: m, cm, mm, in, ft.
@@ -377,6 +448,7 @@ pub struct Args {
     /// need this for lux (without it, results are in the scene's radiosity
     /// units) and for --ies.
     #[arg(long, value_name = "UNIT", value_enum)]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) units: Option<crate::scene::Units>,
 
     /// Make polygons emit as an IES luminaire (repeatable).
@@ -388,6 +460,7 @@ pub struct Args {
     /// along the polygon's first edge. It emits the file's flux below its
     /// plane and reflects nothing. Needs --units for OBJ and .sc scenes.
     #[arg(long, value_name = "NAME=FILE", value_parser = parse_ies)]
+    #[arg(help_heading = heading::LIGHT)]
     pub(crate) ies: Vec<(String, PathBuf)>,
 
     /// Compute the illuminance at the points of this CSV file.
@@ -396,14 +469,16 @@ pub struct Args {
     /// normal of the surface the light falls on), a header line allowed;
     /// each point by a final gather over the converged solution. Written
     /// to --illuminance-out.
-    #[arg(long, value_name = "POINTS.csv", requires = "illuminance_out")]
+    #[arg(long, value_name = "POINTS.csv")]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) illuminance_at: Option<PathBuf>,
 
     /// Where --illuminance-at writes its values (CSV).
     ///
     /// Header `x,y,z,nx,ny,nz,e_r,e_g,e_b,e`; `e` weights the channels by
     /// the Rec. 709 luminance weights; lux with --units.
-    #[arg(long, value_name = "VALUES.csv", requires = "illuminance_at")]
+    #[arg(long, value_name = "VALUES.csv")]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) illuminance_out: Option<PathBuf>,
 
     /// Compute a horizontal work plane: HEIGHT[,SPACING] in scene units.
@@ -414,17 +489,21 @@ pub struct Args {
     /// suggests). Writes PREFIX.csv and PREFIX.png (a false-colour plan
     /// with isolux lines; see --workplane-out) and prints Eavg, Emin, Emax
     /// and Emin/Eavg.
-    #[arg(long, value_name = "HEIGHT[,SPACING]", value_parser = parse_workplane)]
+    #[arg(long, value_name = "HEIGHT[,SPACING]", value_parser = parse_workplane,
+          allow_hyphen_values = true)]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) workplane: Option<(f32, Option<f32>)>,
 
     /// File name prefix of the --workplane results.
     ///
     /// Default: <scene-name>-workplane in the current directory.
-    #[arg(long, value_name = "PREFIX", requires = "workplane")]
+    #[arg(long, value_name = "PREFIX")]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) workplane_out: Option<PathBuf>,
 
     /// Write the view in false colour, with a legend (.png or .tiff).
     #[arg(long, value_name = "FILE.png")]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) falsecolor: Option<PathBuf>,
 
     /// What --falsecolor shows.
@@ -434,17 +513,20 @@ pub struct Args {
     /// reflectance, lux with --units; 0 on black surfaces).
     #[arg(long, value_name = "QUANTITY", value_enum,
           default_value_t = crate::render::falsecolor::Quantity::Luminance)]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) falsecolor_of: crate::render::falsecolor::Quantity,
 
     /// The scale of --falsecolor and of the --workplane plan.
     #[arg(long, value_name = "SCALE", value_enum,
           default_value_t = crate::render::falsecolor::Scale::Log)]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) falsecolor_scale: crate::render::falsecolor::Scale,
 
     /// The value shown red by --falsecolor and the plan.
     ///
     /// Default: the largest value, rounded up to 1, 2 or 5 times a power of 10.
     #[arg(long, value_name = "V")]
+    #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) falsecolor_max: Option<f64>,
 
     // The camera from the command line and --info: kept together.

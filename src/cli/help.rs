@@ -1,8 +1,10 @@
-//! The long help of the options whose text quotes a tuning constant,
-//! written from the constants themselves ([`crate::solver::tuning`]), so
-//! `--help` never says one number while the solver uses another.
+//! What `-h` and `--help` say beyond the options' own doc comments: the
+//! long help of the options whose text quotes a tuning constant, written
+//! from the constants themselves ([`crate::solver::tuning`]) so `--help`
+//! never says one number while the solver uses another; the examples
+//! `--help` ends with ([`EXAMPLES`], each run by a test); and the footers.
 
-use super::args::Args;
+use super::args::{Args, EXIT_CODES};
 use crate::solver::tuning::{
     CHECK_TOLERANCE, CLUSTER_EXTENT, EXACT_RATIO, FACET_SCALE_RATIO, FAR_PROBES, FAR_SHOOTER_RATIO,
     NEAR_FIELD_RATIO, OVERSHOOT_SHARE, RECEIVER_STRIDE, RECEIVER_WEAK_SHARE, SHARE_CREASE_DEG,
@@ -10,10 +12,65 @@ use crate::solver::tuning::{
 };
 use clap::CommandFactory;
 
-/// The command's definition with the long help of every option that
-/// quotes a tuning constant filled in from it.
+/// The examples `--help` ends with: a command (run in the project's
+/// folder, on a bundled scene) and what it does. A test runs each as
+/// `--help` prints it, so none can drift from what the program accepts.
+pub const EXAMPLES: &[(&str, &str)] = &[
+    (
+        "radiosity scenes/cornell.sc",
+        "The Cornell box in a window (without a display: written to cornell.png).",
+    ),
+    (
+        "radiosity scenes/cornell.sc -o cornell.png --exposure 1",
+        "A picture one stop brighter than the automatic exposure.",
+    ),
+    (
+        "radiosity scenes/rtable.sc --adaptive -o rtable.exr --export rtable.glb",
+        "Sharper shadows; linear radiosity (.exr) and the solved mesh for Blender.",
+    ),
+    (
+        "radiosity scenes/cornell.sc --camera scenes/cameras/cornell-base.sc -o base.png",
+        "The same box seen from another camera.",
+    ),
+    (
+        "radiosity scenes/office.sc --units m --ies luminaire=scenes/luminaires/panel.ies \\
+         --workplane 0.8 --falsecolor office-lux.png --falsecolor-of illuminance",
+        "Lux on a desk-high work plane under IES panels, and the view in false colour.",
+    ),
+    (
+        "radiosity scenes/table_chair.sc -o table.png --checkpoint table.ckpt",
+        "Saves the solve as it goes; after a Ctrl-C, add --resume table.ckpt to go on.",
+    ),
+];
+
+/// The text after the options in `--help`: [`EXAMPLES`], then the exit
+/// codes.
+fn after_long_help() -> String {
+    let mut text = String::from("Examples (in the project's folder):\n");
+    for (command, what) in EXAMPLES {
+        text.push_str(&format!("  {command}\n      {what}\n"));
+    }
+    text.push('\n');
+    text.push_str(EXIT_CODES);
+    text
+}
+
+/// The text after the options in `-h`: where the rest is, then the exit
+/// codes.
+fn after_short_help() -> String {
+    format!(
+        "--help shows each option in full, the switches that compare the solver \
+         with its brute-force twins, and examples.\n\n{EXIT_CODES}"
+    )
+}
+
+/// The command's definition as the program parses it: the long help of
+/// every option that quotes a tuning constant filled in from it, and the
+/// footers of `-h` and `--help`.
 pub fn command() -> clap::Command {
     Args::command()
+        .after_help(after_short_help())
+        .after_long_help(after_long_help())
         .mut_arg("no_near_field", |a| a.long_help(near_field()))
         .mut_arg("no_clustering", |a| a.long_help(clustering()))
         .mut_arg("exact_receivers", |a| a.long_help(exact_receivers()))
@@ -25,14 +82,23 @@ pub fn parse() -> Result<Args, clap::Error> {
     parse_from(std::env::args_os())
 }
 
-/// Parses `args` (the program's name first) with [`command`]'s help.
+/// Parses `args` (the program's name first) with [`command`]'s help,
+/// refusing an option given without the one it needs
+/// (the table in `cli/needs.rs`).
 pub fn parse_from<I, T>(args: I) -> Result<Args, clap::Error>
 where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
-    let matches = command().try_get_matches_from(args)?;
-    <Args as clap::FromArgMatches>::from_arg_matches(&matches)
+    let mut command = command();
+    let matches = command.try_get_matches_from_mut(args)?;
+    let args = <Args as clap::FromArgMatches>::from_arg_matches(&matches)?;
+    match super::needs::unmet(&matches, &args) {
+        Some(message) => {
+            Err(command.error(clap::error::ErrorKind::MissingRequiredArgument, message))
+        }
+        None => Ok(args),
+    }
 }
 
 /// A fraction as a percentage with as few digits as it needs (`0.02` →
@@ -139,6 +205,39 @@ mod tests {
         assert_eq!(percent(0.02), "2 %");
         assert_eq!(percent(0.003), "0.3 %");
         assert_eq!(percent(0.001), "0.1 %");
+    }
+
+    /// Every option sits under a heading, and `-h` leaves out exactly the
+    /// switches that compare the solver with its brute-force twins.
+    #[test]
+    fn options_are_grouped_and_comparison_switches_are_long_help_only() {
+        let command = command();
+        let mut hidden = Vec::new();
+        for arg in command.get_arguments() {
+            assert!(
+                arg.get_help_heading().is_some(),
+                "{} has no heading",
+                arg.get_id()
+            );
+            if arg.is_hide_short_help_set() {
+                hidden.push(arg.get_id().as_str());
+            }
+        }
+        hidden.sort_unstable();
+        assert_eq!(
+            hidden,
+            [
+                "exact",
+                "exact_receivers",
+                "hemicube_res",
+                "no_clustering",
+                "no_near_field",
+                "no_overshoot",
+                "no_shaft_culling",
+                "unshot",
+                "without",
+            ]
+        );
     }
 
     #[test]

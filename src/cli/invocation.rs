@@ -14,7 +14,7 @@ use crate::camera::{Camera, CameraOverride};
 use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
-use crate::render::Exposure;
+use crate::render::{Exposure, MAX_EXPOSURE_STOPS};
 use crate::scene::Sides;
 use crate::solver::{Approximations, Heuristic, SolverOptions};
 use glam::Vec3;
@@ -95,8 +95,12 @@ pub enum UsageError {
     /// `levels`), which the flag spells with `adaptive-` before it.
     #[error("--adaptive-{0}")]
     Refine(#[from] refine::OptionsError),
-    /// `--exposure` is not a positive finite number.
-    #[error("--exposure must be a positive number, got {0}")]
+    /// `--exposure` is not a number of stops within
+    /// [`MAX_EXPOSURE_STOPS`] either way.
+    #[error(
+        "--exposure must be a number of stops from -{MAX_EXPOSURE_STOPS} to {MAX_EXPOSURE_STOPS} \
+         (0 is the automatic exposure, +1 twice as bright), got {0}"
+    )]
     Exposure(f32),
     /// `--threads 0`, or more than `MAX_THREADS` (1024).
     #[error(
@@ -208,6 +212,8 @@ fn photometry(a: &PhotometryArgs) -> PhotometryConfig {
                 spacing,
                 csv: with(".csv"),
                 png: with(".png"),
+                scale: a.falsecolor_scale,
+                max: a.falsecolor_max,
             }
         }),
         falsecolor: a.falsecolor.clone().map(|path| FalsecolorConfig {
@@ -250,7 +256,7 @@ impl TryFrom<Args> for Invocation {
         refine.validate()?;
         let exposure = match args.exposure {
             None => Exposure::Auto,
-            Some(x) if x.is_finite() && x > 0.0 => Exposure::Fixed(x),
+            Some(stops) if stops.abs() <= MAX_EXPOSURE_STOPS => Exposure::Stops(stops),
             Some(x) => return Err(UsageError::Exposure(x)),
         };
         let threads = match args.threads {

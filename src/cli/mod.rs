@@ -6,8 +6,11 @@
 //!
 //! The layout follows ripgrep's `flags/`: `args` holds the raw options,
 //! `values` the value parsers, `invocation` the validation and the decisions
-//! taken once (window or batch). Bad values are [`ValueError`]s reported by
-//! clap or [`UsageError`]s from the conversion; both mean exit code 2.
+//! taken once (window or batch), `needs` the options that mean something
+//! only with another, `help` what `-h` and `--help` say beyond each
+//! option's doc comment. Bad values are [`ValueError`]s reported by clap,
+//! an option without the one it needs a clap error from [`parse_from`],
+//! or [`UsageError`]s from the conversion; all mean exit code 2.
 //!
 //! ```
 //! use clap::Parser;
@@ -21,6 +24,7 @@
 mod args;
 mod help;
 mod invocation;
+mod needs;
 mod values;
 
 pub use args::{Args, EXIT_CODES};

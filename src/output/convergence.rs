@@ -86,13 +86,7 @@ pub fn write_log_file(path: &Path, steps: &[StepRecord]) -> Result<(), OutputErr
 /// Checks that `path` names a picture format the plot can be written in
 /// (8-bit: `.png`, `.tif`, `.tiff`).
 pub fn check_plot_path(path: &Path) -> Result<(), OutputError> {
-    if PictureFormat::from_path(path)?.is_linear() {
-        return Err(OutputError::UnknownFormat {
-            path: path.to_path_buf(),
-            reason: "a plot is an 8-bit picture: use .png, .tif or .tiff".into(),
-        });
-    }
-    Ok(())
+    PictureFormat::eight_bit(path, "a plot is an 8-bit picture").map(|_| ())
 }
 
 /// Draws the convergence plot of `steps` (see the module docs) for a solve

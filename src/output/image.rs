@@ -8,9 +8,16 @@
 //! | `.tif`, `.tiff`  | TIFF   | 8-bit sRGB, tone-mapped with the given exposure  |
 //! | `.exr`           | OpenEXR| 32-bit float linear RGB radiosity, as rendered   |
 //! | `.pfm`           | PFM    | 32-bit float linear RGB radiosity, as rendered   |
+//! | `.hdr`           | Radiance RGBE | linear RGB radiosity, 8-bit mantissas sharing an exponent |
 //!
-//! The float formats ignore the exposure: they hold the frame's values
-//! bit for bit, in the scene's radiosity units, for later processing.
+//! The linear formats ignore the exposure: `.exr` and `.pfm` hold the
+//! frame's values bit for bit, in the scene's radiosity units, for later
+//! processing; `.hdr` holds them to the precision of its shared exponent
+//! (about 1 % of a pixel's largest channel), as Radiance's tools read it.
+//!
+//! Outputs that are 8-bit only (plots, false colour, mesh lines, the
+//! window's pictures) take [`PictureFormat::eight_bit`], whose messages
+//! list only the formats they accept.
 
 use super::{write_atomically_seekable, OutputError};
 use crate::render::{to_srgb8, Exposure, Frame};
@@ -20,7 +27,11 @@ use std::path::Path;
 
 /// The picture extensions [`PictureFormat::from_path`] understands, for
 /// messages.
-pub const SUPPORTED_EXTENSIONS: &str = ".png, .tif, .tiff, .exr, .pfm";
+pub const SUPPORTED_EXTENSIONS: &str = ".png, .tif, .tiff, .exr, .pfm, .hdr";
+
+/// The 8-bit picture extensions, for the messages of outputs that take
+/// only those ([`PictureFormat::eight_bit`]).
+pub const EIGHT_BIT_EXTENSIONS: &str = ".png, .tif or .tiff";
 
 /// A picture file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,36 +44,61 @@ pub enum PictureFormat {
     Exr,
     /// Portable float map, 32-bit float linear RGB, little-endian.
     Pfm,
+    /// Radiance RGBE (`.hdr`): linear RGB, an 8-bit mantissa per channel
+    /// and one shared exponent, run-length encoded.
+    Hdr,
 }
 
 impl PictureFormat {
     /// The format named by the path's extension, case-insensitive. A missing
     /// or unknown extension is an error listing [`SUPPORTED_EXTENSIONS`].
     pub fn from_path(path: &Path) -> Result<PictureFormat, OutputError> {
-        let unknown = |reason: String| OutputError::UnknownFormat {
+        Self::named(path).map_err(|reason| OutputError::UnknownFormat {
+            path: path.to_path_buf(),
+            reason: format!("{reason}; supported picture formats are {SUPPORTED_EXTENSIONS}"),
+        })
+    }
+
+    /// The 8-bit format named by the path's extension, for an output that
+    /// writes nothing else; `writer` says which (`--plot writes an 8-bit
+    /// picture`), and an unknown extension or a linear format is an error
+    /// listing [`EIGHT_BIT_EXTENSIONS`] alone.
+    pub fn eight_bit(path: &Path, writer: &str) -> Result<PictureFormat, OutputError> {
+        let refuse = |reason: String| OutputError::UnknownFormat {
             path: path.to_path_buf(),
             reason,
         };
+        let accepted = format!("{writer}: use {EIGHT_BIT_EXTENSIONS}");
+        match Self::named(path) {
+            Ok(format) if !format.is_linear() => Ok(format),
+            Ok(_) => Err(refuse(accepted)),
+            Err(reason) => Err(refuse(format!("{reason}; {accepted}"))),
+        }
+    }
+
+    /// The format of the path's extension, case-insensitive, or what is
+    /// wrong with the extension.
+    fn named(path: &Path) -> Result<PictureFormat, String> {
         let ext = path
             .extension()
-            .ok_or_else(|| unknown("the file name has no extension".to_string()))?;
-        let lower = ext.to_string_lossy().to_ascii_lowercase();
-        match lower.as_str() {
+            .ok_or_else(|| "the file name has no extension".to_string())?;
+        match ext.to_string_lossy().to_ascii_lowercase().as_str() {
             "png" => Ok(PictureFormat::Png),
             "tif" | "tiff" => Ok(PictureFormat::Tiff),
             "exr" => Ok(PictureFormat::Exr),
             "pfm" => Ok(PictureFormat::Pfm),
-            _ => Err(unknown(format!(
-                "unknown extension .{}",
-                ext.to_string_lossy()
-            ))),
+            "hdr" => Ok(PictureFormat::Hdr),
+            _ => Err(format!("unknown extension .{}", ext.to_string_lossy())),
         }
     }
 
-    /// True for the formats that store linear floats rather than tone-mapped
-    /// 8-bit values.
+    /// True for the formats that store linear values rather than
+    /// tone-mapped 8-bit ones.
     pub fn is_linear(self) -> bool {
-        matches!(self, PictureFormat::Exr | PictureFormat::Pfm)
+        matches!(
+            self,
+            PictureFormat::Exr | PictureFormat::Pfm | PictureFormat::Hdr
+        )
     }
 }
 
@@ -92,7 +128,7 @@ pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(
             };
             encode_and_write(path, move |mut w| img.write_to(&mut w, kind))
         }
-        PictureFormat::Exr => {
+        PictureFormat::Exr | PictureFormat::Hdr => {
             let raw: Vec<f32> = frame.pixels.iter().flatten().copied().collect();
             let img = Rgb32FImage::from_raw(frame.width, frame.height, raw).ok_or_else(|| {
                 OutputError::InvalidFrame {
@@ -101,9 +137,12 @@ pub fn write_picture(path: &Path, frame: &Frame, exposure: Exposure) -> Result<(
                     height: frame.height,
                 }
             })?;
-            encode_and_write(path, move |mut w| {
-                img.write_to(&mut w, ImageFormat::OpenExr)
-            })
+            let kind = if format == PictureFormat::Exr {
+                ImageFormat::OpenExr
+            } else {
+                ImageFormat::Hdr
+            };
+            encode_and_write(path, move |mut w| img.write_to(&mut w, kind))
         }
         PictureFormat::Pfm => write_atomically_seekable(path, |w| {
             write_pfm(w, frame).map_err(|error| OutputError::Io {
@@ -155,15 +194,9 @@ impl<T: Write + Seek> WriteSeek for T {}
 /// shows) as PNG or TIFF, chosen by the extension, atomically. The float
 /// formats need the linear frame ([`write_picture`]) and are refused here.
 pub fn write_rgb8(path: &Path, image: &RgbImage) -> Result<(), OutputError> {
-    let kind = match PictureFormat::from_path(path)? {
+    let kind = match PictureFormat::eight_bit(path, "the picture on screen is 8-bit")? {
         PictureFormat::Png => ImageFormat::Png,
-        PictureFormat::Tiff => ImageFormat::Tiff,
-        PictureFormat::Exr | PictureFormat::Pfm => {
-            return Err(OutputError::UnknownFormat {
-                path: path.to_path_buf(),
-                reason: "a window picture is 8-bit: use .png, .tif or .tiff".into(),
-            })
-        }
+        _ => ImageFormat::Tiff,
     };
     if super::write_cancel().is_none() {
         // Not cancellable: encoded straight from the borrowed picture.
@@ -253,6 +286,7 @@ mod tests {
         assert_eq!(f("a.TiFF"), Some(PictureFormat::Tiff));
         assert_eq!(f("a.exr"), Some(PictureFormat::Exr));
         assert_eq!(f("a.Pfm"), Some(PictureFormat::Pfm));
+        assert_eq!(f("a.hdr"), Some(PictureFormat::Hdr));
         assert_eq!(f("a.jpg"), None);
         assert_eq!(f("png"), None);
     }
@@ -271,6 +305,51 @@ mod tests {
             );
         }
         assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+    }
+
+    /// An 8-bit-only output names the formats it takes and no other,
+    /// whether the extension is unknown or linear.
+    #[test]
+    fn eight_bit_outputs_list_only_the_8_bit_formats() {
+        let f = |p: &str| PictureFormat::eight_bit(Path::new(p), "--plot writes an 8-bit picture");
+        assert_eq!(f("a.PNG").ok(), Some(PictureFormat::Png));
+        assert_eq!(f("a.tif").ok(), Some(PictureFormat::Tiff));
+        for (name, why) in [
+            ("a.exr", ""),
+            ("a.hdr", ""),
+            ("a.pfm", ""),
+            ("a.jpg", "unknown extension .jpg; "),
+            ("a", "the file name has no extension; "),
+        ] {
+            let Err(OutputError::UnknownFormat { reason, .. }) = f(name) else {
+                panic!("{name} accepted");
+            };
+            assert_eq!(
+                reason,
+                format!("{why}--plot writes an 8-bit picture: use .png, .tif or .tiff")
+            );
+        }
+    }
+
+    /// `.hdr` holds the linear values to RGBE's precision: each channel
+    /// within one unit of the 8-bit mantissa that the pixel's largest
+    /// channel sets (half a unit of rounding, at most a 128th of it).
+    #[test]
+    fn hdr_holds_the_linear_values_to_rgbe_precision() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.HDR");
+        let f = frame();
+        write_picture(&path, &f, Exposure::Fixed(7.0)).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.starts_with(b"#?RADIANCE\n"));
+        let img = ::image::open(&path).unwrap().into_rgb32f();
+        assert_eq!(img.dimensions(), (5, 3));
+        for (got, want) in img.pixels().zip(&f.pixels) {
+            let largest = want.iter().copied().fold(0.0f32, f32::max);
+            for (g, w) in got.0.iter().zip(want) {
+                assert!((g - w).abs() <= largest / 128.0, "{got:?} for {want:?}");
+            }
+        }
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! Writing results to files: pictures (png, tiff, exr, pfm), the solved
+//! Writing results to files: pictures (png, tiff, exr, pfm, hdr), the solved
 //! mesh (glb, ply), the convergence log and plot, illuminance at points and
 //! over work planes (CSV, plan), and the atomic-write helper every output
 //! shares.
@@ -24,7 +24,9 @@ pub mod illuminance;
 pub mod image;
 pub mod mesh_export;
 
-pub use self::image::{write_picture, write_rgb8, PictureFormat, SUPPORTED_EXTENSIONS};
+pub use self::image::{
+    write_picture, write_rgb8, PictureFormat, EIGHT_BIT_EXTENSIONS, SUPPORTED_EXTENSIONS,
+};
 pub use self::mesh_export::{write_mesh, MeshFormat, MESH_EXTENSIONS};
 
 use crate::cancel::{Cancel, Cancelled};
@@ -56,16 +58,14 @@ pub enum OutputError {
         /// Its parent, which is something else than a directory.
         dir: PathBuf,
     },
-    /// The picture format cannot be told from the path's extension.
-    #[error(
-        "cannot write {}: {reason}; supported picture formats are {}",
-        path.display(),
-        SUPPORTED_EXTENSIONS
-    )]
+    /// The picture format cannot be told from the path's extension, or is
+    /// not one this output writes.
+    #[error("cannot write {}: {reason}", path.display())]
     UnknownFormat {
         /// The file that was to be written.
         path: PathBuf,
-        /// What is wrong with its extension.
+        /// What is wrong with its extension, and the formats this output
+        /// accepts.
         reason: String,
     },
     /// The frame's buffers disagree with its size (a bug in its producer).

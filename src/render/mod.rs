@@ -43,7 +43,7 @@ pub use raster::{Frame, Rasterizer, RenderError, LAYER_DEPTH_BIAS};
 pub use tonemap::{
     auto_exposure, auto_exposure_beside, back_face_color, exposure_probe_size, srgb8, srgb_encode,
     to_srgb8, Exposure, BACK_FACE_COLORS, BACK_FACE_STRIPE, EXPOSURE_PROBE_SIDE,
-    UNLIT_EXPOSURE_SHARE,
+    MAX_EXPOSURE_STOPS, UNLIT_EXPOSURE_SHARE,
 };
 pub use view::{View, ViewError};
 

@@ -4,8 +4,9 @@
 //! about how bright a picture should be. Tone mapping here is the simplest
 //! that keeps the radiosity proportional: multiply by an exposure, clip to
 //! `[0, 1]`, encode with the sRGB transfer curve, round to 8 bits. The
-//! exposure is given ([`Exposure::Fixed`]) or chosen from the frame
-//! ([`auto_exposure`]).
+//! exposure is chosen from the frame ([`auto_exposure`]), in stops around
+//! that ([`Exposure::Stops`], as photographers and Radiance's `pfilt -e`
+//! count), or given ([`Exposure::Fixed`]).
 
 use super::raster::Frame;
 use crate::color::Rgb;
@@ -31,11 +32,20 @@ pub const FALLBACK_EXPOSURE: f32 = 1.0;
 /// (IEC 61966-2-1).
 pub const SRGB_LINEAR_LIMIT: f64 = 0.003_130_8;
 
+/// The most stops [`Exposure::Stops`] may be from the automatic exposure,
+/// either way: 2^40 is about 10^12, past any picture worth looking at,
+/// and far from overflowing an `f32` factor.
+pub const MAX_EXPOSURE_STOPS: f32 = 40.0;
+
 /// How a frame's linear values are scaled before encoding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Exposure {
     /// Chosen from the frame by [`auto_exposure`].
     Auto,
+    /// This many stops above (below, when negative) [`auto_exposure`]:
+    /// the factor is the automatic one × 2^stops, so `Stops(0.0)` is
+    /// `Auto`. Finite, within [`MAX_EXPOSURE_STOPS`].
+    Stops(f32),
     /// This factor, dimensionless: linear value `v` is shown as `v * factor`.
     Fixed(f32),
 }
@@ -44,8 +54,28 @@ impl Exposure {
     /// The factor to use for `frame`.
     pub fn resolve(self, frame: &Frame) -> f32 {
         match self {
-            Exposure::Auto => auto_exposure(frame),
             Exposure::Fixed(k) => k,
+            relative => relative.with_auto(auto_exposure(frame)),
+        }
+    }
+
+    /// The factor when the frame's automatic exposure is `auto`.
+    pub fn with_auto(self, auto: f32) -> f32 {
+        match self {
+            Exposure::Auto => auto,
+            Exposure::Stops(stops) => auto * stops.exp2(),
+            Exposure::Fixed(k) => k,
+        }
+    }
+
+    /// How many stops the factor is from the automatic exposure `auto`:
+    /// 0 for `Auto`, the stops given for `Stops`, `log2(k / auto)` for
+    /// `Fixed(k)`.
+    pub fn stops(self, auto: f32) -> f32 {
+        match self {
+            Exposure::Auto => 0.0,
+            Exposure::Stops(stops) => stops,
+            Exposure::Fixed(k) => (k / auto).log2(),
         }
     }
 }

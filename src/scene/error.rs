@@ -25,17 +25,26 @@ use std::fmt;
 /// usually not a scene at all and more messages help nobody.
 pub const MAX_DIAGNOSTICS: usize = 100;
 
-/// Where the start of a file is, for problems of the file as a whole (it
-/// cannot be read, it is empty, it lacks a required block).
+/// Where the start of a file is, for problems of the text as a whole (it
+/// is empty, it lacks a required block); a file that cannot be read at
+/// all has no position ([`cannot_read`]).
 pub(crate) const FILE_START: SourcePos = SourcePos { line: 1, col: 1 };
 
-/// The diagnostic for a file that cannot be read, at [`FILE_START`].
+/// The diagnostic for a file that cannot be read: of the file as a
+/// whole, with no line and column (there is no text to point into),
+/// printed `FILE: error: cannot read: REASON`, or the refusal
+/// ([`InputError::is_refusal`]) as it words itself.
 pub(crate) fn cannot_read(file: &str, error: &InputError) -> Diagnostic {
-    let message = match error {
-        InputError::Io { error, .. } => format!("cannot read file: {error}"),
+    Diagnostic::whole(file, unreadable(error))
+}
+
+/// What [`cannot_read`] says after `FILE: error: `; also the wording of
+/// the loaders with errors of their own (IES, points files).
+pub(crate) fn unreadable(error: &InputError) -> String {
+    match error {
+        InputError::Io { error, .. } => format!("cannot read: {error}"),
         refused => refused.to_string(),
-    };
-    Diagnostic::new(file, FILE_START, message)
+    }
 }
 
 /// The message for a colour channel written negative: `keyword` is the
@@ -229,6 +238,25 @@ impl fmt::Display for LoadError {
             write!(f, "{d}")?;
         }
         Ok(())
+    }
+}
+
+/// `FILE:LINE:COL: KIND: MESSAGE`, or `FILE: KIND: MESSAGE` when `line`
+/// is 0 (the message concerns the whole file, one that cannot be read,
+/// say), for the loaders whose errors are not [`Diagnostic`]s (IES and
+/// points files); control characters escaped as [`Diagnostic`]'s are.
+pub(crate) fn positioned(
+    file: &str,
+    line: usize,
+    column: usize,
+    kind: &str,
+    message: &str,
+) -> String {
+    let (file, message) = (escape_controls(file), escape_controls(message));
+    if line == 0 {
+        format!("{file}: {kind}: {message}")
+    } else {
+        format!("{file}:{line}:{column}: {kind}: {message}")
     }
 }
 

@@ -21,6 +21,7 @@ mod lighting;
 mod polygon;
 pub mod repair;
 
+pub(crate) use error::fmt_num;
 pub use error::{escape_controls, Diagnostic, LoadError, Warning, MAX_DIAGNOSTICS};
 pub use framing::{
     frame_camera, EYE_ACROSS_FRACTIONS, EYE_ALONG_FRACTIONS, EYE_CLEARANCE_FRACTION,

@@ -4,11 +4,12 @@
 use super::*;
 use crate::config::DEFAULT_MAX_ELEMENTS;
 use crate::solver::{FormFactorMethod, ShooterSamples, UnshotScheme};
-use clap::{CommandFactory, Parser};
+use clap::CommandFactory;
 use std::path::PathBuf;
 
+/// Parses as the program does ([`crate::cli::parse_from`]).
 fn parse(args: &[&str]) -> Result<Args, clap::Error> {
-    Args::try_parse_from(std::iter::once("radiosity").chain(args.iter().copied()))
+    crate::cli::parse_from(std::iter::once("radiosity").chain(args.iter().copied()))
 }
 
 fn invocation(args: &[&str]) -> Result<Invocation, UsageError> {
@@ -87,6 +88,8 @@ fn every_option_reaches_the_config() {
         "p.png",
         "--max-elements",
         "5000",
+        "--checkpoint",
+        "c.bin",
         "--checkpoint-every",
         "2.5",
         "--no-ambient",
@@ -129,7 +132,7 @@ fn every_option_reaches_the_config() {
     );
     assert_eq!(c.size, Some((32, 24)));
     assert_eq!(c.aa, 5);
-    assert_eq!(c.exposure, Exposure::Fixed(2.0));
+    assert_eq!(c.exposure, Exposure::Stops(2.0));
     assert_eq!(c.stats, Some(PathBuf::from("s.json")));
     assert_eq!(c.camera, Some(PathBuf::from("cam.sc")));
     assert_eq!(c.export, Some(PathBuf::from("m.ply")));
@@ -161,11 +164,14 @@ fn form_factor_takes_each_method_by_name() {
         assert_eq!(config(&["--form-factor", name]).solver.form_factor, method);
     }
     assert_eq!(
-        config(&["--hemicube-res", "64"]).solver.hemicube_res.get(),
+        config(&["--form-factor", "hemicube", "--hemicube-res", "64"])
+            .solver
+            .hemicube_res
+            .get(),
         64
     );
     for bad in ["0", "7", "100000", "lots"] {
-        let e = parse(&["--hemicube-res", bad]).unwrap_err();
+        let e = parse(&["--form-factor", "hemicube", "--hemicube-res", bad]).unwrap_err();
         assert_eq!(e.kind(), clap::error::ErrorKind::ValueValidation, "{bad}");
         assert!(e.to_string().contains("even whole number"), "{e}");
     }
@@ -234,6 +240,18 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
             "--lenmax must be a positive number of scene units, got 0",
         ),
         (
+            // A negative number is a value, not an option: it reaches
+            // the range check and gets its message.
+            &["--lenmax", "-1"],
+            UsageError::Mesh(MeshError::BadLenmax(-1.0)),
+            "--lenmax must be a positive number of scene units, got -1",
+        ),
+        (
+            &["--threshold", "-0.5"],
+            UsageError::Threshold(-0.5),
+            "--threshold must be between 0 and 1, got -0.5",
+        ),
+        (
             &["--lenmax", "inf"],
             UsageError::Mesh(MeshError::BadLenmax(f32::INFINITY)),
             "--lenmax must be a positive number of scene units, got inf",
@@ -249,7 +267,7 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
             "--max-elements must be between 1 and ",
         ),
         (
-            &["--checkpoint-every=-1"],
+            &["--checkpoint", "c.bin", "--checkpoint-every", "-1"],
             UsageError::CheckpointEvery(-1.0),
             "--checkpoint-every must be a number of seconds >= 0, got -1",
         ),
@@ -264,9 +282,10 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
             "--adaptive-levels must be between 1 and 6, got 0",
         ),
         (
-            &["--exposure", "0"],
-            UsageError::Exposure(0.0),
-            "--exposure must be a positive number, got 0",
+            &["--exposure", "40.5"],
+            UsageError::Exposure(40.5),
+            "--exposure must be a number of stops from -40 to 40 (0 is the automatic exposure, \
+             +1 twice as bright), got 40.5",
         ),
         (
             &["--threads", "0"],
@@ -286,6 +305,10 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
         assert_eq!(&e, error, "{args:?}");
         assert!(e.to_string().starts_with(message), "{args:?}: {e}");
     }
+    assert!(matches!(
+        invocation(&["--exposure", "nan"]),
+        Err(UsageError::Exposure(x)) if x.is_nan()
+    ));
     let over = (mesh::MAX_ADDRESSABLE_ELEMENTS + 1).to_string();
     assert!(matches!(
         invocation(&["--max-elements", &over]),
@@ -323,6 +346,26 @@ fn adaptive_options_reach_the_config_only_with_adaptive() {
     // Without --adaptive they are refused by clap, not ignored.
     assert!(parse(&["--adaptive-levels", "3"]).is_err());
     assert!(parse(&["--adaptive", "--checkpoint", "c.bin"]).is_err());
+}
+
+/// `--exposure` counts stops from the automatic exposure: 0 is the
+/// automatic one, negative values darken.
+#[test]
+fn exposure_is_in_stops() {
+    assert_eq!(config(&[]).exposure, Exposure::Auto);
+    assert_eq!(config(&["--exposure", "0"]).exposure, Exposure::Stops(0.0));
+    assert_eq!(
+        config(&["--exposure", "-2"]).exposure,
+        Exposure::Stops(-2.0)
+    );
+    assert_eq!(
+        config(&["--exposure", "+1.5"]).exposure,
+        Exposure::Stops(1.5)
+    );
+    assert_eq!(
+        config(&["--exposure", "40"]).exposure,
+        Exposure::Stops(40.0)
+    );
 }
 
 #[test]
@@ -427,6 +470,26 @@ fn photometric_options_reach_the_config() {
     let prefixed = config(&["--workplane", "0.8", "--workplane-out", "out/plan"]);
     let w = prefixed.photometry.workplane.unwrap();
     assert_eq!((w.spacing, w.csv), (None, PathBuf::from("out/plan.csv")));
+    assert_eq!(
+        (w.scale, w.max),
+        (crate::render::falsecolor::Scale::Log, None)
+    );
+    // The plan takes the false-colour scale and maximum without
+    // --falsecolor too.
+    let plan = config(&[
+        "--workplane",
+        "0.8",
+        "--falsecolor-scale",
+        "linear",
+        "--falsecolor-max",
+        "500",
+    ]);
+    let w = plan.photometry.workplane.unwrap();
+    assert_eq!(
+        (w.scale, w.max),
+        (crate::render::falsecolor::Scale::Linear, Some(500.0))
+    );
+    assert_eq!(plan.photometry.falsecolor, None);
     // glTF is in metres without --units; .sc has no unit.
     assert_eq!(config(&["m.glb"]).units(), Some(crate::scene::Units::M));
     assert_eq!(config(&["m.sc"]).units(), None);
@@ -442,7 +505,7 @@ fn photometric_options_reach_the_config() {
         assert!(parse(bad).is_err(), "{bad:?}");
     }
     assert_eq!(
-        invocation(&["--falsecolor-max", "0"]),
+        invocation(&["--falsecolor", "f.png", "--falsecolor-max", "0"]),
         Err(UsageError::FalsecolorMax(0.0))
     );
 }

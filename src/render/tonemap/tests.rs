@@ -40,6 +40,14 @@ fn auto_exposure_of_uniform_frame() {
     assert!((k - 0.45).abs() < EXPOSURE_TOLERANCE * 0.45, "{k}");
     assert_eq!(Exposure::Auto.resolve(&f), k);
     assert_eq!(Exposure::Fixed(3.0).resolve(&f), 3.0);
+    // Stops count from the automatic exposure, as the window's +/- and
+    // pfilt -e +2 do: 0 is automatic, +1 twice as bright, -2 a quarter.
+    assert_eq!(Exposure::Stops(0.0).resolve(&f), k);
+    assert_eq!(Exposure::Stops(1.0).resolve(&f), 2.0 * k);
+    assert_eq!(Exposure::Stops(-2.0).resolve(&f), 0.25 * k);
+    assert_eq!(Exposure::Stops(-2.0).stops(k), -2.0);
+    assert_eq!(Exposure::Fixed(4.0 * k).stops(k), 2.0);
+    assert_eq!(Exposure::Auto.stops(k), 0.0);
 }
 
 #[test]

@@ -34,7 +34,7 @@
 //! Errors give the file, the line and the column of the offending value
 //! and what was expected there ([`IesError`]).
 
-use super::input::{InputError, InputKind, InputSet};
+use super::input::{InputKind, InputSet};
 use std::f64::consts::PI;
 use std::fmt;
 use std::path::Path;
@@ -64,7 +64,7 @@ pub const FLUX_CELLS: (usize, usize) = (360, 720);
 
 /// An error in an IES file: where and what.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: error: {message}")]
+#[error("{}", crate::scene::error::positioned(file, *line, *column, "error", message))]
 pub struct IesError {
     /// The file as named by the user.
     pub file: String,
@@ -127,10 +127,7 @@ impl Photometry {
             file: name.clone(),
             line: 0,
             column: 0,
-            message: match e {
-                InputError::Io { error, .. } => format!("cannot read the IES file: {error}"),
-                refused => refused.to_string(),
-            },
+            message: crate::scene::error::unreadable(&e),
         })?;
         // IES files are ASCII; Latin-1 keywords are not rare, and read as
         // such rather than refused.

@@ -13,7 +13,7 @@
 //! starting with `#` are skipped, and so is a UTF-8 byte order mark.
 //! Blanks around values are allowed.
 
-use super::input::{read_file, InputError, InputKind};
+use super::input::{read_file, InputKind};
 use crate::budget::{fmt_count, MemoryBudget};
 use crate::scene::error::fmt_num;
 use crate::scene::MAX_COORDINATE;
@@ -22,7 +22,7 @@ use std::path::Path;
 
 /// Why a points file could not be read: `FILE:LINE:COLUMN: error: ...`.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: error: {message}")]
+#[error("{}", crate::scene::error::positioned(file, *line, *column, "error", message))]
 pub struct PointsError {
     /// The file as named by the user.
     pub file: String,
@@ -60,12 +60,8 @@ pub fn load_points_within(
         column: 0,
         message,
     };
-    let (bytes, _) = read_file(path, InputKind::Points).map_err(|e| {
-        cannot(match e {
-            InputError::Io { error, .. } => format!("cannot read the points file: {error}"),
-            refused => refused.to_string(),
-        })
-    })?;
+    let (bytes, _) = read_file(path, InputKind::Points)
+        .map_err(|e| cannot(crate::scene::error::unreadable(&e)))?;
     let lines = bytes.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
     let need = (bytes.len() as u64).saturating_add(lines.saturating_mul(BYTES_PER_POINT));
     budget
@@ -73,9 +69,8 @@ pub fn load_points_within(
             format!("{} lines of measurement points", fmt_count(lines))
         })
         .map_err(|over| cannot(over.to_string()))?;
-    let text = String::from_utf8(bytes).map_err(|_| {
-        cannot("cannot read the points file: stream did not contain valid UTF-8".to_string())
-    })?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| cannot("cannot read: stream did not contain valid UTF-8".to_string()))?;
     parse_points(&text, &name)
 }
 

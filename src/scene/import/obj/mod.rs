@@ -211,7 +211,7 @@ pub fn load_obj_with(
     // A library or texture refused for what it is or where it lies ends
     // the load, though one that is missing is only warned about.
     if let Some(refused) = folder.refused() {
-        return Err(Diagnostic::new(&file, FILE_START, refused).into());
+        return Err(Diagnostic::whole(&file, refused).into());
     }
     scene?.with_camera_read(camera, inputs)
 }

@@ -397,7 +397,7 @@ fn load_obj_reads_libraries_next_to_the_file_and_a_sidecar_camera() {
     let missing = dir.path().join("none.obj");
     let e = load_obj(&missing, None, &InputSet::default()).unwrap_err();
     assert!(
-        messages(&e)[0].contains("none.obj:1:1: error: cannot read file"),
+        messages(&e)[0].contains("none.obj: error: cannot read: "),
         "{e}"
     );
     let e = load_obj(
@@ -407,7 +407,7 @@ fn load_obj_reads_libraries_next_to_the_file_and_a_sidecar_camera() {
     )
     .unwrap_err();
     assert!(
-        messages(&e)[0].contains("nocam.sc:1:1: error: cannot read file"),
+        messages(&e)[0].contains("nocam.sc: error: cannot read: "),
         "{e}"
     );
 }

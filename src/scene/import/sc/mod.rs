@@ -109,8 +109,8 @@ pub fn load_camera_into(path: &Path, inputs: &InputSet) -> Result<Camera, LoadEr
 }
 
 /// Reads `path` and parses it; the path as given names the file in
-/// diagnostics. A file that cannot be read is reported at `1:1`, a file
-/// that is not UTF-8 at its first bad byte.
+/// diagnostics. A file that cannot be read is reported without a
+/// position, a file that is not UTF-8 at its first bad byte.
 pub(crate) fn load_file(path: &Path, inputs: &InputSet) -> Result<Scene, LoadError> {
     let file = path.display().to_string();
     let bytes = inputs
