@@ -536,14 +536,14 @@ pub struct Args {
     /// automatic one) and keeps the rest: with --eye alone the camera
     /// still looks at the same point. The window's `c` key prints the
     /// current camera as these options.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_eye, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_eye, allow_hyphen_values = true, help_heading = heading::PICTURE)]
     pub(crate) eye: Option<glam::Vec3>,
 
     /// The point the camera looks at, X,Y,Z in scene units.
     ///
     /// Radiance's -vd gives a direction instead: the look-at point is the
     /// eye plus that direction.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_look_at, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_look_at, allow_hyphen_values = true, help_heading = heading::PICTURE)]
     pub(crate) look_at: Option<glam::Vec3>,
 
     /// The camera's up direction X,Y,Z (as Radiance's -vu).
@@ -551,13 +551,13 @@ pub struct Args {
     /// Need not be at right angles to the view, nor of unit length, but
     /// must not be parallel to it. Default: the scene camera's (0,1,0 for
     /// the automatic camera).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_up, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_up, allow_hyphen_values = true, help_heading = heading::PICTURE)]
     pub(crate) up: Option<glam::Vec3>,
 
     /// Vertical field of view in degrees, more than 0 and below 180.
     ///
     /// As Radiance's -vv (its -vh is the horizontal one).
-    #[arg(long, value_name = "DEG", value_parser = parse_fov, allow_hyphen_values = true)]
+    #[arg(long, value_name = "DEG", value_parser = parse_fov, allow_hyphen_values = true, help_heading = heading::PICTURE)]
     pub(crate) fov: Option<f32>,
 
     /// Describe the scene and exit, without solving.
@@ -566,7 +566,7 @@ pub struct Args {
     /// bounds, the camera (as --eye ... options), the default --lenmax,
     /// the estimated element count and the warnings of loading, after
     /// --emit, --sky and the sides options are applied.
-    #[arg(long, conflicts_with_all = [
+    #[arg(long, help_heading = heading::INPUT, conflicts_with_all = [
         "output", "export", "log", "plot", "stats", "checkpoint", "resume",
         "falsecolor", "workplane", "illuminance_at", "mesh_lines", "no_window",
     ])]
