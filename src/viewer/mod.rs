@@ -774,11 +774,11 @@ impl<'a> Ui<'a> {
 
     /// Applies key presses; true when the picture must be redrawn.
     fn handle_keys(&mut self, keys: &[Press], control: &Control) -> bool {
-        let held =
-            self.window.is_key_down(Key::LeftShift) || self.window.is_key_down(Key::RightShift);
         let mut dirty = false;
-        for &(key, shifted) in keys {
-            let shift = shifted || held;
+        // Shift as it was when each key went down: `c` then Shift+`C`
+        // typed within one frame are a print and a save, where the state
+        // polled once a frame would make both saves.
+        for &(key, shift) in keys {
             match key {
                 Key::W if !shift => self.writes.push(Writing::Picture),
                 Key::F => self.writes.push(Writing::FullQuality),
