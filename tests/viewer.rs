@@ -29,6 +29,28 @@ fn skip(why: &str) {
 /// removes its socket and lock file, then SIGKILL if it lingers.
 struct Reaper(Child);
 
+impl Reaper {
+    /// Everything the exited program printed on its standard output.
+    fn stdout(&mut self) -> String {
+        use std::io::Read;
+        let mut text = String::new();
+        if let Some(mut out) = self.0.stdout.take() {
+            out.read_to_string(&mut text).unwrap();
+        }
+        text
+    }
+
+    /// Everything the exited program printed on its standard error.
+    fn stderr(&mut self) -> String {
+        use std::io::Read;
+        let mut text = String::new();
+        if let Some(mut err) = self.0.stderr.take() {
+            err.read_to_string(&mut text).unwrap();
+        }
+        text
+    }
+}
+
 impl Drop for Reaper {
     fn drop(&mut self) {
         let terminated = Command::new("kill")
@@ -242,29 +264,14 @@ fn window_writes_a_picture_and_quits_on_keys() {
         program.0.try_wait().ok().flatten()
     })
     .expect("the program exits within 5 s of q");
-    let mut stdout = String::new();
-    use std::io::Read;
-    program
-        .0
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut stdout)
-        .unwrap();
+    let stdout = program.stdout();
     assert!(status.success(), "exit status {status}");
     assert!(
         stdout.contains("wrote cornell-001.tiff"),
         "stdout: {stdout}"
     );
     // One summary line on the terminal when the window closes.
-    let mut stderr = String::new();
-    program
-        .0
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut stderr)
-        .unwrap();
+    let stderr = program.stderr();
     let summary: Vec<&str> = stderr
         .lines()
         .filter(|l| l.contains("window closed after"))
@@ -484,15 +491,7 @@ fn camera_keys_print_and_save_the_view_and_f_writes_it_at_full_quality() {
     xdotool(&display, &["key", "w"]).expect("key w");
     let plain = read_written(&dir.path().join("box-002.tiff"));
     quit(&display, &mut program);
-    let mut stdout = String::new();
-    use std::io::Read;
-    program
-        .0
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut stdout)
-        .unwrap();
+    let stdout = program.stdout();
 
     // The printed options and block, and the saved file, are one camera.
     let options = stdout

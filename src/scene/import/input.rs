@@ -309,11 +309,7 @@ pub fn read_file(path: &Path, kind: InputKind) -> Result<(Vec<u8>, InputFile), I
         kind,
         error,
     };
-    let file = open(path).map_err(io_error)?;
-    // What was opened is what is checked: no name lookup between the
-    // check and the read for another file to take its place.
-    let meta = file.metadata().map_err(io_error)?;
-    check_file(path, &meta, kind)?;
+    let (file, meta) = open_checked(path, kind)?;
     let cap = kind.max_bytes();
     // The size is within the cap, so this allocation is bounded.
     let mut bytes = Vec::with_capacity(usize::try_from(meta.len()).unwrap_or(0));
@@ -335,6 +331,14 @@ pub fn read_file(path: &Path, kind: InputKind) -> Result<(Vec<u8>, InputFile), I
 /// is a regular file within the kind's size limit, and opens) without
 /// reading it.
 pub fn check_readable(path: &Path, kind: InputKind) -> Result<(), InputError> {
+    open_checked(path, kind).map(drop)
+}
+
+/// Opens `path` ([`open`]) and checks what was opened as a `kind`
+/// ([`check_file`]): what was opened is what is checked, with no name
+/// lookup between the check and the read for another file to take its
+/// place.
+fn open_checked(path: &Path, kind: InputKind) -> Result<(File, Metadata), InputError> {
     let io_error = |error| InputError::Io {
         path: path.to_path_buf(),
         kind,
@@ -342,7 +346,8 @@ pub fn check_readable(path: &Path, kind: InputKind) -> Result<(), InputError> {
     };
     let file = open(path).map_err(io_error)?;
     let meta = file.metadata().map_err(io_error)?;
-    check_file(path, &meta, kind)
+    check_file(path, &meta, kind)?;
+    Ok((file, meta))
 }
 
 /// Opens `path` for reading without blocking: a FIFO opens at once (and
