@@ -58,13 +58,15 @@ impl<'a> Progressive<'a> {
             return Expectation::NONE;
         }
         let ambient = self.ambient().max(Rgb::BLACK) * OVERSHOOT_SHARE;
-        let (mut shot, mut area, mut reflected) = (0.0, 0.0, 0.0);
-        for (j, pm) in self.mesh.polygons.iter().enumerate() {
-            shot += self
-                .unshot
+        let shot_so_far = self.per_polygon(|j| {
+            self.unshot
                 .shot_so_far(&self.mesh, j, &self.radiosity)
                 .mean()
-                * self.power_weight[j];
+                * self.power_weight[j]
+        });
+        let (mut shot, mut area, mut reflected) = (0.0, 0.0, 0.0);
+        for (j, pm) in self.mesh.polygons.iter().enumerate() {
+            shot += shot_so_far[j];
             if !pm.sky {
                 area += pm.area;
                 reflected += self.reflectance[j].mean() * pm.area;
@@ -140,14 +142,21 @@ impl<'a> Progressive<'a> {
                 return Some(chosen);
             }
         }
+        let overshoot = self.options.approximations.overshoot;
+        let due = self.per_polygon(|i| {
+            let negative = if overshoot {
+                self.polygon_due(i, true, expected)
+            } else {
+                0.0
+            };
+            (self.polygon_due(i, false, expected), negative)
+        });
         let mut positive = vec![0.0f64; self.clusters.len()];
         let mut negative = vec![0.0f64; self.clusters.len()];
-        for i in 0..self.mesh.polygons.len() {
+        for (i, (p, n)) in due.into_iter().enumerate() {
             let c = self.clusters.of(PolygonId(i as u32));
-            positive[c] += self.polygon_due(i, false, expected);
-            if self.options.approximations.overshoot {
-                negative[c] += self.polygon_due(i, true, expected);
-            }
+            positive[c] += p;
+            negative[c] += n;
         }
         let mut best: Option<(usize, f64, bool)> = None;
         for (c, (&p, &n)) in positive.iter().zip(&negative).enumerate() {
@@ -203,17 +212,22 @@ impl<'a> Progressive<'a> {
     /// over the reflecting polygons' area, sky facets left out.
     pub(in crate::solver) fn settle_floor(&self) -> f64 {
         let areas = &self.vertex_area;
-        let (mut sum, mut area) = (0.0, 0.0);
-        for (j, pm) in self.mesh.polygons.iter().enumerate() {
+        let parts = self.per_polygon(|j| {
+            let pm = &self.mesh.polygons[j];
+            let (mut sum, mut area) = (0.0, 0.0);
             if pm.sky || self.reflectance[j].is_black() {
-                continue;
+                return (sum, area);
             }
             let range = pm.vertices.start as usize..pm.vertices.end as usize;
             for (b, a) in self.radiosity[range.clone()].iter().zip(&areas[range]) {
                 sum += b.mean() * a;
                 area += a;
             }
-        }
+            (sum, area)
+        });
+        let (sum, area) = parts
+            .into_iter()
+            .fold((0.0, 0.0), |(s, a), (ps, pa)| (s + ps, a + pa));
         if area > 0.0 {
             SETTLE_FLOOR * sum / area
         } else {
@@ -233,18 +247,17 @@ impl<'a> Progressive<'a> {
     ) -> Option<(usize, f64, bool)> {
         let floor = self.settle_floor();
         let tolerance = self.options.settle;
-        // Per cluster, for each sign: (unsettled power, power due).
-        let mut sums = vec![[(0.0f64, 0.0f64); 2]; self.clusters.len()];
         let signs: &[bool] = if self.options.approximations.overshoot {
             &[false, true]
         } else {
             &[false]
         };
-        for i in 0..self.mesh.polygons.len() {
+        // Per polygon, for each sign: (unsettled power, power due).
+        let parts = self.per_polygon(|i| {
+            let mut part = [(0.0f64, 0.0f64); 2];
             if self.mesh.polygons[i].sky {
-                continue;
+                return part;
             }
-            let c = self.clusters.of(PolygonId(i as u32));
             for &negative in signs {
                 let shot = if negative {
                     self.polygon_shot(i, true, expected)
@@ -259,9 +272,23 @@ impl<'a> Progressive<'a> {
                     tolerance,
                     floor,
                 );
-                let sum = &mut sums[c][negative as usize];
-                sum.0 += unsettled * self.power_weight[i];
-                sum.1 += self.polygon_due(i, negative, expected);
+                part[negative as usize] = (
+                    unsettled * self.power_weight[i],
+                    self.polygon_due(i, negative, expected),
+                );
+            }
+            part
+        });
+        // Per cluster, for each sign: (unsettled power, power due).
+        let mut sums = vec![[(0.0f64, 0.0f64); 2]; self.clusters.len()];
+        for (i, part) in parts.into_iter().enumerate() {
+            if self.mesh.polygons[i].sky {
+                continue;
+            }
+            let c = self.clusters.of(PolygonId(i as u32));
+            for (sum, p) in sums[c].iter_mut().zip(part) {
+                sum.0 += p.0;
+                sum.1 += p.1;
             }
         }
         let mut best: Option<(usize, f64, bool, f64)> = None;
