@@ -21,7 +21,7 @@ use crate::render::{View, ViewError};
 use crate::scene::repair::{self, FirstHit, RepairError, RepairOptions};
 use crate::scene::{
     self, IesError, InputKind, InputSet, LoadError, LuminaireError, Photometry, PolygonError,
-    Scene, SplitStats, UnknownName, Warning,
+    PolygonId, Scene, SplitStats, UnknownName, Warning,
 };
 use crate::visibility::Visibility;
 use glam::Vec3;
@@ -253,7 +253,7 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
     let built = |scene: &Scene| {
         let t = Instant::now();
         let built = Visibility::new(scene);
-        bvh_seconds = t.elapsed().as_secs_f64();
+        bvh_seconds += t.elapsed().as_secs_f64();
         built
     };
     let (mut scene, repaired) =
@@ -380,8 +380,8 @@ fn check_mesh_memory(
 /// The BVH casts the rays of the trapped-sides pass
 /// ([`Scene::silence_covered_sides`]).
 impl FirstHit for Visibility {
-    fn first_hit_distance(&self, origin: Vec3, direction: Vec3) -> Option<f32> {
-        self.first_hit(origin, direction).map(|hit| hit.1)
+    fn first_hit_polygon(&self, origin: Vec3, direction: Vec3) -> Option<(PolygonId, f32)> {
+        self.first_hit(origin, direction)
     }
 }
 

@@ -15,11 +15,12 @@ pub(super) mod sides;
 pub(super) mod solids;
 pub(super) mod split;
 pub(super) mod trapped;
+pub(super) mod unreached;
 
 use crate::budget::{MemoryBudget, OverBudget};
 use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
-use crate::scene::{PolygonError, Scene, Sides, SplitStats, SplitStop};
+use crate::scene::{PolygonError, PolygonId, Scene, Sides, SplitStats, SplitStop};
 use glam::Vec3;
 
 /// What the repair passes are told: the choices of the command line that
@@ -60,10 +61,15 @@ pub enum RepairError {
 /// the scene stays below the visibility code, so whoever runs the passes
 /// supplies them (the BVH, or brute force in a test).
 pub trait FirstHit {
-    /// The distance in scene units along the ray from `origin` in the unit
-    /// `direction` to the nearest polygon, or `None` when the ray leaves
-    /// the scene.
-    fn first_hit_distance(&self, origin: Vec3, direction: Vec3) -> Option<f32>;
+    /// The nearest polygon along the ray from `origin` in the unit
+    /// `direction`, and the distance to it in scene units, or `None` when
+    /// the ray leaves the scene.
+    fn first_hit_polygon(&self, origin: Vec3, direction: Vec3) -> Option<(PolygonId, f32)>;
+
+    /// The distance of [`FirstHit::first_hit_polygon`] alone.
+    fn first_hit_distance(&self, origin: Vec3, direction: Vec3) -> Option<f32> {
+        self.first_hit_polygon(origin, direction).map(|hit| hit.1)
+    }
 }
 
 /// What [`run`] did besides changing the scene.
@@ -74,21 +80,26 @@ pub struct RepairReport<R> {
     /// The rays built on the finished scene to look for trapped sides,
     /// when some face emits from both sides (else none were built).
     pub rays: Option<R>,
+    /// Back copies left out because no light can reach them
+    /// ([`unreached`]).
+    pub unreached_backs: usize,
 }
 
 /// Runs the repair passes on a loaded scene whose emission (`--emit`,
 /// `--ies`) is set, pushing their warnings onto [`Scene::warnings`] in
 /// the order the passes run, and returns the repaired scene. `build_rays`
-/// is called at most once, on the finished scene, when some face emits
-/// from both sides ([`Scene::emits_from_both_sides`]).
+/// is called on the scene before its back copies are made, when some
+/// polygon would get one, to find the backs no light reaches
+/// ([`unreached`]), and on the finished scene, when some face emits from
+/// both sides ([`Scene::emits_from_both_sides`]).
 ///
 /// Fails when the `--sky` enclosure would lie beyond
 /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE), or when splitting
 /// would go over [`RepairOptions::budget`].
-pub fn run<R: FirstHit>(
+pub fn run<R: FirstHit + Sync>(
     scene: Scene,
     options: &RepairOptions<'_>,
-    build_rays: impl FnOnce(&Scene) -> R,
+    build_rays: impl FnMut(&Scene) -> R,
 ) -> Result<(Scene, RepairReport<R>), RepairError> {
     run_cancellable(scene, options, build_rays, &Cancel::never())
 }
@@ -96,10 +107,10 @@ pub fn run<R: FirstHit>(
 /// [`run`], stopping with [`RepairError::Interrupted`] soon after `cancel`
 /// is set: it is checked between the passes and per polygon while
 /// splitting, the pass that can take long.
-pub fn run_cancellable<R: FirstHit>(
+pub fn run_cancellable<R: FirstHit + Sync>(
     mut scene: Scene,
     options: &RepairOptions<'_>,
-    build_rays: impl FnOnce(&Scene) -> R,
+    mut build_rays: impl FnMut(&Scene) -> R,
     cancel: &Cancel,
 ) -> Result<(Scene, RepairReport<R>), RepairError> {
     cancel.check()?;
@@ -117,7 +128,25 @@ pub fn run_cancellable<R: FirstHit>(
             SplitStop::Memory(e) => RepairError::Memory(e),
             SplitStop::Interrupted(c) => RepairError::Interrupted(c),
         })?;
-    let mut scene = scene.with_sides(options.sides);
+    // Backs only where light can reach them: on the scene as it is, so
+    // that the rays meet each face once.
+    cancel.check()?;
+    let two_sided = scene.would_get_backs(options.sides);
+    let mut unreached_backs = 0;
+    let keep = if options.sides != Sides::Two && two_sided.iter().any(|&t| t) {
+        let rays = build_rays(&scene);
+        let reached = unreached::reached_backs(&scene, &two_sided, options.sky.is_some(), &rays);
+        unreached_backs = two_sided
+            .iter()
+            .zip(&reached)
+            .filter(|&(&t, &r)| t && !r)
+            .count();
+        reached
+    } else {
+        vec![true; scene.polygons.len()]
+    };
+    cancel.check()?;
+    let mut scene = scene.with_sides_where(options.sides, &keep);
     // A luminaire's back is a back copy, or made here as one: after the
     // back copies, so that it finds those of a two-sided scene.
     scene.light_luminaire_backs();
@@ -140,5 +169,12 @@ pub fn run_cancellable<R: FirstHit>(
         }
         rays = Some(built);
     }
-    Ok((scene, RepairReport { split, rays }))
+    Ok((
+        scene,
+        RepairReport {
+            split,
+            rays,
+            unreached_backs,
+        },
+    ))
 }

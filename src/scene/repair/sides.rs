@@ -174,7 +174,38 @@ impl Scene {
     /// [`Surface::back_of`]: crate::scene::Surface::back_of
     /// [`Surface::back`]: crate::scene::Surface::back
     /// [`Surface::two_sided`]: crate::scene::Surface::two_sided
-    pub fn with_sides(mut self, sides: Sides) -> Scene {
+    pub fn with_sides(self, sides: Sides) -> Scene {
+        let keep = vec![true; self.polygons.len()];
+        self.with_sides_where(sides, &keep)
+    }
+
+    /// Per polygon, whether [`Scene::with_sides`] with `sides` would give
+    /// it a back copy: two-sided as `sides` reads it, not part of a closed
+    /// solid, and not written out a second time reversed.
+    pub fn would_get_backs(&self, sides: Sides) -> Vec<bool> {
+        let keys: HashMap<Vec<[u32; 3]>, usize> = self
+            .polygons
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (face_key(&p.vertices), i))
+            .collect();
+        self.polygons
+            .iter()
+            .map(|p| {
+                !keys.contains_key(&reversed_key(&p.vertices))
+                    && !p.surface.solid
+                    && match sides {
+                        Sides::AsLoaded => p.surface.two_sided,
+                        Sides::One => false,
+                        Sides::Two => true,
+                    }
+            })
+            .collect()
+    }
+
+    /// [`Scene::with_sides`], making a back copy of polygon `i` only where
+    /// `keep[i]` (one entry per polygon): the others stay one-sided.
+    pub fn with_sides_where(mut self, sides: Sides, keep: &[bool]) -> Scene {
         let keys: HashMap<Vec<[u32; 3]>, usize> = self
             .polygons
             .iter()
@@ -191,6 +222,7 @@ impl Scene {
             }
             let p = &self.polygons[i];
             let two = !p.surface.solid
+                && keep.get(i).copied().unwrap_or(true)
                 && match sides {
                     Sides::AsLoaded => p.surface.two_sided,
                     Sides::One => false,
