@@ -385,3 +385,56 @@ fn shared_facet_rays_match_per_vertex_rays() {
     };
     assert!(same_bits(&threads(1), &threads(2)));
 }
+
+/// Blocks of cells facing every way (36 small boxes standing on a
+/// room's floor, as a game level's steps and pillars stand), whose
+/// strata far receivers take by normal bins in every step, strong or
+/// weak: the solve gives what every polygon shooting alone gives, the
+/// vertices within 1 % (relative L1; measured 0.13 %).
+#[test]
+fn blocks_facing_every_way_match_the_twin() {
+    let mut s = tiled_box(false, 4);
+    for i in 0..6 {
+        for k in 0..6 {
+            let (x, y) = (0.3 + 0.07 * i as f32, 0.3 + 0.07 * k as f32);
+            let top = 0.04 + 0.01 * ((i + k) % 3) as f32;
+            for mut p in crate::testutil::cuboid([x, y, 0.0], [x + 0.04, y + 0.04, top], false) {
+                p.material = crate::scene::MaterialId(1);
+                s.polygons.push(p);
+            }
+        }
+    }
+    let options = SolverOptions {
+        threshold: 1e-3,
+        ..Default::default()
+    };
+    let mesh = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.1,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(&s);
+    let mut solver = Progressive::new(&s, &mesh, &vis, options);
+    while !solver.is_done() && solver.step().is_some() {}
+    let rays = solver.rays();
+    let clustered = solver.radiosity().to_vec();
+    let alone = solve_on(
+        &s,
+        mesh.clone(),
+        SolverOptions {
+            approximations: options.approximations.with(Heuristic::Clusters, false),
+            ..options
+        },
+    );
+    let areas = mesh.vertex_areas();
+    let (mut diff, mut total) = (0.0, 0.0);
+    for (l, (a, b)) in clustered.iter().zip(&alone.radiosity).enumerate() {
+        diff += (a.mean() - b.mean()).abs() * areas[l];
+        total += b.mean() * areas[l];
+    }
+    eprintln!("relL1 {}, {rays} rays", diff / total);
+    assert!(diff / total < 0.01, "vertex relL1 {}", diff / total);
+}
