@@ -21,6 +21,7 @@ impl<'a> Progressive<'a> {
     /// `expected` light the step read them with): a cluster's members
     /// receive from each other in the step that empties them.
     pub(in crate::solver) fn apply_chunk(&mut self, u: &mut Underway, polygons: Range<usize>) {
+        self.changed();
         let negative = u.shot_power < 0.0;
         if !u.spent {
             for &m in self.clusters.members(u.cluster) {

@@ -57,6 +57,16 @@ impl<'a> Progressive<'a> {
         if !self.options.approximations.overshoot {
             return Expectation::NONE;
         }
+        if let Some(expected) = self.kept(|s| s.expectation) {
+            return expected;
+        }
+        let expected = self.expectation_scanned();
+        self.keep(|s| s.expectation = Some(expected));
+        expected
+    }
+
+    /// [`Progressive::expectation`] with overshooting on, scanned afresh.
+    fn expectation_scanned(&self) -> Expectation {
         let ambient = self.ambient().max(Rgb::BLACK) * OVERSHOOT_SHARE;
         let shot_so_far = self.per_polygon(|j| {
             self.unshot
