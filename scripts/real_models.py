@@ -1,0 +1,80 @@
+#!/usr/bin/env python3
+"""Solve the real exported models of tests/models under a uniform sky and
+print the rows of docs/performance.md's "Real models at real size" table.
+
+    real_models.py [--radiosity target/release/radiosity] [--max-steps N]
+                   [--work DIR] [MODEL ...]
+
+Each model (by default every level, room and house listed below) is run
+as `radiosity MODEL --sky 1 --no-window -o DIR/NAME.pfm --stats ...
+--log ...` at default options, under /usr/bin/time for the whole
+process's wall and CPU seconds and peak memory. With --max-steps a model
+that has not converged by then says so in its row. One model at a time:
+on a shared machine, the CPU seconds are the steadier figure.
+"""
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+
+MODELS = [
+    "tests/models/godot/room.glb",
+    "tests/models/sauerbraten/zdm2.obj",
+    "tests/models/sauerbraten/pandora.obj",
+    "tests/models/redeclipse/fortitude.obj",
+    "tests/models/godot/zdm2.glb",
+    "tests/models/xeogl/vianney_house_2/scene.gltf",
+]
+
+
+def run(radiosity, model, work, max_steps):
+    name = model.replace("/", "_")
+    stats = os.path.join(work, name + ".json")
+    log = os.path.join(work, name + ".csv")
+    timing = os.path.join(work, name + ".time")
+    cmd = [
+        "/usr/bin/time", "-f", "%e %U %S %M", "-o", timing,
+        radiosity, model, "--sky", "1", "--no-window",
+        "-o", os.path.join(work, name + ".pfm"),
+        "--stats", stats, "--log", log,
+    ]
+    if max_steps:
+        cmd += ["--max-steps", str(max_steps)]
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall, user, system, kb = open(timing).read().split()[-4:]
+    s = json.load(open(stats))
+    steps = list(csv.DictReader(open(log)))
+    # `seconds` is the solve's time so far; a sky facet's step is the
+    # difference from the row before.
+    sky_seconds, before = 0.0, 0.0
+    for r in steps:
+        if int(r["shooter"]) >= s["polygons"]:
+            sky_seconds += float(r["seconds"]) - before
+        before = float(r["seconds"])
+    state = "converged" if s["converged"] else "not converged ({:.2%} unshot)".format(
+        s["unshot_fraction"])
+    return "| `{}` | {:,} / {:,} | {}: {:,} steps (the sky's 80 in {:.0f} s), {:.0f} s wall, {:.0f} s CPU | {:.0f} MB |".format(
+        model.replace("tests/models/", ""), s["polygons"], s["vertices"], state, s["steps"],
+        sky_seconds, float(wall), float(user) + float(system), int(kb) / 1024)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("models", nargs="*", default=MODELS)
+    p.add_argument("--radiosity", default="target/release/radiosity")
+    p.add_argument("--max-steps", type=int, default=0)
+    p.add_argument("--work", default="real-models")
+    a = p.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    print("| model | polygons / element vertices | `--sky 1` | peak memory |")
+    print("|---|---|---|---|")
+    for model in a.models:
+        print(run(a.radiosity, model, a.work, a.max_steps))
+        sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()
