@@ -179,16 +179,21 @@ impl Scene {
         self.with_sides_where(sides, &keep)
     }
 
+    /// Each polygon's [`face_key`], to find a face written out a second
+    /// time reversed.
+    fn face_keys(&self) -> HashMap<Vec<[u32; 3]>, usize> {
+        self.polygons
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (face_key(&p.vertices), i))
+            .collect()
+    }
+
     /// Per polygon, whether [`Scene::with_sides`] with `sides` would give
     /// it a back copy: two-sided as `sides` reads it, not part of a closed
     /// solid, and not written out a second time reversed.
     pub fn would_get_backs(&self, sides: Sides) -> Vec<bool> {
-        let keys: HashMap<Vec<[u32; 3]>, usize> = self
-            .polygons
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (face_key(&p.vertices), i))
-            .collect();
+        let keys = self.face_keys();
         self.polygons
             .iter()
             .map(|p| {
@@ -206,12 +211,7 @@ impl Scene {
     /// [`Scene::with_sides`], making a back copy of polygon `i` only where
     /// `keep[i]` (one entry per polygon): the others stay one-sided.
     pub fn with_sides_where(mut self, sides: Sides, keep: &[bool]) -> Scene {
-        let keys: HashMap<Vec<[u32; 3]>, usize> = self
-            .polygons
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (face_key(&p.vertices), i))
-            .collect();
+        let keys = self.face_keys();
         let count = self.polygons.len();
         let mut copies = Vec::new();
         for i in 0..count {
