@@ -64,12 +64,21 @@ fn report(config: &RunConfig, ready: &ReadyScene) -> String {
         config.scene.display_name(),
         polygons(model)
     );
+    let mut sides = Vec::new();
     if backs > 0 {
-        let _ = write!(
-            out,
-            " ({} of them with a back side)",
+        sides.push(format!(
+            "{} of them with a back side",
             fmt_count(backs as u64)
-        );
+        ));
+    }
+    if ready.unreached_backs > 0 {
+        sides.push(format!(
+            "{} two-sided faces without one, as no light reaches their back",
+            fmt_count(ready.unreached_backs as u64)
+        ));
+    }
+    if !sides.is_empty() {
+        let _ = write!(out, " ({})", sides.join("; "));
     }
     out.push('\n');
     materials(scene, &mut out);

@@ -194,6 +194,9 @@ pub struct ReadyScene {
     pub scene: Scene,
     /// What splitting along intersections did.
     pub split: SplitStats,
+    /// Two-sided faces left without a back copy, as no light can reach
+    /// their back ([`repair::RepairReport::unreached_backs`]).
+    pub unreached_backs: usize,
     /// The mesh options: `--lenmax` or the default within the vertex
     /// budget, and `--inset`.
     pub mesh_options: MeshOptions,
@@ -291,6 +294,7 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
     Ok(ReadyScene {
         scene,
         split: repaired.split,
+        unreached_backs: repaired.unreached_backs,
         mesh_options,
         inputs,
         rays: repaired.rays.map(|built| (built, bvh_seconds)),
@@ -307,6 +311,7 @@ fn prepare_deferred_cancellable(
     let ReadyScene {
         scene,
         split,
+        unreached_backs: _,
         mesh_options,
         inputs,
         rays,

@@ -268,3 +268,60 @@ fn a_rug_in_the_floor_plane_is_drawn_on_top_and_not_shadowed() {
         "irradiance on the rug {rug} against the floor beside it {floor}"
     );
 }
+
+/// A cave as a game level exports it: six faces looking in at a lamp,
+/// every one two-sided as OBJ faces are read. Their backs look out into
+/// the dark, so they get no back copies (`--info` says how many), and
+/// under a sky, which lights the outside, they do.
+const CAVE: &str = "o Cave
+v 0 0 0
+v 0 0 4
+v 4 0 4
+v 4 0 0
+v 0 4 0
+v 4 4 0
+v 4 4 4
+v 0 4 4
+f 1 2 3 4
+f 5 6 7 8
+f 1 5 8 2
+f 4 3 7 6
+f 1 4 6 5
+f 2 8 7 3
+o Lamp
+v 1.5 3.5 1.5
+v 2.5 3.5 1.5
+v 2.5 3.5 2.5
+v 1.5 3.5 2.5
+f 9 10 11 12
+";
+
+#[test]
+fn a_lit_cave_gets_no_backs_facing_the_dark_unless_a_sky_lights_them() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "cave.obj", CAVE);
+    let info = run_in(dir.path(), &["--info", "cave.obj", "--emit", "Lamp=10"]);
+    assert!(info.status.success(), "{}", stderr(&info));
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        text.contains(
+            "scene: cave.obj, 7 polygons (1 of them with a back side; \
+             6 two-sided faces without one, as no light reaches their back)"
+        ),
+        "{text}"
+    );
+    for (sky, polygons) in [(false, 8), (true, 14)] {
+        let mut args = vec!["cave.obj", "--emit", "Lamp=10", "--lenmax", "1", "-q"];
+        args.extend(["-o", "cave.pfm", "--stats", "cave.json"]);
+        if sky {
+            args.extend(["--sky", "1"]);
+        }
+        let out = run_in(dir.path(), &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let stats = read_json(dir.path(), "cave.json");
+        assert_eq!(
+            stats["polygons"], polygons,
+            "sky {sky}: the 7 faces, the lamp's back and the walls' only under a sky: {stats}"
+        );
+    }
+}

@@ -81,7 +81,7 @@ pub struct RepairReport<R> {
     /// when some face emits from both sides (else none were built).
     pub rays: Option<R>,
     /// Back copies left out because no light can reach them
-    /// ([`unreached`]).
+    /// (`unreached.rs`).
     pub unreached_backs: usize,
 }
 
@@ -90,7 +90,7 @@ pub struct RepairReport<R> {
 /// the order the passes run, and returns the repaired scene. `build_rays`
 /// is called on the scene before its back copies are made, when some
 /// polygon would get one, to find the backs no light reaches
-/// ([`unreached`]), and on the finished scene, when some face emits from
+/// (`unreached.rs`), and on the finished scene, when some face emits from
 /// both sides ([`Scene::emits_from_both_sides`]).
 ///
 /// Fails when the `--sky` enclosure would lie beyond
