@@ -45,6 +45,9 @@ const LIFT_SHARE: f32 = 1e-4;
 /// Polygons per parallel run of probe rays.
 const RUN: usize = 64;
 
+/// Polygons whose probe rays are cast before they are joined.
+const BLOCK: usize = 1 << 16;
+
 /// Per polygon of `scene`, whether its back side can be reached by light:
 /// `back[i]` is consulted only for the polygons that would get a back
 /// copy (`two_sided[i]`). Every entry is `true` when nothing emits and
@@ -83,42 +86,47 @@ pub fn reached_backs<R: FirstHit + Sync>(
             None
         }
     };
-    // Per polygon, the nodes each of its sides' rays meet.
-    let links: Vec<Vec<(usize, usize)>> = (0..n)
-        .into_par_iter()
-        .with_min_len(RUN)
-        .map(|i| {
-            let p = &scene.polygons[i];
-            let mut out = Vec::new();
-            for front in [true, false] {
-                let Some(from) = side(i, front) else {
-                    continue;
-                };
-                // A written-out twin casts its own rays as a front.
-                if !front && p.surface.back.is_some() {
-                    continue;
-                }
-                let normal = if front { p.normal } else { -p.normal };
-                for (origin, direction) in probes(p, normal) {
-                    let to = match rays.first_hit_polygon(origin, direction) {
-                        None => Some(outside),
-                        Some((q, _)) => {
-                            let q = q.index();
-                            let hit_front = direction.dot(scene.polygons[q].normal) < 0.0;
-                            side(q, hit_front)
-                        }
-                    };
-                    if let Some(to) = to {
-                        out.push((from, to));
+    // Per polygon, the nodes each of its sides' rays meet, a block of
+    // polygons at a time so that the links held stay bounded (about
+    // 500 bytes a polygon of the block).
+    let links_of = |i: usize| {
+        let p = &scene.polygons[i];
+        let mut out = Vec::new();
+        for front in [true, false] {
+            let Some(from) = side(i, front) else {
+                continue;
+            };
+            // A written-out twin casts its own rays as a front.
+            if !front && p.surface.back.is_some() {
+                continue;
+            }
+            let normal = if front { p.normal } else { -p.normal };
+            for (origin, direction) in probes(p, normal) {
+                let to = match rays.first_hit_polygon(origin, direction) {
+                    None => Some(outside),
+                    Some((q, _)) => {
+                        let q = q.index();
+                        let hit_front = direction.dot(scene.polygons[q].normal) < 0.0;
+                        side(q, hit_front)
                     }
+                };
+                if let Some(to) = to {
+                    out.push((from, to));
                 }
             }
-            out
-        })
-        .collect();
+        }
+        out
+    };
     let mut sets = Sets::new(2 * n + 1);
-    for (a, b) in links.into_iter().flatten() {
-        sets.join(a, b);
+    for block in (0..n).step_by(BLOCK) {
+        let links: Vec<Vec<(usize, usize)>> = (block..(block + BLOCK).min(n))
+            .into_par_iter()
+            .with_min_len(RUN)
+            .map(links_of)
+            .collect();
+        for (a, b) in links.into_iter().flatten() {
+            sets.join(a, b);
+        }
     }
     let mut lit = vec![false; 2 * n + 1];
     let mut seed = |node: usize, sets: &mut Sets| {
