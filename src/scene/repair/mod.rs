@@ -135,7 +135,8 @@ pub fn run_cancellable<R: FirstHit + Sync>(
     let mut unreached_backs = 0;
     let keep = if options.sides != Sides::Two && two_sided.iter().any(|&t| t) {
         let rays = build_rays(&scene);
-        let reached = unreached::reached_backs(&scene, &two_sided, options.sky.is_some(), &rays);
+        let reached =
+            unreached::reached_backs(&scene, &two_sided, options.sky.is_some(), &rays, cancel)?;
         unreached_backs = two_sided
             .iter()
             .zip(&reached)

@@ -29,6 +29,7 @@
 //! with `--two-sided`, which asks for every back.
 
 use super::FirstHit;
+use crate::cancel::{Cancel, Cancelled};
 use crate::scene::{Polygon, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -52,13 +53,16 @@ const BLOCK: usize = 1 << 16;
 /// `back[i]` is consulted only for the polygons that would get a back
 /// copy (`two_sided[i]`). Every entry is `true` when nothing emits and
 /// `sky` is false. `rays` casts into `scene` as it is (no back copies, no
-/// sky). Polygons are joined as the module docs say.
+/// sky). Polygons are joined as the module docs say. Stops with
+/// [`Cancelled`] soon after `cancel` is set (checked per block of
+/// 65,536 polygons).
 pub fn reached_backs<R: FirstHit + Sync>(
     scene: &Scene,
     two_sided: &[bool],
     sky: bool,
     rays: &R,
-) -> Vec<bool> {
+    cancel: &Cancel,
+) -> Result<Vec<bool>, Cancelled> {
     let n = scene.polygons.len();
     let emits: Vec<bool> = scene
         .polygons
@@ -69,7 +73,7 @@ pub fn reached_backs<R: FirstHit + Sync>(
         })
         .collect();
     if !sky && !emits.iter().any(|&e| e) {
-        return vec![true; n];
+        return Ok(vec![true; n]);
     }
     let outside = 2 * n;
     // The node of the side of polygon `q` that a ray meets, when light can
@@ -119,6 +123,7 @@ pub fn reached_backs<R: FirstHit + Sync>(
     };
     let mut sets = Sets::new(2 * n + 1);
     for block in (0..n).step_by(BLOCK) {
+        cancel.check()?;
         let links: Vec<Vec<(usize, usize)>> = (block..(block + BLOCK).min(n))
             .into_par_iter()
             .with_min_len(RUN)
@@ -142,7 +147,7 @@ pub fn reached_backs<R: FirstHit + Sync>(
             seed(2 * i + 1, &mut sets);
         }
     }
-    (0..n).map(|i| lit[sets.root(2 * i + 1)]).collect()
+    Ok((0..n).map(|i| lit[sets.root(2 * i + 1)]).collect())
 }
 
 /// The probe rays of one side of `p` facing `normal` (unit): origins
@@ -262,14 +267,28 @@ mod tests {
     #[test]
     fn the_backs_of_a_lit_cave_face_the_dark_and_are_left_out() {
         let (scene, two_sided) = cave();
-        let reached = reached_backs(&scene, &two_sided, false, &BruteForce(&scene));
+        let reached = reached_backs(
+            &scene,
+            &two_sided,
+            false,
+            &BruteForce(&scene),
+            &Cancel::never(),
+        )
+        .unwrap();
         assert_eq!(&reached[..6], &[false; 6]);
     }
 
     #[test]
     fn under_a_sky_the_outside_is_lit_and_every_back_kept() {
         let (scene, two_sided) = cave();
-        let reached = reached_backs(&scene, &two_sided, true, &BruteForce(&scene));
+        let reached = reached_backs(
+            &scene,
+            &two_sided,
+            true,
+            &BruteForce(&scene),
+            &Cancel::never(),
+        )
+        .unwrap();
         assert_eq!(&reached[..6], &[true; 6]);
     }
 
@@ -289,7 +308,14 @@ mod tests {
             ],
         );
         assert!(scene.polygons[6].normal.y > 0.99);
-        let reached = reached_backs(&scene, &two_sided, false, &BruteForce(&scene));
+        let reached = reached_backs(
+            &scene,
+            &two_sided,
+            false,
+            &BruteForce(&scene),
+            &Cancel::never(),
+        )
+        .unwrap();
         assert_eq!(&reached[..6], &[true; 6]);
     }
 
@@ -297,7 +323,14 @@ mod tests {
     fn nothing_is_left_out_of_a_scene_that_nothing_lights() {
         let (mut scene, two_sided) = cave();
         scene.materials[1].k_emission = 0.0;
-        let reached = reached_backs(&scene, &two_sided, false, &BruteForce(&scene));
+        let reached = reached_backs(
+            &scene,
+            &two_sided,
+            false,
+            &BruteForce(&scene),
+            &Cancel::never(),
+        )
+        .unwrap();
         assert!(reached.iter().all(|&r| r));
     }
 
@@ -331,7 +364,14 @@ mod tests {
                 testutil::grey("lamp", 1.0, 0.0),
             ],
         );
-        let reached = reached_backs(&scene, &[true, false], false, &BruteForce(&scene));
+        let reached = reached_backs(
+            &scene,
+            &[true, false],
+            false,
+            &BruteForce(&scene),
+            &Cancel::never(),
+        )
+        .unwrap();
         assert!(reached[0]);
     }
 }
