@@ -238,6 +238,11 @@ mod tests {
         }
     }
 
+    /// [`reached_backs`] with every polygon tested, never cancelled.
+    fn reached(scene: &Scene, two_sided: &[bool], sky: bool) -> Vec<bool> {
+        reached_backs(scene, two_sided, sky, &BruteForce(scene), &Cancel::never()).unwrap()
+    }
+
     /// A cave: the six walls of the box `[0, 4]³` facing in (material 0,
     /// grey), every one two-sided, and a lamp (material 1) in its middle
     /// facing down, one-sided.
@@ -267,28 +272,14 @@ mod tests {
     #[test]
     fn the_backs_of_a_lit_cave_face_the_dark_and_are_left_out() {
         let (scene, two_sided) = cave();
-        let reached = reached_backs(
-            &scene,
-            &two_sided,
-            false,
-            &BruteForce(&scene),
-            &Cancel::never(),
-        )
-        .unwrap();
+        let reached = reached(&scene, &two_sided, false);
         assert_eq!(&reached[..6], &[false; 6]);
     }
 
     #[test]
     fn under_a_sky_the_outside_is_lit_and_every_back_kept() {
         let (scene, two_sided) = cave();
-        let reached = reached_backs(
-            &scene,
-            &two_sided,
-            true,
-            &BruteForce(&scene),
-            &Cancel::never(),
-        )
-        .unwrap();
+        let reached = reached(&scene, &two_sided, true);
         assert_eq!(&reached[..6], &[true; 6]);
     }
 
@@ -308,14 +299,7 @@ mod tests {
             ],
         );
         assert!(scene.polygons[6].normal.y > 0.99);
-        let reached = reached_backs(
-            &scene,
-            &two_sided,
-            false,
-            &BruteForce(&scene),
-            &Cancel::never(),
-        )
-        .unwrap();
+        let reached = reached(&scene, &two_sided, false);
         assert_eq!(&reached[..6], &[true; 6]);
     }
 
@@ -323,14 +307,7 @@ mod tests {
     fn nothing_is_left_out_of_a_scene_that_nothing_lights() {
         let (mut scene, two_sided) = cave();
         scene.materials[1].k_emission = 0.0;
-        let reached = reached_backs(
-            &scene,
-            &two_sided,
-            false,
-            &BruteForce(&scene),
-            &Cancel::never(),
-        )
-        .unwrap();
+        let reached = reached(&scene, &two_sided, false);
         assert!(reached.iter().all(|&r| r));
     }
 
@@ -364,14 +341,7 @@ mod tests {
                 testutil::grey("lamp", 1.0, 0.0),
             ],
         );
-        let reached = reached_backs(
-            &scene,
-            &[true, false],
-            false,
-            &BruteForce(&scene),
-            &Cancel::never(),
-        )
-        .unwrap();
+        let reached = reached(&scene, &[true, false], false);
         assert!(reached[0]);
     }
 }
