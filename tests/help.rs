@@ -137,6 +137,23 @@ fn short_help_is_grouped_and_comparison_switches_are_in_long_help() {
     assert!(examples < codes);
 }
 
+/// The help is written for the command line, not rustdoc: no doc-link
+/// brackets or private item paths leak from the code's doc comments into
+/// what `-h` and `--help` print (the values' lists included).
+#[test]
+fn help_shows_no_rustdoc_links() {
+    for flag in ["-h", "--help"] {
+        let help = stdout(&run_in(&root(), &[flag]));
+        for (n, line) in help.lines().enumerate() {
+            assert!(
+                !line.contains("[`") && !line.contains("::"),
+                "{flag} line {}: {line}",
+                n + 1
+            );
+        }
+    }
+}
+
 /// Each option that means something only with another is refused
 /// without it, with one message of one form naming what it needs, exit
 /// code 2, and nothing written.

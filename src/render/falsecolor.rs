@@ -53,6 +53,7 @@ pub enum Quantity {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Scale {
     /// Logarithmic, over [`LOG_DECADES`] decades below the maximum.
+    #[value(help = "Logarithmic, over three decades below the maximum")]
     Log,
     /// Linear from 0 to the maximum.
     Linear,
@@ -335,6 +336,17 @@ pub fn plan(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The command line's help spells the decades out in words, so it
+    /// must follow the constant.
+    #[test]
+    fn the_log_scale_help_names_its_decades() {
+        use clap::ValueEnum;
+        let help = Scale::Log.to_possible_value().unwrap();
+        let words = ["zero", "one", "two", "three", "four", "five", "six"];
+        let word = words[LOG_DECADES as usize];
+        assert!(help.get_help().unwrap().to_string().contains(word));
+    }
 
     #[test]
     fn mappings_invert_and_clamp() {

@@ -94,32 +94,58 @@ pub struct Approximations {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Heuristic {
     /// [`Approximations::emitters_first`].
+    #[value(help = "lamps shoot their own light before any reflector")]
     EmittersFirst,
     /// [`Approximations::overshoot`].
+    #[value(
+        help = "a step also sends the light its shooter will receive later (Feda and Purgathofer)"
+    )]
     Overshoot,
     /// [`Approximations::settling`].
+    #[value(help = "past the threshold, shoot on until every point has sent most of its light")]
     Settling,
     /// [`Approximations::near_field`].
+    #[value(help = "the exact point-to-cell form factor for receivers near a shooter cell")]
     NearField,
     /// [`Approximations::shaft_culling`].
+    #[value(
+        help = "shadow rays test only the polygons between shooter and receiver (same result)"
+    )]
     ShaftCulling,
     /// [`Approximations::clusters`].
+    #[value(help = "nearby small polygons shoot their light together")]
     Clusters,
     /// [`Approximations::strata`].
+    #[value(help = "a weak step shoots from fewer, coarser cells")]
     Strata,
     /// [`Approximations::receiver_interpolation`].
+    #[value(
+        help = "large receiving grids are evaluated at coarse vertices and interpolated where a check holds"
+    )]
     ReceiverInterpolation,
     /// [`Approximations::weak_strata`].
+    #[value(help = "a near stratum whose light is weak at a vertex is taken as one term")]
     WeakStrata,
     /// [`Approximations::crowded_cells`].
+    #[value(help = "a receiving cell with another polygon close in front is never interpolated")]
     CrowdedCells,
     /// [`Approximations::facet_rays`].
+    #[value(
+        help = "a facet under half an element across asks one shadow ray per sample for all its vertices"
+    )]
     FacetRays,
     /// [`Approximations::sky_probes`].
+    #[value(
+        help = "a vertex asks a few of a sky facet's directions first, the rest only when they disagree"
+    )]
     SkyProbes,
     /// [`Approximations::far_shooters`].
+    #[value(
+        help = "a vertex far from a lamp asks a few of its samples first, the rest only when they disagree"
+    )]
     FarShooters,
     /// [`Approximations::shared_receivers`].
+    #[value(help = "vertices of one surface at one point receive as one")]
     SharedReceivers,
 }
 

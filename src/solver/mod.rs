@@ -179,7 +179,13 @@ pub enum FormFactorMethod {
     /// ([`hemicube`]). No shadow rays; aliases where elements are small
     /// seen from the shooter. Shoots every polygon alone (no clusters,
     /// every receiver exact); a sky facet still shoots by Wallace's rays.
-    #[value(name = "hemicube")]
+    #[value(
+        name = "hemicube",
+        help = "Cohen and Greenberg's hemicube: each shooter cell projects the scene's elements \
+                onto a hemicube of --hemicube-res pixels with a z-buffer. No shadow rays; aliases \
+                where elements are small seen from the shooter. Shoots every polygon alone; a sky \
+                facet still shoots by Wallace's rays"
+    )]
     Hemicube,
 }
 
