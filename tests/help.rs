@@ -272,6 +272,14 @@ fn negative_values_get_the_range_message() {
         ),
         (&["--size", "-1x5"], "--size must look like 640x480"),
         (&["--aa", "-1"], "-1 is not in 1..=8"),
+        (
+            &["--max-steps", "-1"],
+            "'--max-steps <N>': expected a whole number like 0, 200 or 2e5, got `-1`",
+        ),
+        (
+            &["--threads", "-2"],
+            "'--threads <N>': expected a whole number like 0, 200 or 2e5",
+        ),
     ];
     let dir = tempfile::tempdir().unwrap();
     for (args, message) in cases {
@@ -281,6 +289,54 @@ fn negative_values_get_the_range_message() {
         assert!(err.contains(message), "{args:?}: {err}");
         assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
     }
+}
+
+/// A value that is not a number of the option's kind says what a good
+/// one looks like, not the parser's "invalid digit found in string"; a
+/// whole count may be written with an exponent.
+#[test]
+fn values_that_are_not_numbers_say_what_is_expected() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["--lenmax", "abc"],
+            "'--lenmax <L>': expected a number like 0.5, 2 or 1e-3, got `abc`",
+        ),
+        (
+            &["--exposure", "bright"],
+            "'--exposure <STOPS>': expected a number like 0.5, 2 or 1e-3",
+        ),
+        (
+            &["--max-steps", "1.5"],
+            "'--max-steps <N>': expected a whole number like 0, 200 or 2e5, got `1.5`",
+        ),
+        (
+            &["--adaptive-levels", "5000000000"],
+            "expected a whole number like 0, 200 or 2e5 (at most 4294967295)",
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    for (args, message) in cases {
+        let mut all = vec![cornell.to_str().unwrap()];
+        all.extend_from_slice(args);
+        let out = run_in(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = stderr(&out);
+        assert!(err.contains(message), "{args:?}: {err}");
+        assert!(!err.contains("invalid digit"), "{args:?}: {err}");
+    }
+    let out = run_in(
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--max-steps",
+            "2e0",
+            "-q",
+            "-o",
+            "x.png",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
 }
 
 /// A file that cannot be read is `FILE: error: cannot read: REASON`,

@@ -6,8 +6,8 @@
 //! line `-h` shows, the whole comment is what `--help` shows.
 
 use super::values::{
-    parse_emit, parse_eye, parse_fov, parse_hemicube_res, parse_ies, parse_look_at,
-    parse_shooter_samples, parse_size, parse_sky, parse_up, parse_workplane,
+    parse_emit, parse_eye, parse_fov, parse_hemicube_res, parse_ies, parse_look_at, parse_number,
+    parse_shooter_samples, parse_size, parse_sky, parse_up, parse_whole, parse_workplane,
 };
 use crate::color::Rgb;
 use crate::config;
@@ -78,7 +78,7 @@ pub struct Args {
     /// Default: 1/80 of the scene's bounding-box diagonal, or coarser when
     /// that mesh would have more than about 400,000 vertices (a line then
     /// says which lenmax was chosen).
-    #[arg(long, value_name = "L")]
+    #[arg(long, value_name = "L", value_parser = parse_number::<f32>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) lenmax: Option<f32>,
 
@@ -86,7 +86,7 @@ pub struct Args {
     ///
     /// Boundary vertices are evaluated this far inside their polygon, so
     /// room corners do not come out dark; 0 disables it.
-    #[arg(long, value_name = "F", default_value_t = DEFAULT_INSET)]
+    #[arg(long, value_name = "F", default_value_t = DEFAULT_INSET, value_parser = parse_number::<f32>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) inset: f32,
 
@@ -96,7 +96,7 @@ pub struct Args {
     /// 0 means: run until --max-steps, or until nothing is left to shoot
     /// (the unshot power is exactly zero; the run then ends as converged,
     /// exit 0). Without --max-steps that can take many thousands of steps.
-    #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD)]
+    #[arg(long, value_name = "T", default_value_t = DEFAULT_THRESHOLD, value_parser = parse_number::<f64>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) threshold: f64,
 
@@ -107,12 +107,12 @@ pub struct Args {
     /// lamp, a sphere's underside over the floor) is a small share of the
     /// scene's power but most of the pocket's own; the threshold alone
     /// would leave such places too dark. 0 stops at the threshold alone.
-    #[arg(long, value_name = "F", default_value_t = DEFAULT_SETTLE)]
+    #[arg(long, value_name = "F", default_value_t = DEFAULT_SETTLE, value_parser = parse_number::<f64>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) settle: f64,
 
     /// Stop after this many shooting steps at most.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = parse_whole::<u64>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) max_steps: Option<u64>,
 
@@ -224,14 +224,14 @@ pub struct Args {
     ///
     /// An element is split when its vertex luminances differ by more than
     /// this fraction of the largest of them.
-    #[arg(long, value_name = "T", default_value_t = refine::DEFAULT_THRESHOLD)]
+    #[arg(long, value_name = "T", default_value_t = refine::DEFAULT_THRESHOLD, value_parser = parse_number::<f64>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive_threshold: f64,
 
     /// Split each initial element at most this many times (--adaptive).
     ///
     /// Each split halves the element's edges.
-    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS)]
+    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_LEVELS, value_parser = parse_whole::<u32>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive_levels: u32,
 
@@ -265,7 +265,7 @@ pub struct Args {
     /// 2^STOPS, as the window's + and - keys and Radiance's `pfilt -e +2`
     /// count; 0 is the automatic exposure, the default. The summary line
     /// and --stats give the automatic value. From -40 to 40.
-    #[arg(long, value_name = "STOPS")]
+    #[arg(long, value_name = "STOPS", value_parser = parse_number::<f32>)]
     #[arg(help_heading = heading::PICTURE)]
     pub(crate) exposure: Option<f32>,
 
@@ -354,7 +354,7 @@ pub struct Args {
     /// Worker threads for the solver and renderer.
     ///
     /// Default: all cores.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = parse_whole::<usize>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) threads: Option<usize>,
 
@@ -385,7 +385,7 @@ pub struct Args {
     /// The mesh is refused before it is built, and the message says which
     /// --lenmax fits. The default allows meshes of up to about 12 GB
     /// (estimated), which --max-memory may refuse first.
-    #[arg(long, value_name = "N", default_value_t = config::DEFAULT_MAX_ELEMENTS)]
+    #[arg(long, value_name = "N", default_value_t = config::DEFAULT_MAX_ELEMENTS, value_parser = parse_whole::<u64>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) max_elements: u64,
 
@@ -413,7 +413,7 @@ pub struct Args {
     pub(crate) checkpoint: Option<PathBuf>,
 
     /// Seconds between checkpoints.
-    #[arg(long, value_name = "SECS", default_value_t = config::DEFAULT_CHECKPOINT_EVERY.as_secs_f64())]
+    #[arg(long, value_name = "SECS", default_value_t = config::DEFAULT_CHECKPOINT_EVERY.as_secs_f64(), value_parser = parse_number::<f64>)]
     #[arg(help_heading = heading::LONG)]
     pub(crate) checkpoint_every: f64,
 
@@ -525,7 +525,7 @@ pub struct Args {
     /// The value shown red by --falsecolor and the plan.
     ///
     /// Default: the largest value, rounded up to 1, 2 or 5 times a power of 10.
-    #[arg(long, value_name = "V")]
+    #[arg(long, value_name = "V", value_parser = parse_number::<f64>)]
     #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) falsecolor_max: Option<f64>,
 

@@ -66,9 +66,84 @@ pub enum ValueError {
     /// not all zero.
     #[error("--up must be a direction X,Y,Z like 0,1,0 (three numbers, not all zero), got `{0}`")]
     Up(String),
+    /// A number option's value is not a number.
+    #[error("expected a number like 0.5, 2 or 1e-3, got `{0}`")]
+    Number(String),
+    /// A count option's value is not a whole number from 0 up (written
+    /// `200` or `2e5`) that fits the count.
+    #[error("expected a whole number like 0, 200 or 2e5{}, got `{text}`", at_most(*.max))]
+    Whole {
+        /// The value given.
+        text: String,
+        /// The largest count the option takes.
+        max: u64,
+    },
     /// `--fov` is not a number of degrees strictly between 0 and 180.
     #[error("--fov must be a vertical field of view in degrees, more than 0 and less than 180, got `{0}`")]
     Fov(String),
+}
+
+/// Parses a number option (`f32` or `f64`): any float Rust reads
+/// (`0.5`, `-2`, `1e-3`, `inf`); whether it is in range is the option's own
+/// check, made later with its meaning in the message.
+pub fn parse_number<T: std::str::FromStr>(text: &str) -> Result<T, ValueError> {
+    text.trim()
+        .parse()
+        .map_err(|_| ValueError::Number(text.to_string()))
+}
+
+/// Parses a count option (steps, threads, elements): a whole number from
+/// 0 up, also in exponent form when it is whole (`2e5`), at most `T`'s
+/// largest value.
+pub fn parse_whole<T>(text: &str) -> Result<T, ValueError>
+where
+    T: TryFrom<u64> + Bounded,
+{
+    let refuse = || ValueError::Whole {
+        text: text.to_string(),
+        max: T::MAX_COUNT,
+    };
+    let trimmed = text.trim();
+    let whole: u64 = match trimmed.parse::<u64>() {
+        Ok(n) => n,
+        Err(_) => {
+            let x: f64 = trimmed.parse().map_err(|_| refuse())?;
+            // 2^64 is the first f64 past u64's range.
+            if !(x >= 0.0 && x.fract() == 0.0 && x < 18_446_744_073_709_551_616.0) {
+                return Err(refuse());
+            }
+            x as u64
+        }
+    };
+    T::try_from(whole).map_err(|_| refuse())
+}
+
+/// ` (at most N)` for a count type smaller than `u64`, whose largest
+/// value a user can reach; nothing for `u64`.
+fn at_most(max: u64) -> String {
+    if max < u64::MAX {
+        format!(" (at most {max})")
+    } else {
+        String::new()
+    }
+}
+
+/// The largest value of a count type, for [`parse_whole`]'s message.
+pub trait Bounded {
+    /// The type's largest value.
+    const MAX_COUNT: u64;
+}
+
+impl Bounded for u32 {
+    const MAX_COUNT: u64 = u32::MAX as u64;
+}
+
+impl Bounded for u64 {
+    const MAX_COUNT: u64 = u64::MAX;
+}
+
+impl Bounded for usize {
+    const MAX_COUNT: u64 = usize::MAX as u64;
 }
 
 /// Parses `--hemicube-res`: pixels across a hemicube's top face, an even
@@ -227,6 +302,31 @@ fn parse_radiosity(value: &str) -> Option<Rgb> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn counts_are_whole_numbers_that_fit() {
+        assert_eq!(parse_whole::<u64>("200"), Ok(200));
+        assert_eq!(parse_whole::<u64>(" 2e5 "), Ok(200_000));
+        assert_eq!(parse_whole::<u32>("4294967295"), Ok(u32::MAX));
+        for bad in ["-1", "1.5", "abc", "", "nan", "inf", "-0.5", "1e30"] {
+            assert!(
+                matches!(parse_whole::<u64>(bad), Err(ValueError::Whole { .. })),
+                "{bad}"
+            );
+        }
+        assert_eq!(
+            parse_whole::<u32>("4294967296"),
+            Err(ValueError::Whole {
+                text: "4294967296".into(),
+                max: u64::from(u32::MAX)
+            })
+        );
+        assert_eq!(parse_number::<f32>("1e-3"), Ok(1e-3));
+        assert_eq!(
+            parse_number::<f64>("x"),
+            Err(ValueError::Number("x".into()))
+        );
+    }
 
     #[test]
     fn sizes_are_width_by_height_in_whole_pixels() {
