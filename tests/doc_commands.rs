@@ -308,6 +308,16 @@ fn run_documented(doc: &Documented) {
     if real_model && solves && !args.iter().any(|a| a == "--max-steps") {
         args.extend(["--max-steps".to_string(), "5".to_string()]);
     }
+    // A row's mesh size is read back from `--stats` (added when the
+    // command has none of its own).
+    let stats = match args.iter().position(|a| a == "--stats") {
+        Some(k) => args[k + 1].clone(),
+        None if doc.vertices.is_some() => {
+            args.extend(["--stats".to_string(), "doc-stats.json".to_string()]);
+            "doc-stats.json".to_string()
+        }
+        None => String::new(),
+    };
     let o = run_in(
         dir.path(),
         &args.iter().map(String::as_str).collect::<Vec<_>>(),
@@ -321,6 +331,15 @@ fn run_documented(doc: &Documented) {
         assert!(
             dir.path().join(output).is_file(),
             "{at}: wrote no {output}: {err}"
+        );
+    }
+    if let Some(vertices) = doc.vertices {
+        let text = std::fs::read_to_string(dir.path().join(&stats)).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(
+            json["vertices"].as_u64(),
+            Some(vertices),
+            "{at}: the docs give {vertices} vertices"
         );
     }
     let stdout = String::from_utf8_lossy(&o.stdout);
