@@ -1,0 +1,155 @@
+//! The baked light in a glTF export looks in a web browser as it does in
+//! the program's own picture: `scripts/browser/render.mjs` loads the file
+//! with three.js's `GLTFLoader` in headless Chromium and renders the same
+//! camera, and the two pictures are compared over 4 × 4-pixel blocks.
+//!
+//! Needs `node`, Debian's `chromium` and the script's `npm` packages
+//! (`.ci/run` installs all three and sets `RADIOSITY_REQUIRE_BROWSER`, so
+//! in CI a missing piece fails the test). Elsewhere, without them, the test
+//! says loudly that it skipped.
+
+mod common;
+
+use common::*;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn which(program: &str) -> Option<PathBuf> {
+    std::env::var_os("PATH")?
+        .to_str()?
+        .split(':')
+        .map(|dir| Path::new(dir).join(program))
+        .find(|p| p.is_file())
+}
+
+/// Why the browser check cannot run here, if it cannot.
+fn missing() -> Option<String> {
+    let chromium = std::env::var_os("CHROMIUM")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+    if which("node").is_none() {
+        Some("node is not installed".into())
+    } else if !chromium.is_file() {
+        Some(format!("no Chromium at {}", chromium.display()))
+    } else if !root()
+        .join("scripts/browser/node_modules/three/package.json")
+        .is_file()
+    {
+        Some("scripts/browser has no node_modules (npm ci there)".into())
+    } else {
+        None
+    }
+}
+
+/// Mean absolute difference of 4 × 4-pixel block means over the blocks
+/// either picture lights, relative to the first picture's mean there, in
+/// linear light (sRGB codes decoded), the three channels together.
+fn block_error(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let linear = |code: u8| {
+        let e = f64::from(code) / 255.0;
+        if e <= 0.04045 {
+            e / 12.92
+        } else {
+            ((e + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let (w, h) = a.dimensions();
+    let (mut diff, mut sum) = (0.0, 0.0);
+    for by in 0..h / 4 {
+        for bx in 0..w / 4 {
+            let mut block = [0.0f64; 2];
+            for (k, picture) in [a, b].into_iter().enumerate() {
+                for y in by * 4..by * 4 + 4 {
+                    for x in bx * 4..bx * 4 + 4 {
+                        block[k] += picture
+                            .get_pixel(x, y)
+                            .0
+                            .iter()
+                            .map(|&c| linear(c))
+                            .sum::<f64>();
+                    }
+                }
+            }
+            diff += (block[0] - block[1]).abs();
+            sum += block[0];
+        }
+    }
+    diff / sum
+}
+
+/// The largest relative block error accepted. The two rasterisers differ
+/// only at polygon edges (which pixel an edge's centre falls in) and in
+/// rounding; a picture upside down, mirrored, shifted by a pixel or
+/// exposed differently is well over it (checked below).
+const MAX_ERROR: f64 = 0.01;
+
+#[test]
+fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
+    if let Some(why) = missing() {
+        assert!(
+            std::env::var_os("RADIOSITY_REQUIRE_BROWSER").is_none(),
+            "the browser check must run here: {why}"
+        );
+        eprintln!("\n**************** SKIPPED: browser test: {why} ****************\n");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let camera = [
+        "--eye",
+        "278,273,-800",
+        "--look-at",
+        "278,273,0",
+        "--up",
+        "0,1,0",
+        "--fov",
+        "39.31",
+        "--size",
+        "320x240",
+    ];
+    let cornell = scene("cornell.sc");
+    let mut args = vec![
+        cornell.to_str().unwrap(),
+        "--export",
+        "c.glb",
+        "-o",
+        "c.png",
+    ];
+    args.extend(["--aa", "1", "-q", "--no-window"]);
+    args.extend(camera);
+    let out = run_in(dir.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = Command::new("node")
+        .arg(root().join("scripts/browser/render.mjs"))
+        .args(["c.glb", "three.png", "--show", "colours"])
+        .args(camera)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let program = image::open(dir.path().join("c.png")).unwrap().to_rgb8();
+    let three = image::open(dir.path().join("three.png")).unwrap().to_rgb8();
+    let error = block_error(&program, &three);
+    eprintln!(
+        "three.js against the program: {:.2} % relative block error",
+        error * 100.0
+    );
+    assert!(error < MAX_ERROR, "{:.2} %", error * 100.0);
+    // The measure tells a wrong picture apart: the same picture upside
+    // down, or shifted by two pixels, is far off.
+    let flipped = image::imageops::flip_vertical(&three);
+    let mut shifted = three.clone();
+    for (x, y, p) in shifted.enumerate_pixels_mut() {
+        *p = *three.get_pixel(x.saturating_sub(2), y);
+    }
+    let (flipped, shifted) = (
+        block_error(&program, &flipped),
+        block_error(&program, &shifted),
+    );
+    eprintln!(
+        "upside down: {:.2} %, two pixels to the right: {:.2} %",
+        flipped * 100.0,
+        shifted * 100.0
+    );
+    assert!(flipped > 5.0 * MAX_ERROR && shifted > MAX_ERROR);
+}
