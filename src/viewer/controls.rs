@@ -7,8 +7,9 @@
 //! around an object seen from outside, a drag across a 640-pixel window
 //! turns the eye by about 290°; inside a room (the eye within the scene's
 //! bounds, [`CameraControl::within`]) the eye moves by a fixed share of the
-//! room's size per pixel, and an orbit stops short of the room's walls,
-//! floor and ceiling rather than take the eye out of the room.
+//! room's size per pixel, and an orbit, a walk, a zoom or a move towards
+//! the cursor stops short of the room's walls, floor and ceiling rather
+//! than take the eye out of the room.
 
 use crate::scene::Camera;
 use glam::{Quat, Vec3};
@@ -44,9 +45,9 @@ const ORBIT_CLAMP_STEPS: u32 = 16;
 /// The window's camera: starts as the scene's camera and moves with input.
 ///
 /// Invariants: `eye != lookat`; the view direction is never parallel to
-/// `up`; `up`, the field of view and the picture size never change; an
-/// orbit that starts with the eye inside the room ([`CameraControl::within`])
-/// ends with it inside.
+/// `up`; `up`, the field of view and the picture size never change; a
+/// move (orbit, walk, zoom, dolly) that starts with the eye inside the
+/// room ([`CameraControl::within`]) ends with it inside.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraControl {
     home: Camera,
@@ -88,6 +89,43 @@ impl CameraControl {
             Some(shrunk)
         } else {
             inside((lo, hi)).then_some((lo, hi))
+        }
+    }
+
+    /// The share in `[0, 1]` of a straight move of the eye by `delta`
+    /// (scene units) that keeps it in the room it stands in: the move
+    /// stops at the room's bounds less [`ROOM_WALL_MARGIN`], and an eye
+    /// already within that margin of a wall moves no nearer to it. 1 when
+    /// the eye is not in a room ([`CameraControl::room_around_eye`]).
+    fn share_inside(&self, delta: Vec3) -> f32 {
+        let (Some((lo, hi)), Some(_)) = (self.room, self.room_around_eye()) else {
+            return 1.0;
+        };
+        let margin = Vec3::splat(ROOM_WALL_MARGIN * (hi - lo).min_element());
+        let (lo, hi) = (lo + margin, hi - margin);
+        let eye = self.camera.eye;
+        let mut share = 1.0f32;
+        for axis in 0..3 {
+            let d = delta[axis];
+            let room = if d > 0.0 {
+                hi[axis] - eye[axis]
+            } else if d < 0.0 {
+                lo[axis] - eye[axis]
+            } else {
+                continue;
+            };
+            share = share.min((room / d).max(0.0));
+        }
+        share.clamp(0.0, 1.0)
+    }
+
+    /// Moves eye and look-at point together by `delta`, or by as much of
+    /// it as keeps the eye in its room.
+    fn shift(&mut self, delta: Vec3) {
+        let delta = delta * self.share_inside(delta);
+        if delta.is_finite() {
+            self.camera.eye += delta;
+            self.camera.lookat += delta;
         }
     }
 
@@ -199,7 +237,8 @@ impl CameraControl {
 
     /// Multiplies the distance to the look-at point by `factor` (below 1
     /// moves closer), kept within [`MIN_DISTANCE_FRACTION`] and
-    /// [`MAX_DISTANCE_FACTOR`] of the scene camera's distance.
+    /// [`MAX_DISTANCE_FACTOR`] of the scene camera's distance; inside a
+    /// room, the eye backs away only as far as the room lets it.
     pub fn zoom(&mut self, factor: f32) {
         if !(factor.is_finite() && factor > 0.0) {
             return;
@@ -208,7 +247,11 @@ impl CameraControl {
         let distance = (self.distance() * factor)
             .clamp(home * MIN_DISTANCE_FRACTION, home * MAX_DISTANCE_FACTOR);
         let direction = (self.camera.eye - self.camera.lookat).normalize();
-        self.camera.eye = self.camera.lookat + direction * distance;
+        let delta = self.camera.lookat + direction * distance - self.camera.eye;
+        let delta = delta * self.share_inside(delta);
+        if delta.is_finite() {
+            self.camera.eye += delta;
+        }
     }
 
     /// Moves the camera (eye and look-at point together, so the view keeps
@@ -218,8 +261,9 @@ impl CameraControl {
     /// moves closer). Moving closer stops `stop` scene units in front of
     /// the target, so the eye never reaches the surface it moves towards;
     /// an eye already that close does not move closer. Moving away is
-    /// limited to [`MAX_DISTANCE_FACTOR`] scene-camera distances.
-    /// Non-finite or non-positive input changes nothing.
+    /// limited to [`MAX_DISTANCE_FACTOR`] scene-camera distances, and
+    /// inside a room to the room. Non-finite or non-positive input changes
+    /// nothing.
     pub fn dolly(&mut self, target: Vec3, factor: f32, stop: f32) {
         if !(factor.is_finite()
             && factor > 0.0
@@ -239,25 +283,18 @@ impl CameraControl {
         } else {
             (d * factor).min(d.max(self.home_distance() * MAX_DISTANCE_FACTOR))
         };
-        let delta = offset / d * (d - wanted);
-        if delta.is_finite() {
-            self.camera.eye += delta;
-            self.camera.lookat += delta;
-        }
+        self.shift(offset / d * (d - wanted));
     }
 
     /// Moves eye and look-at point together: `right`, `up` and `forward`
-    /// in units of the current distance to the look-at point.
+    /// in units of the current distance to the look-at point; inside a
+    /// room, only as far as keeps the eye in it.
     pub fn walk(&mut self, right: f32, up: f32, forward: f32) {
         let view = (self.camera.lookat - self.camera.eye).normalize();
         let side = view.cross(self.camera.up).normalize_or_zero();
         let true_up = side.cross(view);
         let d = self.distance();
-        let delta = (side * right + true_up * up + view * forward) * d;
-        if delta.is_finite() {
-            self.camera.eye += delta;
-            self.camera.lookat += delta;
-        }
+        self.shift((side * right + true_up * up + view * forward) * d);
     }
 }
 
@@ -488,6 +525,68 @@ mod tests {
         let (lo, hi) = scene.bounds();
         assert_eq!((lo, hi), (Vec3::ZERO, Vec3::new(5.0, 3.0, 5.0)));
         (scene.camera, lo, hi)
+    }
+
+    /// Holding an arrow key, turning the wheel or backing away from the
+    /// look-at point in `rtable` stops at its walls; outside a room the
+    /// same moves go as far as asked.
+    #[test]
+    fn walking_zooming_and_the_wheel_stay_in_the_room() {
+        let (start, lo, hi) = rtable();
+        let inside = |c: &CameraControl| {
+            let eye = c.camera().eye;
+            eye.cmpgt(lo).all() && eye.cmplt(hi).all()
+        };
+        for (right, up, forward) in [
+            (0.0, 0.0, 0.2),
+            (0.0, 0.0, -0.2),
+            (0.2, 0.0, 0.0),
+            (-0.2, 0.0, 0.0),
+            (0.0, 0.2, 0.0),
+            (0.0, -0.2, 0.0),
+            (0.15, 0.1, 0.15),
+        ] {
+            let mut c = CameraControl::new(start).within(lo, hi);
+            // As the window repeats a held key, a hundred frames.
+            for _ in 0..100 {
+                c.walk(right, up, forward);
+                assert!(
+                    inside(&c),
+                    "walk ({right}, {up}, {forward}): {}",
+                    c.camera().eye
+                );
+            }
+            assert_ne!(c.camera().eye, start.eye);
+            // It went most of the way to the wall it walked towards.
+            let room = hi - lo;
+            let margin = ROOM_WALL_MARGIN * room.min_element();
+            let to_wall = (c.camera().eye - lo).min(hi - c.camera().eye).min_element();
+            assert!(
+                to_wall < margin + 0.01 * room.min_element(),
+                "{}",
+                c.camera().eye
+            );
+            // The view keeps its direction.
+            let view = c.camera().lookat - c.camera().eye;
+            let home_view = start.lookat - start.eye;
+            assert!(view.normalize().dot(home_view.normalize()) > 0.9999);
+        }
+        let mut c = CameraControl::new(start).within(lo, hi);
+        for _ in 0..100 {
+            c.zoom(1.3);
+            assert!(inside(&c), "zoom: {}", c.camera().eye);
+        }
+        let mut c = CameraControl::new(start).within(lo, hi);
+        let target = Vec3::new(2.5, 0.78, 2.8);
+        for _ in 0..100 {
+            c.dolly(target, 1.3, 0.05);
+            assert!(inside(&c), "wheel back: {}", c.camera().eye);
+        }
+        // Seen from outside (no room around the eye) nothing is clamped.
+        let mut c = CameraControl::new(home());
+        c.walk(0.0, 0.0, 5.0);
+        let walked = c.camera().eye.distance(home().eye);
+        assert!((walked - 5.0 * home().eye.distance(home().lookat)).abs() < 1e-3 * walked);
     }
 
     #[test]
