@@ -8,17 +8,10 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use common::which;
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn which(program: &str) -> Option<PathBuf> {
-    std::env::var_os("PATH")?
-        .to_str()?
-        .split(':')
-        .map(|dir| Path::new(dir).join(program))
-        .find(|p| p.is_file())
-}
 
 fn skip(why: &str) {
     eprintln!("\n**************** SKIPPED: window end-to-end test: {why} ****************\n");

@@ -187,3 +187,12 @@ pub fn spawn_in(dir: &Path, args: &[&str]) -> std::process::Child {
         .spawn()
         .expect("the radiosity binary starts")
 }
+
+/// The program `program` as found on `PATH`, if it is there.
+pub fn which(program: &str) -> Option<PathBuf> {
+    std::env::var_os("PATH")?
+        .to_str()?
+        .split(':')
+        .map(|dir| Path::new(dir).join(program))
+        .find(|p| p.is_file())
+}
