@@ -156,9 +156,8 @@ pub struct DaylightConfig {
     /// `--sky cie-...`: the standard sky and its level, if asked for
     /// (never with a uniform [`RunConfig::sky`]).
     pub sky: Option<(crate::scene::SkyModel, Option<crate::scene::SkyLevel>)>,
-    /// `--sun`: where the sun is, and its normal illuminance in lux if
-    /// given.
-    pub sun: Option<(crate::scene::SunPosition, Option<f64>)>,
+    /// `--sun`: where the sun is.
+    pub sun: Option<crate::scene::SunPosition>,
     /// `--north`: true north clockwise from the model's north, radians.
     pub north: f64,
 }
@@ -170,7 +169,7 @@ impl DaylightConfig {
     ) -> Result<Option<crate::scene::DaylightSky>, crate::scene::DaylightError> {
         self.sky
             .map(|(model, level)| {
-                crate::scene::DaylightSky::new(model, level, self.sun.map(|s| s.0), self.north)
+                crate::scene::DaylightSky::new(model, level, self.sun, self.north)
             })
             .transpose()
     }

@@ -325,12 +325,13 @@ pub struct Args {
     #[arg(help_heading = heading::LIGHT)]
     pub(crate) sky: Option<SkyArg>,
 
-    /// Where the sun is: AZIMUTH,ALTITUDE[,ILLUMINANCE].
+    /// Where the sun is: AZIMUTH,ALTITUDE.
     ///
     /// Degrees clockwise from north (90 is east), degrees above the
     /// horizon (0 to 90). Shapes the luminance of the standard skies that
-    /// depend on the sun (--sky cie-clear, cie:N).
-    #[arg(long, value_name = "AZ,ALT[,LX]", value_parser = parse_sun, allow_hyphen_values = true)]
+    /// depend on the sun (--sky cie-clear, cie:N); the sun's own direct
+    /// light is not added.
+    #[arg(long, value_name = "AZ,ALT", value_parser = parse_sun, allow_hyphen_values = true)]
     #[arg(help_heading = heading::LIGHT)]
     pub(crate) sun: Option<SunArg>,
 

@@ -312,7 +312,7 @@ impl TryFrom<Args> for Invocation {
                 Some(SkyArg::Standard(model, level)) => Some((model, level)),
                 _ => None,
             },
-            sun: args.sun.map(|s| (s.position, s.illuminance)),
+            sun: args.sun.map(|s| s.position),
             north: args.north.unwrap_or(0.0).to_radians(),
         };
         if args.sun.is_some() && daylight.sky.is_none_or(|(m, _)| !m.needs_sun()) {

@@ -46,11 +46,11 @@ pub enum ValueError {
          or `,3000cd` (zenith luminance in cd/m²), got `{0}`"
     )]
     StandardSky(String),
-    /// `--sun` is not `AZIMUTH,ALTITUDE[,ILLUMINANCE]`: degrees clockwise
-    /// from north, degrees above the horizon from 0 to 90, lux `> 0`.
+    /// `--sun` is not `AZIMUTH,ALTITUDE`: degrees clockwise from north,
+    /// degrees above the horizon from 0 to 90.
     #[error(
-        "--sun must look like 135,40 or 135,40,80000 (azimuth in degrees clockwise from north, \
-         altitude in degrees from 0 to 90, the sun's normal illuminance in lux > 0), got `{0}`"
+        "--sun must look like 135,40 (azimuth in degrees clockwise from north, \
+         altitude in degrees from 0 to 90), got `{0}`"
     )]
     Sun(String),
     /// `--north` is not a finite number of degrees.
@@ -277,20 +277,15 @@ pub fn parse_sky(text: &str) -> Result<SkyArg, ValueError> {
     Ok(SkyArg::Standard(model, level))
 }
 
-/// What `--sun` gives: the sun's position and its normal illuminance in
-/// lux, if given.
+/// What `--sun` gives: the sun's position.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunArg {
     /// Where the sun is.
     pub position: SunPosition,
-    /// The sun's illuminance on a plane facing it, lux (`> 0`), if given.
-    pub illuminance: Option<f64>,
 }
 
-/// Parses `--sun`: `AZIMUTH,ALTITUDE[,ILLUMINANCE]`, the azimuth in
-/// degrees clockwise from north (any finite number), the altitude in
-/// degrees from 0 to 90, the illuminance in lux finite and `> 0`, at most
-/// [`MAX_EMISSION`].
+/// Parses `--sun`: `AZIMUTH,ALTITUDE`, the azimuth in degrees clockwise
+/// from north (any finite number), the altitude in degrees from 0 to 90.
 pub fn parse_sun(text: &str) -> Result<SunArg, ValueError> {
     let bad = || ValueError::Sun(text.to_string());
     let numbers = text
@@ -298,17 +293,14 @@ pub fn parse_sun(text: &str) -> Result<SunArg, ValueError> {
         .map(|c| c.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
         .collect::<Option<Vec<f64>>>()
         .ok_or_else(bad)?;
-    let (azimuth, altitude, illuminance) = match numbers[..] {
-        [a, h] => (a, h, None),
-        [a, h, e] if e > 0.0 && e <= MAX_EMISSION => (a, h, Some(e)),
-        _ => return Err(bad()),
+    let [azimuth, altitude] = numbers[..] else {
+        return Err(bad());
     };
     if !(0.0..=90.0).contains(&altitude) || azimuth.abs() > 360.0 * 1e6 {
         return Err(bad());
     }
     Ok(SunArg {
         position: SunPosition::from_degrees(azimuth.rem_euclid(360.0), altitude),
-        illuminance,
     })
 }
 
@@ -458,19 +450,17 @@ mod tests {
     }
 
     #[test]
-    fn the_sun_is_an_azimuth_an_altitude_and_maybe_an_illuminance() {
+    fn the_sun_is_an_azimuth_and_an_altitude() {
         let sun = parse_sun("135, 40").unwrap();
         assert_eq!(sun.position, SunPosition::from_degrees(135.0, 40.0));
-        assert_eq!(sun.illuminance, None);
-        let sun = parse_sun("-90,90,80000").unwrap();
+        let sun = parse_sun("-90,90").unwrap();
         assert_eq!(sun.position, SunPosition::from_degrees(270.0, 90.0));
-        assert_eq!(sun.illuminance, Some(80_000.0));
         for bad in [
             "",
             "135",
             "135,-1",
             "135,91",
-            "135,40,0",
+            "135,40,80000",
             "135,40,1,2",
             "a,b",
             "inf,3",

@@ -39,6 +39,7 @@ pub use import::sc::{
 pub use import::{load, load_with};
 pub use lighting::daylight::{
     DaylightError, DaylightSky, HorizonFrame, SkyLevel, SkyLight, SkyModel, SunPosition,
+    CLEAR_TURBIDITY, DAYLIGHT_RADIUS_FACTOR, DEFAULT_HORIZONTAL_LUX, FACET_SPLITS,
     GROUND_REFLECTANCE,
 };
 pub use lighting::emit::{

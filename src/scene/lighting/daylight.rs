@@ -331,7 +331,8 @@ impl DaylightSky {
         (lit, weight)
     }
 
-    /// The radiosity (lm/m²) of each facet of [`dome`] when the ground
+    /// The radiosity (lm/m²) of each facet of the dome (in the order of
+    /// the enclosure's facets) when the ground
     /// is lit by `ground_lux` (the horizontal illuminance from the sky and
     /// any sun): above the horizon `π` times the `cos Z`-weighted mean
     /// luminance, below it [`GROUND_REFLECTANCE`] `× ground_lux`.
