@@ -194,8 +194,8 @@ fn tutorial_room() -> String {
 }
 
 /// The daylight section's open floor: 10 × 10 m of reflectance 0.5,
-/// facing up, nothing above it.
-const OPEN_FLOOR: &str = "material floor\n  color 0.5 0.5 0.5\n  k_diffrefl 1\nend\n\
+/// facing up, nothing above it, and a camera looking down at it.
+const OPEN_FLOOR: &str = "camera\n  eye 5 6 4\n  lookat 5 0 -5\nend\nmaterial floor\n  color 0.5 0.5 0.5\n  k_diffrefl 1\nend\n\
 polygon floor\n  vertex 0 0 0\n  vertex 10 0 0\n  vertex 10 0 -10\n  vertex 0 0 -10\nend\n";
 
 /// A room as Blender exports a scaled cube: faces pointing out, a `Lamp`

@@ -647,13 +647,16 @@ mod tests {
     }
 
     /// How far the facets' constant luminance is from the sky's own on a
-    /// vertical plane at the centre (the window's case), facing the sun,
-    /// away from it and across: what 80 facets cost in accuracy. Printed
-    /// with `--nocapture`; the bounds are the measured errors rounded up.
+    /// vertical plane at the centre (the window's case), facing the sun
+    /// (35° high), across and away from it: what 80 facets cost in
+    /// accuracy. Measured: overcast +5.3 % every way (the `cos Z` weight
+    /// that makes the horizontal exact favours a facet's upper, brighter
+    /// part, and a vertical plane sees the low facets most); clear −3.3 %,
+    /// −3.9 %, −9.8 %. The bounds are those rounded up.
     #[test]
     fn vertical_planes_see_the_facets_nearly_as_the_sky() {
         let sun = SunPosition::from_degrees(180.0, 35.0);
-        for (model, bound) in [(SkyModel::CieOvercast, 0.02), (SkyModel::CLEAR, 0.08)] {
+        for (model, bound) in [(SkyModel::CieOvercast, 0.06), (SkyModel::CLEAR, 0.11)] {
             let sky = DaylightSky::new(model, Some(SkyLevel::Zenith(1.0)), Some(sun), 0.0).unwrap();
             let b = sky.facet_radiosities(0.0);
             for azimuth in [180.0f64, 90.0, 0.0] {
