@@ -144,6 +144,35 @@ pub struct RunConfig {
     /// `--illuminance-at`, `--workplane`, `--falsecolor`); all off by
     /// default.
     pub photometry: PhotometryConfig,
+    /// Daylight: a standard sky (`--sky cie-...`), the sun and north; all
+    /// off by default.
+    pub daylight: DaylightConfig,
+}
+
+/// The daylight part of a run: a standard sky, where the sun is and
+/// which way north lies.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DaylightConfig {
+    /// `--sky cie-...`: the standard sky and its level, if asked for
+    /// (never with a uniform [`RunConfig::sky`]).
+    pub sky: Option<(crate::scene::SkyModel, Option<crate::scene::SkyLevel>)>,
+    /// `--sun`: where the sun is.
+    pub sun: Option<crate::scene::SunPosition>,
+    /// `--north`: true north clockwise from the model's north, radians.
+    pub north: f64,
+}
+
+impl DaylightConfig {
+    /// The standard sky made definite, `None` when none is asked for.
+    pub fn resolve(
+        &self,
+    ) -> Result<Option<crate::scene::DaylightSky>, crate::scene::DaylightError> {
+        self.sky
+            .map(|(model, level)| {
+                crate::scene::DaylightSky::new(model, level, self.sun, self.north)
+            })
+            .transpose()
+    }
 }
 
 /// The photometric part of a run: what a scene unit is, the luminaires,
@@ -178,6 +207,9 @@ pub struct WorkplaneConfig {
     pub csv: PathBuf,
     /// The plan to write (`PREFIX.png`).
     pub png: PathBuf,
+    /// With `--daylight-factor`, the plan of daylight factors to write
+    /// (`PREFIX-df.png`).
+    pub daylight_factor: Option<PathBuf>,
     /// The plan's false-colour scale (`--falsecolor-scale`).
     pub scale: crate::render::falsecolor::Scale,
     /// The value the plan shows red (`--falsecolor-max`), in lux with a
@@ -232,6 +264,7 @@ impl RunConfig {
             sides: Sides::AsLoaded,
             sky: None,
             photometry: PhotometryConfig::default(),
+            daylight: DaylightConfig::default(),
         }
     }
 
@@ -286,7 +319,8 @@ impl RunConfig {
             self.photometry
                 .workplane
                 .iter()
-                .flat_map(|w| [&w.csv, &w.png]),
+                .flat_map(|w| [Some(&w.csv), Some(&w.png), w.daylight_factor.as_ref()])
+                .flatten(),
         )
         .chain(self.photometry.falsecolor.iter().map(|f| &f.path))
     }

@@ -228,7 +228,8 @@ fn emitters(scene: &Scene, out: &mut String) {
             }
         }
         if is_sky {
-            sky = Some(m.emission());
+            // A standard sky's facets each have a material: say its mean.
+            sky = scene.sky();
         } else if n > 0 {
             lines.push(format!(
                 "  {}: emits {}, {}, area {}",

@@ -21,7 +21,7 @@ use crate::render::{View, ViewError};
 use crate::scene::repair::{self, FirstHit, RepairError, RepairOptions};
 use crate::scene::{
     self, IesError, InputKind, InputSet, LoadError, LuminaireError, Photometry, PolygonError,
-    PolygonId, Scene, SplitStats, UnknownName, Warning,
+    PolygonId, Scene, SkyLight, SplitStats, UnknownName, Warning,
 };
 use crate::visibility::Visibility;
 use glam::Vec3;
@@ -62,6 +62,15 @@ pub enum PrepareError {
          at distances in metres (glTF scenes are in metres; OBJ and .sc have no unit)"
     )]
     NoUnits(String),
+    /// A standard sky on a scene without a unit: its luminance is in cd/m².
+    #[error(
+        "--sky {0} needs --units for {1}: a standard sky's luminance is in cd/m² and its \
+         illuminance in lux (glTF scenes are in metres; OBJ and .sc have no unit)"
+    )]
+    SkyNoUnits(String, String),
+    /// A standard sky cannot be made as asked.
+    #[error("{0}")]
+    Daylight(#[from] crate::scene::DaylightError),
     /// The scene would need more memory than `--max-memory`: what the
     /// estimate is and what makes it.
     #[error("{0}")]
@@ -247,9 +256,21 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
     // BVH they build to find trapped sides is kept for the solve.
     let mut bvh_seconds = 0.0;
     let name = config.scene.display_name();
+    let sky = match config.daylight.resolve()? {
+        Some(daylight) => {
+            if config.units().is_none() {
+                return Err(PrepareError::SkyNoUnits(
+                    daylight.model.name(),
+                    config.scene.display_name(),
+                ));
+            }
+            Some(SkyLight::Daylight(daylight, 0.0))
+        }
+        None => config.sky.map(SkyLight::Uniform),
+    };
     let options = RepairOptions {
         sides: config.sides,
-        sky: config.sky,
+        sky,
         file: &name,
         budget: config.max_memory,
     };

@@ -172,6 +172,9 @@ fn fixture(dir: &Path, name: &str) -> Option<()> {
             );
         }
         "camera.sc" => copy(models.join("mcguire/camera.sc"), "camera.sc"),
+        "floor.sc" => {
+            write(dir, "floor.sc", OPEN_FLOOR);
+        }
         _ => return None,
     }
     Some(())
@@ -189,6 +192,11 @@ fn tutorial_room() -> String {
     let close = rest[open..].find("```").unwrap();
     rest[open..open + close].to_string()
 }
+
+/// The daylight section's open floor: 10 × 10 m of reflectance 0.5,
+/// facing up, nothing above it, and a camera looking down at it.
+const OPEN_FLOOR: &str = "camera\n  eye 5 6 4\n  lookat 5 0 -5\nend\nmaterial floor\n  color 0.5 0.5 0.5\n  k_diffrefl 1\nend\n\
+polygon floor\n  vertex 0 0 0\n  vertex 10 0 0\n  vertex 10 0 -10\n  vertex 0 0 -10\nend\n";
 
 /// A room as Blender exports a scaled cube: faces pointing out, a `Lamp`
 /// plane under the ceiling and a box on the floor, no materials.

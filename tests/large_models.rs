@@ -455,7 +455,7 @@ fn repair_and_mesh(m: &Model, loaded: Scene) {
     let name = model(m.rel).display().to_string();
     let options = RepairOptions {
         sides: Sides::AsLoaded,
-        sky: Some(Rgb::splat(1.0)),
+        sky: Some(radiosity::scene::SkyLight::Uniform(Rgb::splat(1.0))),
         file: &name,
         budget: radiosity::budget::MemoryBudget::UNLIMITED,
     };

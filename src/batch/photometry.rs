@@ -1,6 +1,7 @@
 //! The photometric results of a batch run: illuminance at points
-//! (`--illuminance-at`), the work plane (`--workplane`) and the view in
-//! false colour (`--falsecolor`), from the converged solution.
+//! (`--illuminance-at`), the work plane (`--workplane`) and its daylight
+//! factors (`--daylight-factor`), and the view in false colour
+//! (`--falsecolor`), from the converged solution.
 //!
 //! Each says on stderr what it computed and how long it took (unless
 //! quiet); the work plane's figures go to stdout whatever `--quiet` says,
@@ -13,6 +14,7 @@ use crate::cancel::Cancel;
 use crate::color::Rgb;
 use crate::config::RunConfig;
 use crate::mesh::Mesh;
+use crate::output::daylight_factor::{self, DaylightFactors};
 use crate::output::{self, illuminance as out};
 use crate::prepare::Prepared;
 use crate::render::falsecolor::{self, Mapping, Quantity};
@@ -149,6 +151,38 @@ pub(super) fn write(
             w.height,
             u.line(photometric.illuminance_unit())
         );
+        if let Some(png) = &w.daylight_factor {
+            let sky = config.daylight.resolve().ok().flatten().ok_or_else(|| {
+                RunError::Options("--daylight-factor needs a standard sky".into())
+            })?;
+            let outside = sky.horizontal_illuminance();
+            let df: Vec<Option<f64>> = values
+                .iter()
+                .zip(&behind)
+                .map(|(e, &hidden)| (!hidden).then(|| 100.0 * e.luminance() / outside))
+                .collect();
+            let open: Vec<f64> = df.iter().flatten().copied().collect();
+            let all: Vec<f64> = values
+                .iter()
+                .map(|e| 100.0 * e.luminance() / outside)
+                .collect();
+            let figures = DaylightFactors::of(if open.is_empty() { &all } else { &open });
+            let steps = grid.nx.max(grid.ny).max(2) as u32 - 1;
+            let pixels = (out::PLAN_PIXELS / steps)
+                .max(out::PLAN_MIN_PIXELS.div_ceil(steps))
+                .max(1);
+            daylight_factor::write_plan(png, &df, grid.nx, grid.ny, pixels)
+                .map_err(RunError::Write)?;
+            written.push(png);
+            let [first, second] = figures.lines();
+            println!(
+                "daylight factor at {} (outside {:.0} lx, {} sky): {first}",
+                w.height,
+                outside,
+                sky.model.name()
+            );
+            println!("{second}");
+        }
     }
     if let Some(f) = &p.falsecolor {
         cancel.check()?;

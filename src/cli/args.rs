@@ -6,8 +6,9 @@
 //! line `-h` shows, the whole comment is what `--help` shows.
 
 use super::values::{
-    parse_emit, parse_eye, parse_fov, parse_hemicube_res, parse_ies, parse_look_at, parse_number,
-    parse_shooter_samples, parse_size, parse_sky, parse_up, parse_whole, parse_workplane,
+    parse_emit, parse_eye, parse_fov, parse_hemicube_res, parse_ies, parse_look_at, parse_north,
+    parse_number, parse_shooter_samples, parse_size, parse_sky, parse_sun, parse_up, parse_whole,
+    parse_workplane, SkyArg, SunArg,
 };
 use crate::color::Rgb;
 use crate::config;
@@ -304,16 +305,43 @@ pub struct Args {
     #[arg(long)]
     #[arg(help_heading = heading::INPUT)]
     pub(crate) two_sided: bool,
-    /// Light the scene from all around with a uniform sky.
+    /// Light the scene from all around with a uniform or standard sky.
     ///
     /// V or R,G,B: a diffuse sky of this radiosity, in the scene's units,
     /// surrounds the scene (as Blender's world colour) and lights it
     /// through every opening; closed rooms stay dark inside. An unoccluded
     /// floor of reflectance rho under a sky V comes out rho * V. The sky is
     /// not drawn and not exported: the picture's background stays black.
+    ///
+    /// cie-overcast, cie-clear or cie:N (the CIE standard general sky of
+    /// type N, 1 to 15; cie-clear is type 12), optionally with ,Elx (the
+    /// sky's unobstructed horizontal illuminance) or ,Lcd (its zenith
+    /// luminance in cd/m²): a sky whose luminance varies over the dome as
+    /// the CIE defines it, above a ground of reflectance 0.2. Default
+    /// 10000 lx; cie-clear's default is gensky's zenith luminance for the
+    /// sun's altitude. Needs --units; all but cie-overcast, cie:1, cie:3
+    /// and cie:5 need --sun.
     #[arg(long, value_name = "VALUE", value_parser = parse_sky, allow_hyphen_values = true)]
     #[arg(help_heading = heading::LIGHT)]
-    pub(crate) sky: Option<Rgb>,
+    pub(crate) sky: Option<SkyArg>,
+
+    /// Where the sun is: AZIMUTH,ALTITUDE.
+    ///
+    /// Degrees clockwise from north (90 is east), degrees above the
+    /// horizon (0 to 90). Shapes the luminance of the standard skies that
+    /// depend on the sun (--sky cie-clear, cie:N); the sun's own direct
+    /// light is not added.
+    #[arg(long, value_name = "AZ,ALT", value_parser = parse_sun, allow_hyphen_values = true)]
+    #[arg(help_heading = heading::LIGHT)]
+    pub(crate) sun: Option<SunArg>,
+
+    /// Where true north is: DEG clockwise from the model's north.
+    ///
+    /// The model's north is -z when up is +y (+y when up is +z); up is the
+    /// camera's, snapped to an axis. Default 0.
+    #[arg(long, value_name = "DEG", value_parser = parse_north, allow_hyphen_values = true)]
+    #[arg(help_heading = heading::LIGHT)]
+    pub(crate) north: Option<f64>,
 
     /// Take the camera from this .sc file.
     ///
@@ -493,6 +521,18 @@ pub struct Args {
           allow_hyphen_values = true)]
     #[arg(help_heading = heading::PHOTOMETRY)]
     pub(crate) workplane: Option<(f32, Option<f32>)>,
+
+    /// Give the work plane's daylight factors under the overcast sky.
+    ///
+    /// DF = E_inside / E_outside: each --workplane point's illuminance over
+    /// the sky's unobstructed horizontal illuminance, in %. Prints the mean
+    /// and the minimum and the EN 17037 figures (the share of the plane at
+    /// DF >= 2 % and at DF >= 0.7 %), and writes PREFIX-df.png, the plan
+    /// in false colour with those two target lines. Needs --workplane and
+    /// --sky cie-overcast (or cie:1).
+    #[arg(long)]
+    #[arg(help_heading = heading::PHOTOMETRY)]
+    pub(crate) daylight_factor: bool,
 
     /// File name prefix of the --workplane results.
     ///

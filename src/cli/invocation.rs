@@ -9,13 +9,16 @@
 //! interval and thread count) are checked here.
 
 use super::args::Args;
+use super::values::SkyArg;
 use crate::budget::MemoryBudget;
 use crate::camera::{Camera, CameraOverride};
-use crate::config::{FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig};
+use crate::config::{
+    DaylightConfig, FalsecolorConfig, PhotometryConfig, RunConfig, SceneSource, WorkplaneConfig,
+};
 use crate::mesh::refine::{self, RefineOptions};
 use crate::mesh::{self, MeshError};
 use crate::render::{Exposure, MAX_EXPOSURE_STOPS};
-use crate::scene::Sides;
+use crate::scene::{Sides, SkyModel};
 use crate::solver::{Approximations, Heuristic, SolverOptions};
 use glam::Vec3;
 use std::num::NonZeroUsize;
@@ -109,6 +112,21 @@ pub enum UsageError {
         cores = std::thread::available_parallelism().map_or(1, |n| n.get())
     )]
     Threads(usize),
+    /// A standard sky cannot be made as asked (it needs `--sun`).
+    #[error("{0}")]
+    Daylight(#[from] crate::scene::DaylightError),
+    /// `--daylight-factor` without the overcast sky it is defined under.
+    #[error(
+        "--daylight-factor needs --sky cie-overcast (or cie:1): the daylight factor is \
+         defined under the CIE overcast sky"
+    )]
+    DaylightFactorSky,
+    /// `--sun` without a standard sky shaped by it.
+    #[error(
+        "--sun needs a standard sky that depends on the sun (--sky cie-clear or cie:N, \
+         N other than 1, 3, 5)"
+    )]
+    SunWithoutSky,
     /// `--falsecolor-max` is not a positive finite number.
     #[error("--falsecolor-max must be a positive number, got {0}")]
     FalsecolorMax(f64),
@@ -160,6 +178,7 @@ struct PhotometryArgs {
     illuminance_out: Option<std::path::PathBuf>,
     workplane: Option<(f32, Option<f32>)>,
     workplane_out: Option<std::path::PathBuf>,
+    daylight_factor: bool,
     falsecolor: Option<std::path::PathBuf>,
     falsecolor_of: crate::render::falsecolor::Quantity,
     falsecolor_scale: crate::render::falsecolor::Scale,
@@ -212,6 +231,7 @@ fn photometry(a: &PhotometryArgs) -> PhotometryConfig {
                 spacing,
                 csv: with(".csv"),
                 png: with(".png"),
+                daylight_factor: a.daylight_factor.then(|| with("-df.png")),
                 scale: a.falsecolor_scale,
                 max: a.falsecolor_max,
             }
@@ -281,11 +301,32 @@ impl TryFrom<Args> for Invocation {
             illuminance_out: args.illuminance_out.clone(),
             workplane: args.workplane,
             workplane_out: args.workplane_out.clone(),
+            daylight_factor: args.daylight_factor,
             falsecolor: args.falsecolor.clone(),
             falsecolor_of: args.falsecolor_of,
             falsecolor_scale: args.falsecolor_scale,
             falsecolor_max: args.falsecolor_max,
         };
+        let daylight = DaylightConfig {
+            sky: match args.sky {
+                Some(SkyArg::Standard(model, level)) => Some((model, level)),
+                _ => None,
+            },
+            sun: args.sun.map(|s| s.position),
+            north: args.north.unwrap_or(0.0).to_radians(),
+        };
+        if args.sun.is_some() && daylight.sky.is_none_or(|(m, _)| !m.needs_sun()) {
+            return Err(UsageError::SunWithoutSky);
+        }
+        daylight.resolve()?;
+        if args.daylight_factor
+            && !matches!(
+                daylight.sky,
+                Some((SkyModel::CieOvercast | SkyModel::Cie(1), _))
+            )
+        {
+            return Err(UsageError::DaylightFactorSky);
+        }
         let approximations = approximations(&args);
         let camera_override = camera_override(&args)?;
         let config = RunConfig {
@@ -339,8 +380,12 @@ impl TryFrom<Args> for Invocation {
                 (_, true) => Sides::Two,
                 (false, false) => Sides::AsLoaded,
             },
-            sky: args.sky,
+            sky: match args.sky {
+                Some(SkyArg::Uniform(rgb)) => Some(rgb),
+                _ => None,
+            },
             photometry: photometry(&args_photometry),
+            daylight,
         };
         let mode = if args.info {
             Mode::Info

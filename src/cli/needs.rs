@@ -88,6 +88,18 @@ pub const NEEDS: &[Need] = &[
         parent: "--falsecolor or --workplane",
         met: |a| a.falsecolor.is_some() || a.workplane.is_some(),
     },
+    Need {
+        id: "daylight_factor",
+        flag: "--daylight-factor",
+        parent: "--workplane",
+        met: |a| a.workplane.is_some(),
+    },
+    Need {
+        id: "north",
+        flag: "--north",
+        parent: "--sun",
+        met: |a| a.sun.is_some(),
+    },
 ];
 
 /// The message for the first option of [`NEEDS`] given on the command

@@ -4,7 +4,7 @@
 //! (exit code 2) naming the option.
 
 use crate::color::Rgb;
-use crate::scene::{MAX_COORDINATE, MAX_EMISSION};
+use crate::scene::{SkyLevel, SkyModel, SunPosition, MAX_COORDINATE, MAX_EMISSION};
 use crate::solver::hemicube::HemicubeRes;
 use crate::solver::ShooterSamples;
 
@@ -36,6 +36,26 @@ pub enum ValueError {
         max = MAX_EMISSION
     )]
     Sky(String),
+    /// `--sky cie-...` is not a standard sky `cie-overcast`, `cie-clear`
+    /// or `cie:N` (N from 1 to 15), optionally followed by `,VALUELX` (an
+    /// unobstructed horizontal illuminance) or `,VALUECD` (a zenith
+    /// luminance in cd/m²), the value finite and `> 0`.
+    #[error(
+        "--sky must name a standard sky like cie-overcast, cie-clear or cie:7 (types 1 to 15), \
+         optionally with its brightness as `,10000lx` (unobstructed horizontal illuminance) \
+         or `,3000cd` (zenith luminance in cd/m²), got `{0}`"
+    )]
+    StandardSky(String),
+    /// `--sun` is not `AZIMUTH,ALTITUDE`: degrees clockwise from north,
+    /// degrees above the horizon from 0 to 90.
+    #[error(
+        "--sun must look like 135,40 (azimuth in degrees clockwise from north, \
+         altitude in degrees from 0 to 90), got `{0}`"
+    )]
+    Sun(String),
+    /// `--north` is not a finite number of degrees.
+    #[error("--north must be a number of degrees (true north clockwise from the model's north), got `{0}`")]
+    North(String),
     /// `--hemicube-res` is not a whole number, or not one a hemicube can
     /// have ([`HemicubeRes::new`]).
     #[error("--hemicube-res must be an even whole number of pixels from {min} to {max}, got `{0}`",
@@ -275,11 +295,96 @@ pub fn parse_emit(text: &str) -> Result<(String, Rgb), ValueError> {
     Ok((name.to_string(), rgb))
 }
 
+/// What `--sky` asks for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SkyArg {
+    /// A uniform sky of this radiosity (scene units).
+    Uniform(Rgb),
+    /// A standard sky, at this level or the model's default.
+    Standard(SkyModel, Option<SkyLevel>),
+}
+
 /// Parses `--sky`: a radiosity in the scene's units, `V` (grey) or
 /// `R,G,B`, every channel finite, `>= 0` and at most [`MAX_EMISSION`],
-/// as the value of `--emit`.
-pub fn parse_sky(text: &str) -> Result<Rgb, ValueError> {
-    parse_radiosity(text).ok_or_else(|| ValueError::Sky(text.to_string()))
+/// as the value of `--emit`; or a standard sky (text starting `cie`):
+/// `cie-overcast`, `cie-clear` or `cie:N`, then optionally `,Elx` or
+/// `,Lcd` (case ignored).
+pub fn parse_sky(text: &str) -> Result<SkyArg, ValueError> {
+    if !text.trim_start().to_ascii_lowercase().starts_with("cie") {
+        return parse_radiosity(text)
+            .map(SkyArg::Uniform)
+            .ok_or_else(|| ValueError::Sky(text.to_string()));
+    }
+    let bad = || ValueError::StandardSky(text.to_string());
+    let lower = text.trim().to_ascii_lowercase();
+    let (name, value) = match lower.split_once(',') {
+        Some((n, v)) => (n.trim(), Some(v.trim())),
+        None => (lower.as_str(), None),
+    };
+    let model = match name {
+        "cie-overcast" => SkyModel::CieOvercast,
+        "cie-clear" => SkyModel::CLEAR,
+        _ => {
+            let n = name.strip_prefix("cie:").ok_or_else(bad)?;
+            SkyModel::Cie(n.trim().parse::<u8>().map_err(|_| bad())?)
+        }
+    };
+    if !model.is_valid() {
+        return Err(bad());
+    }
+    let level = match value {
+        None => None,
+        Some(v) => {
+            let (number, level): (&str, fn(f64) -> SkyLevel) = if let Some(n) = v.strip_suffix("lx")
+            {
+                (n, SkyLevel::Horizontal)
+            } else if let Some(n) = v.strip_suffix("cd") {
+                (n, SkyLevel::Zenith)
+            } else {
+                return Err(bad());
+            };
+            match number.trim().parse::<f64>() {
+                Ok(x) if x.is_finite() && x > 0.0 && x <= MAX_EMISSION => Some(level(x)),
+                _ => return Err(bad()),
+            }
+        }
+    };
+    Ok(SkyArg::Standard(model, level))
+}
+
+/// What `--sun` gives: the sun's position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunArg {
+    /// Where the sun is.
+    pub position: SunPosition,
+}
+
+/// Parses `--sun`: `AZIMUTH,ALTITUDE`, the azimuth in degrees clockwise
+/// from north (any finite number), the altitude in degrees from 0 to 90.
+pub fn parse_sun(text: &str) -> Result<SunArg, ValueError> {
+    let bad = || ValueError::Sun(text.to_string());
+    let numbers = text
+        .split(',')
+        .map(|c| c.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<Vec<f64>>>()
+        .ok_or_else(bad)?;
+    let [azimuth, altitude] = numbers[..] else {
+        return Err(bad());
+    };
+    if !(0.0..=90.0).contains(&altitude) || azimuth.abs() > 360.0 * 1e6 {
+        return Err(bad());
+    }
+    Ok(SunArg {
+        position: SunPosition::from_degrees(azimuth.rem_euclid(360.0), altitude),
+    })
+}
+
+/// Parses `--north`: degrees, finite (any sign, read modulo 360).
+pub fn parse_north(text: &str) -> Result<f64, ValueError> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x.abs() <= 360.0 * 1e6 => Ok(x.rem_euclid(360.0)),
+        _ => Err(ValueError::North(text.to_string())),
+    }
 }
 
 /// A radiosity `V` or `R,G,B` (spaces around channels allowed), every
@@ -391,9 +496,10 @@ mod tests {
 
     #[test]
     fn sky_is_a_grey_or_coloured_radiosity() {
-        assert_eq!(parse_sky("1"), Ok(Rgb::splat(1.0)));
-        assert_eq!(parse_sky("0.8, 0.9,1.2"), Ok(Rgb::new(0.8, 0.9, 1.2)));
-        assert_eq!(parse_sky("0"), Ok(Rgb::BLACK));
+        let uniform = |rgb| Ok(SkyArg::Uniform(rgb));
+        assert_eq!(parse_sky("1"), uniform(Rgb::splat(1.0)));
+        assert_eq!(parse_sky("0.8, 0.9,1.2"), uniform(Rgb::new(0.8, 0.9, 1.2)));
+        assert_eq!(parse_sky("0"), uniform(Rgb::BLACK));
         for bad in ["", "-1", "a", "1,2", "1,2,3,4", "nan", "inf", "1e21", "x=1"] {
             assert_eq!(parse_sky(bad), Err(ValueError::Sky(bad.into())), "{bad}");
         }
@@ -402,6 +508,67 @@ mod tests {
             "--sky must look like 1 or 0.8,0.9,1.2 (a radiosity per channel, \
              from 0 to 1e20), got `-1`"
         );
+    }
+
+    #[test]
+    fn standard_skies_name_a_model_and_maybe_a_level() {
+        use SkyLevel::{Horizontal, Zenith};
+        let ok = |m, l| Ok(SkyArg::Standard(m, l));
+        assert_eq!(parse_sky("cie-overcast"), ok(SkyModel::CieOvercast, None));
+        assert_eq!(
+            parse_sky("CIE-Overcast, 10000lx"),
+            ok(SkyModel::CieOvercast, Some(Horizontal(10_000.0)))
+        );
+        assert_eq!(
+            parse_sky("cie-clear,8000cd"),
+            ok(SkyModel::CLEAR, Some(Zenith(8000.0)))
+        );
+        assert_eq!(parse_sky("cie:7"), ok(SkyModel::Cie(7), None));
+        assert_eq!(
+            parse_sky("cie:15,2e4lx"),
+            ok(SkyModel::Cie(15), Some(Horizontal(2e4)))
+        );
+        for bad in [
+            "cie",
+            "cie-sunny",
+            "cie:0",
+            "cie:16",
+            "cie:x",
+            "cie-overcast,10000",
+            "cie-clear,0lx",
+            "cie-clear,-5cd",
+            "cie-clear,nanlx",
+            "cie:3,1e21lx",
+            "cie-overcast,",
+        ] {
+            assert_eq!(
+                parse_sky(bad),
+                Err(ValueError::StandardSky(bad.into())),
+                "{bad}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_sun_is_an_azimuth_and_an_altitude() {
+        let sun = parse_sun("135, 40").unwrap();
+        assert_eq!(sun.position, SunPosition::from_degrees(135.0, 40.0));
+        let sun = parse_sun("-90,90").unwrap();
+        assert_eq!(sun.position, SunPosition::from_degrees(270.0, 90.0));
+        for bad in [
+            "",
+            "135",
+            "135,-1",
+            "135,91",
+            "135,40,80000",
+            "135,40,1,2",
+            "a,b",
+            "inf,3",
+        ] {
+            assert_eq!(parse_sun(bad), Err(ValueError::Sun(bad.into())), "{bad}");
+        }
+        assert_eq!(parse_north("-30"), Ok(330.0));
+        assert_eq!(parse_north("x"), Err(ValueError::North("x".into())));
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! Writing results to files: pictures (png, tiff, exr, pfm, hdr), the solved
 //! mesh (glb, ply), the convergence log and plot, illuminance at points and
-//! over work planes (CSV, plan), and the atomic-write helper every output
+//! over work planes (CSV, plan), daylight factors, and the atomic-write helper every output
 //! shares.
 //!
 //! Every file is written to a temporary file in its destination directory
@@ -20,6 +20,7 @@
 //! the operating system or an encoder failed, says why in the same message.
 
 pub mod convergence;
+pub mod daylight_factor;
 pub mod illuminance;
 pub mod image;
 pub mod mesh_export;

@@ -37,6 +37,11 @@ pub use import::sc::{
     load_camera, load_camera_into, parse_bytes, parse_camera_str, parse_str, KEYWORDS, MAX_EMISSION,
 };
 pub use import::{load, load_with};
+pub use lighting::daylight::{
+    DaylightError, DaylightSky, HorizonFrame, SkyLevel, SkyLight, SkyModel, SunPosition,
+    CLEAR_TURBIDITY, DAYLIGHT_RADIUS_FACTOR, DEFAULT_HORIZONTAL_LUX, FACET_SPLITS,
+    GROUND_REFLECTANCE,
+};
 pub use lighting::emit::{
     looks_like_lamp, Group, GroupKind, UnknownName, LAMP_SUBSTRINGS, LAMP_WORDS, MAX_LISTED_NAMES,
 };

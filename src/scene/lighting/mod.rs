@@ -2,9 +2,12 @@
 //! emit ([`Scene::set_emission`](crate::scene::Scene::set_emission)), the
 //! luminaires an `--ies` file shapes
 //! ([`Scene::set_luminaire`](crate::scene::Scene::set_luminaire)), the
-//! `--sky` enclosure ([`Scene::add_sky`](crate::scene::Scene::add_sky)) and
+//! `--sky` enclosure ([`Scene::add_sky`](crate::scene::Scene::add_sky)), the
+//! standard skies of daylighting
+//! ([`Scene::add_daylight_sky`](crate::scene::Scene::add_daylight_sky)) and
 //! the units that turn a luminous intensity into the scene's radiosity.
 
+pub(super) mod daylight;
 pub(super) mod emit;
 pub(super) mod luminaire;
 pub(super) mod sky;

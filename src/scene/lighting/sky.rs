@@ -57,16 +57,35 @@ impl Scene {
     /// [`MAX_COORDINATE`](crate::scene::MAX_COORDINATE) (a scene within a tenth of
     /// that limit).
     pub fn add_sky(&mut self, radiosity: Rgb) -> Result<(), PolygonError> {
+        let triangles = geodesic_sphere(SKY_SUBDIVISIONS);
+        let emissions = vec![radiosity];
+        self.add_enclosure(triangles, emissions, SKY_RADIUS_FACTOR)
+    }
+
+    /// Adds the enclosure of the unit triangles `triangles` (each facing
+    /// the centre), centred as the module docs say, `radius_factor` times
+    /// the scene's half-diagonal in radius, appended
+    /// after every other polygon with [`Surface::sky`] set: one material
+    /// named [`SKY_MATERIAL_NAME`] a facet emitting `emissions[i]`, or one
+    /// for all when `emissions` holds a single value.
+    pub(super) fn add_enclosure(
+        &mut self,
+        triangles: Vec<[DVec3; 3]>,
+        emissions: Vec<Rgb>,
+        radius_factor: f32,
+    ) -> Result<(), PolygonError> {
         let (lo, hi) = self.bounds();
         let centre = ((lo + hi) * 0.5).as_dvec3();
         let half_diagonal = match (hi - lo).length() * 0.5 {
             h if h > 0.0 => h,
             _ => EMPTY_SCENE_HALF_DIAGONAL,
         };
-        let radius = f64::from(half_diagonal * SKY_RADIUS_FACTOR);
-        let material = MaterialId(self.materials.len() as u32);
+        let radius = f64::from(half_diagonal * radius_factor);
+        let first = self.materials.len() as u32;
+        let shared = emissions.len() == 1;
         let mut facets = Vec::new();
-        for [a, b, c] in geodesic_sphere(SKY_SUBDIVISIONS) {
+        for (i, [a, b, c]) in triangles.into_iter().enumerate() {
+            let material = MaterialId(first + if shared { 0 } else { i as u32 });
             let corners = [a, b, c].map(|v| (centre + v * radius).as_vec3());
             let mut polygon = Polygon::new(material, corners.to_vec(), SourcePos::default())?;
             polygon.surface = Surface {
@@ -75,21 +94,34 @@ impl Scene {
             };
             facets.push(polygon);
         }
-        self.materials.push(Material {
-            name: SKY_MATERIAL_NAME.to_string(),
-            color: radiosity,
-            k_diffrefl: 0.0,
-            k_emission: 1.0,
-        });
+        for radiosity in emissions {
+            self.materials.push(Material {
+                name: SKY_MATERIAL_NAME.to_string(),
+                color: radiosity,
+                k_diffrefl: 0.0,
+                k_emission: 1.0,
+            });
+        }
         self.polygons.extend(facets);
         Ok(())
     }
 
-    /// The radiosity of the sky [`Scene::add_sky`] added, or `None` when
-    /// the scene has none.
+    /// The radiosity of the sky [`Scene::add_sky`] added, or for a sky
+    /// whose facets differ ([`Scene::add_daylight_sky`]) their mean
+    /// weighted by area; `None` when the scene has none.
     pub fn sky(&self) -> Option<Rgb> {
-        let facet = self.polygons.iter().find(|p| p.surface.sky)?;
-        Some(self.materials.get(facet.material.index())?.emission())
+        let mut facets = self.polygons.iter().filter(|p| p.surface.sky);
+        let first = facets.next()?;
+        let emission = |p: &Polygon| self.materials.get(p.material.index()).map(|m| m.emission());
+        if facets.all(|p| p.material == first.material) {
+            return emission(first);
+        }
+        let (mut sum, mut area) = (Rgb::BLACK, 0.0);
+        for p in self.polygons.iter().filter(|p| p.surface.sky) {
+            sum += emission(p)? * p.area;
+            area += p.area;
+        }
+        (area > 0.0).then(|| sum / area)
     }
 }
 
@@ -97,7 +129,7 @@ impl Scene {
 /// triangle split in four `subdivisions` times, new vertices pushed out to
 /// the sphere. Each triangle is counter-clockwise seen from the centre, so
 /// its front faces inward. `20 · 4^subdivisions` triangles.
-fn geodesic_sphere(subdivisions: u32) -> Vec<[DVec3; 3]> {
+pub(super) fn geodesic_sphere(subdivisions: u32) -> Vec<[DVec3; 3]> {
     let phi = (1.0 + 5f64.sqrt()) / 2.0;
     let v: Vec<DVec3> = [
         (-1.0, phi, 0.0),

@@ -19,8 +19,7 @@ pub(super) mod unreached;
 
 use crate::budget::{MemoryBudget, OverBudget};
 use crate::cancel::{Cancel, Cancelled};
-use crate::color::Rgb;
-use crate::scene::{PolygonError, PolygonId, Scene, Sides, SplitStats, SplitStop};
+use crate::scene::{PolygonError, PolygonId, Scene, Sides, SkyLight, SplitStats, SplitStop};
 use glam::Vec3;
 
 /// What the repair passes are told: the choices of the command line that
@@ -29,9 +28,9 @@ use glam::Vec3;
 pub struct RepairOptions<'a> {
     /// Which faces are two-sided (`--sides`).
     pub sides: Sides,
-    /// The radiosity of the `--sky` enclosure, in the scene's units, when
-    /// one is asked for (see [`Scene::add_sky`]).
-    pub sky: Option<Rgb>,
+    /// The `--sky` enclosure, when one is asked for (see
+    /// [`Scene::add_sky_light`]).
+    pub sky: Option<SkyLight>,
     /// The scene's name as the warnings give it.
     pub file: &'a str,
     /// The memory the repaired scene may take: the splitting along
@@ -153,8 +152,8 @@ pub fn run_cancellable<R: FirstHit + Sync>(
     scene.light_luminaire_backs();
     // Last, after everything that adds or changes polygons, so that the
     // enclosure is built around the finished scene.
-    if let Some(sky) = options.sky {
-        scene.add_sky(sky)?;
+    if let Some(sky) = &options.sky {
+        scene.add_sky_light(sky)?;
     }
     // An emitting face with two sides, one just under a ceiling, emits
     // from the other only. Rays find the gap, so they are cast on the
