@@ -907,8 +907,8 @@ pub fn summary(stats: &RunStats) -> String {
         return format!("{}: nothing emits, nothing solved → {written}", stats.scene);
     }
     let sky = match stats.sky {
-        Some([r, g, b]) if r == g && g == b => format!(" under a sky of {r}"),
-        Some([r, g, b]) => format!(" under a sky of {r},{g},{b}"),
+        Some([r, g, b]) if r == g && g == b => format!(" under a sky of {}", short(r)),
+        Some([r, g, b]) => format!(" under a sky of {},{},{}", short(r), short(g), short(b)),
         None => String::new(),
     };
     format!(
@@ -1003,5 +1003,36 @@ mod tests {
             "interrupted after 3 steps; wrote a.png; saved the checkpoint c.ckpt: \
              resume with --resume c.ckpt"
         );
+    }
+}
+
+/// `x` to four significant digits, without trailing zeros (`1`, `0.6667`,
+/// `5438`), for the lines a person reads; files keep every digit.
+pub(crate) fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i32;
+    let decimals = (3 - magnitude).clamp(0, 17) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+#[cfg(test)]
+mod short_tests {
+    use super::short;
+
+    #[test]
+    fn numbers_read_to_four_significant_digits() {
+        assert_eq!(short(1.0), "1");
+        assert_eq!(short(5438.146010915304), "5438");
+        assert_eq!(short(0.6666667), "0.6667");
+        assert_eq!(short(0.25), "0.25");
+        assert_eq!(short(123456.0), "123456");
+        assert_eq!(short(0.0), "0");
     }
 }

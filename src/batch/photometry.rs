@@ -111,7 +111,7 @@ pub(super) fn write(
             "work plane of {} × {} points {} apart: {:.2} s",
             grid.nx,
             grid.ny,
-            grid.spacing,
+            super::short(f64::from(grid.spacing)),
             t.elapsed().as_secs_f64()
         ));
         let (scale, max) = (w.scale, w.max);
