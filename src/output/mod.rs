@@ -22,6 +22,7 @@
 pub mod convergence;
 pub mod illuminance;
 pub mod image;
+pub mod lightmap;
 pub mod mesh_export;
 
 pub use self::image::{
