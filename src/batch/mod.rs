@@ -383,6 +383,10 @@ pub fn run_prepared(
     // The points are read once, here: a file given as a pipe has no
     // second reading.
     let points = photometry::check(config, prepared)?;
+    if let (true, Some(d)) = (config.wants_lightmap(), config.lightmap_density) {
+        output::lightmap::uv::check_scene_density(&prepared.scene, d)
+            .map_err(|why| RunError::Options(format!("cannot bake the lightmap: {why}")))?;
+    }
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.

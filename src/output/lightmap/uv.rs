@@ -58,15 +58,7 @@ pub fn lay_out(model: &mut SourceModel, density: Option<f32>) -> Result<Layout, 
         return Ok(own_layout(area, density));
     }
     if let Some(d) = density {
-        let side = (area * f64::from(d) * f64::from(d) / EXPECTED_UTILISATION).sqrt();
-        if side > f64::from(MAX_SIDE) {
-            return Err(format!(
-                "--lightmap-density {d} texels per unit would need a texture of about {side:.0} \
-                 texels a side for this model ({area:.4} square units of surface); the largest \
-                 is {MAX_SIDE}: give at most {:.3}",
-                f64::from(MAX_SIDE) * EXPECTED_UTILISATION.sqrt() / area.sqrt()
-            ));
-        }
+        check_density(area, d)?;
     }
     let density_option = match density {
         Some(d) => uvunwrap::Density::Fixed {
@@ -112,6 +104,35 @@ pub fn lay_out(model: &mut SourceModel, density: Option<f32>) -> Result<Layout, 
         charts: atlas.chart_count,
         generated: true,
     })
+}
+
+/// Refuses a density `d` (texels per unit) at which `area` square units
+/// of surface would not fit a texture of [`MAX_SIDE`], at the utilisation
+/// the packer usually reaches: said before solving
+/// ([`check_scene_density`]) and again once the model is known.
+pub fn check_density(area: f64, d: f32) -> Result<(), String> {
+    let side = (area * f64::from(d) * f64::from(d) / EXPECTED_UTILISATION).sqrt();
+    if side > f64::from(MAX_SIDE) {
+        return Err(format!(
+            "--lightmap-density {d} texels per unit would need a texture of about {side:.0} \
+             texels a side for this model ({area:.4} square units of surface); the largest \
+             is {MAX_SIDE}: give at most {:.4}",
+            f64::from(MAX_SIDE) * EXPECTED_UTILISATION.sqrt() / area.sqrt()
+        ));
+    }
+    Ok(())
+}
+
+/// [`check_density`] over the scene's polygons (the sky's left out), for
+/// a run to refuse a density before it solves.
+pub fn check_scene_density(scene: &crate::scene::Scene, d: f32) -> Result<(), String> {
+    let area: f64 = scene
+        .polygons
+        .iter()
+        .filter(|p| !p.surface.sky)
+        .map(|p| p.area)
+        .sum();
+    check_density(area, d)
 }
 
 /// The layout of a model that has its own `TEXCOORD_1`: a square texture
