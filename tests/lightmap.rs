@@ -36,6 +36,9 @@ usemtl Lamp
 f 10 9 8 7
 ";
 
+/// A triangle of the model: its corners' positions and lightmap UVs.
+type Triangle = ([[f32; 3]; 3], [[f32; 2]; 3]);
+
 /// A `.glb` read back: its JSON and binary chunk.
 struct Glb {
     json: Value,
@@ -93,7 +96,7 @@ impl Glb {
     }
 
     /// Every triangle of every primitive: positions and TEXCOORD_1.
-    fn triangles(&self) -> Vec<([[f32; 3]; 3], [[f32; 2]; 3])> {
+    fn triangles(&self) -> Vec<Triangle> {
         let mut out = Vec::new();
         for mesh in self.json["meshes"].as_array().unwrap() {
             for p in mesh["primitives"].as_array().unwrap() {
