@@ -387,3 +387,128 @@ fn bad_lightmap_options_are_refused_with_exit_code_2() {
         stderr(&out)
     );
 }
+
+/// A glTF file of one quad (two indexed triangles) with normals,
+/// `TEXCOORD_0` and a base colour texture (`png`), drawn by a node moved
+/// by `(10, 0, 0)`; everything in `data:` URIs.
+fn textured_quad_gltf(png: &[u8]) -> String {
+    use base64::Engine as _;
+    let b64 = |bytes: &[u8]| base64::engine::general_purpose::STANDARD.encode(bytes);
+    let positions: [[f32; 3]; 4] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 0.0, -1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let normals = [[0.0f32, 1.0, 0.0]; 4];
+    let uv0: [[f32; 2]; 4] = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+    let indices: [u32; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bin = Vec::new();
+    for v in positions
+        .iter()
+        .flatten()
+        .chain(normals.iter().flatten())
+        .chain(uv0.iter().flatten())
+    {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    for i in indices {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"name": "Tile", "mesh": 0, "translation": [10.0, 0.0, 0.0]}],
+        "meshes": [{"primitives": [{
+            "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
+            "indices": 3, "material": 0}]}],
+        "materials": [{"name": "Checker", "doubleSided": false,
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9728}],
+        "images": [{"uri": format!("data:image/png;base64,{}", b64(png))}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [0.0, 0.0, -1.0], "max": [1.0, 0.0, 0.0]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5125, "count": 6, "type": "SCALAR"},
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 96, "byteLength": 32},
+            {"buffer": 0, "byteOffset": 128, "byteLength": 24},
+        ],
+        "buffers": [{"byteLength": bin.len(),
+                     "uri": format!("data:application/octet-stream;base64,{}", b64(&bin))}],
+    })
+    .to_string()
+}
+
+#[test]
+fn a_gltf_model_keeps_its_texture_coordinates_and_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut png = Vec::new();
+    image::RgbImage::from_fn(2, 2, |x, y| {
+        image::Rgb(if (x + y) % 2 == 0 {
+            [200, 40, 40]
+        } else {
+            [40, 40, 200]
+        })
+    })
+    .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+    .unwrap();
+    write(dir.path(), "tile.gltf", &textured_quad_gltf(&png));
+    let out = run_in(
+        dir.path(),
+        &[
+            "tile.gltf",
+            "--sky",
+            "1",
+            "-o",
+            "tile.png",
+            "--lightmap",
+            "tile.glb",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let glb = Glb::read(&dir.path().join("tile.glb"));
+    assert_eq!(glb.json["nodes"][0]["name"], "Tile");
+    let material = &glb.json["materials"][0];
+    assert_eq!(material["name"], "Checker");
+    // The base colour texture is the file's image, byte for byte, with its
+    // sampler.
+    let texture = material["pbrMetallicRoughness"]["baseColorTexture"]["index"]
+        .as_u64()
+        .unwrap();
+    let texture = &glb.json["textures"][texture as usize];
+    assert_eq!(
+        glb.json["samplers"][texture["sampler"].as_u64().unwrap() as usize]["magFilter"],
+        9728
+    );
+    let image = &glb.json["images"][texture["source"].as_u64().unwrap() as usize];
+    assert_eq!(
+        glb.view(image["bufferView"].as_u64().unwrap() as usize),
+        &png[..]
+    );
+    // Every vertex keeps its own position (moved by its node), normal and
+    // TEXCOORD_0, whatever the lightmap's seams split.
+    let p = &glb.json["meshes"][0]["primitives"][0];
+    let pos = glb.floats(p["attributes"]["POSITION"].as_u64().unwrap());
+    let nor = glb.floats(p["attributes"]["NORMAL"].as_u64().unwrap());
+    let uv0 = glb.floats(p["attributes"]["TEXCOORD_0"].as_u64().unwrap());
+    assert_eq!(glb.floats(p["indices"].as_u64().unwrap()).len(), 6);
+    for k in 0..pos.len() / 3 {
+        let (x, z) = (pos[3 * k], pos[3 * k + 2]);
+        assert_eq!(&nor[3 * k..3 * k + 3], &[0.0, 1.0, 0.0]);
+        // The file's UVs are u = x, v = 1 + z in the quad's own frame.
+        assert_eq!(
+            [uv0[2 * k], uv0[2 * k + 1]],
+            [x - 10.0, 1.0 + z],
+            "vertex {k}"
+        );
+    }
+}
