@@ -363,7 +363,7 @@ pub struct Args {
     ///
     /// Default: the highest density whose charts fit one 2048x2048
     /// texture (printed). The texture may be at most 4096 texels a side.
-    #[arg(long, value_name = "TEXELS_PER_UNIT", value_parser = parse_lightmap_density)]
+    #[arg(long, value_name = "D", value_parser = parse_lightmap_density)]
     #[arg(help_heading = heading::OUTPUT)]
     pub(crate) lightmap_density: Option<f32>,
 
