@@ -27,7 +27,7 @@ pub const PROBE_TOLERANCE: f32 = 1e-4;
 
 /// Surfaces in front of a point, nearer than [`PROBE_OFFSET`], that a
 /// probe steps past before it gives up on the point.
-const PROBE_STEPS: usize = 3;
+pub const PROBE_STEPS: usize = 3;
 
 /// Barycentric slack for a point on an element triangle's edge, which
 /// rounding may put a hair outside.
