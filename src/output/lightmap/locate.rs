@@ -70,7 +70,10 @@ impl<'a> Locator<'a> {
         shown: &'a [Rgb],
         radiosity: &'a [Rgb],
     ) -> Self {
-        let (lo, hi) = scene.polygons.iter().flat_map(|p| &p.vertices).fold(
+        // The model's size, not the sky's: the sky's facets enclose the
+        // scene far off, and would make the probes start centimetres out.
+        let model = scene.polygons.iter().filter(|p| !p.surface.sky);
+        let (lo, hi) = model.flat_map(|p| &p.vertices).fold(
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), &v| (lo.min(v), hi.max(v)),
         );

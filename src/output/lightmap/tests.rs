@@ -300,3 +300,43 @@ fn chebyshev_to_triangle(p: Vec2, t: &[Vec2; 3]) -> f32 {
         .map(|c| (*c - p).abs().max_element())
         .fold(nearest, f32::min)
 }
+
+#[test]
+fn probes_are_sized_by_the_model_not_by_the_sky_around_it() {
+    // The floor, a slab 5 cm above part of it (a table top's underside),
+    // and a sky facet 1000 units away: probes start a thousandth of the
+    // model's diagonal above the floor, below the slab.
+    let mut polygons = floor_scene().polygons;
+    polygons.push(polygon(
+        0,
+        &[
+            [0.0, 0.05, -0.5],
+            [1.0, 0.05, -0.5],
+            [1.0, 0.05, 0.5],
+            [0.0, 0.05, 0.5],
+        ],
+    ));
+    let mut sky = polygon(
+        0,
+        &[
+            [-1000.0, 1000.0, -1000.0],
+            [1000.0, 1000.0, -1000.0],
+            [1000.0, 1000.0, 1000.0],
+        ],
+    );
+    sky.surface.sky = true;
+    polygons.push(sky);
+    let s = scene(polygons, vec![grey("floor", 0.0, 0.5)]);
+    let (mesh, radiosity) = linear_solution(&s, 0.25);
+    let visibility = Visibility::new(&s);
+    let locator = Locator::new(&s, &mesh, &visibility, &radiosity, &radiosity);
+    for x in [0.1f32, 0.5, 0.9] {
+        let p = Vec3::new(x, 0.0, 0.1);
+        let sample = locator
+            .sample(p, Vec3::Y)
+            .expect("the floor under the slab");
+        assert_eq!(sample.polygon.index(), 0);
+        let want = light_at(p);
+        assert!((sample.radiosity.r - want).abs() < 1e-4 * want, "{x}");
+    }
+}
