@@ -91,6 +91,14 @@ pub struct RunConfig {
     pub camera_override: crate::camera::CameraOverride,
     /// Where to write the solved mesh (`.glb` or `.ply`), if anywhere.
     pub export: Option<PathBuf>,
+    /// Where to write the model with its baked lightmap (`.glb`), if
+    /// anywhere ([`crate::output::lightmap`]).
+    pub lightmap: Option<PathBuf>,
+    /// Where to write the bare lightmap texture (`.png` or `.exr`), if
+    /// anywhere.
+    pub lightmap_texture: Option<PathBuf>,
+    /// Lightmap texels per scene unit (`> 0`); `None` for the default.
+    pub lightmap_density: Option<f32>,
     /// Where to write the per-step CSV log, if anywhere.
     pub log: Option<PathBuf>,
     /// Where to write the convergence plot (`.png`), if anywhere.
@@ -248,6 +256,9 @@ impl RunConfig {
             camera: None,
             camera_override: crate::camera::CameraOverride::default(),
             export: None,
+            lightmap: None,
+            lightmap_texture: None,
+            lightmap_density: None,
             log: None,
             plot: None,
             max_elements: DEFAULT_MAX_ELEMENTS,
@@ -297,10 +308,17 @@ impl RunConfig {
     /// window should open.
     pub fn wants_batch_outputs(&self) -> bool {
         self.export.is_some()
+            || self.wants_lightmap()
             || self.log.is_some()
             || self.plot.is_some()
             || self.mesh_lines
             || self.wants_photometry()
+    }
+
+    /// True when the run bakes a lightmap (`--lightmap` or
+    /// `--lightmap-texture`).
+    pub fn wants_lightmap(&self) -> bool {
+        self.lightmap.is_some() || self.lightmap_texture.is_some()
     }
 
     /// Every file the batch run writes besides the picture.
@@ -308,6 +326,8 @@ impl RunConfig {
         [
             &self.stats,
             &self.export,
+            &self.lightmap,
+            &self.lightmap_texture,
             &self.log,
             &self.plot,
             &self.checkpoint,

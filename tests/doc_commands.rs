@@ -134,9 +134,11 @@ fn strip_comment(line: &str) -> &str {
 }
 
 /// Options whose value is a file the command writes.
-const OUTPUT_OPTIONS: [&str; 8] = [
+const OUTPUT_OPTIONS: [&str; 10] = [
     "-o",
     "--export",
+    "--lightmap",
+    "--lightmap-texture",
     "--log",
     "--plot",
     "--stats",

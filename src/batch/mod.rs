@@ -40,7 +40,7 @@ pub use checkpoint::CheckpointError;
 pub use outputs::{check_outputs, check_outputs_against};
 
 use crate::cancel::{Cancel, Cancelled};
-use crate::config::RunConfig;
+use crate::config::{RunConfig, SceneSource};
 use crate::mesh::MeshRef;
 use crate::output::convergence::{self, StepRecord};
 use crate::output::{self, OutputError};
@@ -383,6 +383,10 @@ pub fn run_prepared(
     // The points are read once, here: a file given as a pipe has no
     // second reading.
     let points = photometry::check(config, prepared)?;
+    if let (true, Some(d)) = (config.wants_lightmap(), config.lightmap_density) {
+        output::lightmap::uv::check_scene_density(&prepared.scene, d)
+            .map_err(|why| RunError::Options(format!("cannot bake the lightmap: {why}")))?;
+    }
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
@@ -620,6 +624,10 @@ impl Results<'_, '_> {
             .map_err(RunError::Write)?;
             written.push(path);
         }
+        if config.wants_lightmap() {
+            cancel.check()?;
+            write_lightmap(config, prepared, solved, exposure, written)?;
+        }
         if let Some(path) = &config.log {
             cancel.check()?;
             convergence::write_log_file(path, &solved.records).map_err(RunError::Write)?;
@@ -644,6 +652,92 @@ impl Results<'_, '_> {
         )?;
         Ok(())
     }
+}
+
+/// Bakes the lightmap of the scene's model from the solution and writes
+/// what `config` asks for (`--lightmap`, `--lightmap-texture`), saying its
+/// size, density and time in one line unless quiet.
+fn write_lightmap(
+    config: &RunConfig,
+    prepared: &Prepared,
+    solved: &Solved<'_>,
+    exposure: f32,
+    written: &mut Written,
+) -> Result<(), RunError> {
+    use output::lightmap;
+    let t = Instant::now();
+    let model = match &config.scene {
+        SceneSource::File(path) if is_gltf(path) => {
+            let model =
+                crate::scene::import::gltf::source::load_gltf_source(path, &prepared.inputs)
+                    .map_err(|e| RunError::Prepare(PrepareError::Load(e)))?;
+            if let Some(why) = &model.textures_dropped {
+                eprintln!(
+                    "{}: warning: the lightmap's model has no textures: {why}",
+                    path.display()
+                );
+            }
+            model
+        }
+        _ => lightmap::model::scene_model(&prepared.scene, &config.scene.stem()),
+    };
+    let mesh: &crate::mesh::Mesh = &solved.mesh;
+    let baked = lightmap::bake(
+        model,
+        &prepared.scene,
+        mesh,
+        prepared.visibility(),
+        &solved.shown,
+        &solved.radiosity,
+        config.lightmap_density,
+    )
+    .map_err(|why| RunError::Options(format!("cannot bake the lightmap: {why}")))?;
+    let layout = &baked.layout;
+    if config.progress {
+        let how = match (layout.generated, config.lightmap_density) {
+            (false, _) => "the model's own TEXCOORD_1".to_string(),
+            (true, Some(_)) => format!("{} charts at --lightmap-density", layout.charts),
+            (true, None) => format!(
+                "{} charts, the highest density that fits {side}x{side}; \
+                 --lightmap-density sets it",
+                layout.charts,
+                side = lightmap::uv::DEFAULT_SIDE
+            ),
+        };
+        eprintln!(
+            "lightmap: {}x{} texels, {:.4} texels per unit ({how}), baked in {:.1} s",
+            layout.width,
+            layout.height,
+            layout.texels_per_unit,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    if baked.texture.unmatched > 0 {
+        // Said whatever `-q` says: the texture has holes the user should
+        // know of.
+        eprintln!(
+            "warning: lightmap: {} texel(s) stand for points of the model on no solved \
+             surface (a face dropped on loading?); they are filled from their neighbours",
+            baked.texture.unmatched
+        );
+    }
+    if let Some(path) = &config.lightmap {
+        lightmap::write_glb(path, &baked, exposure, &config.scene.stem())
+            .map_err(RunError::Write)?;
+        written.push(path);
+    }
+    if let Some(path) = &config.lightmap_texture {
+        lightmap::write_texture(path, &baked, exposure).map_err(RunError::Write)?;
+        written.push(path);
+    }
+    Ok(())
+}
+
+/// True when `path` names a glTF file (`.gltf` or `.glb`).
+fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .is_some_and(|e| e == "gltf" || e == "glb")
 }
 
 /// Draws and writes the convergence plot of `records` to `path`; the

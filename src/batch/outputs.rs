@@ -34,6 +34,19 @@ pub fn check_outputs(config: &RunConfig) -> Result<(), RunError> {
     if let Some(export) = &config.export {
         MeshFormat::from_path(export).map_err(RunError::BadOutput)?;
     }
+    if let Some(path) = &config.lightmap {
+        output::lightmap::check_glb_path(path).map_err(RunError::BadOutput)?;
+    }
+    if let Some(path) = &config.lightmap_texture {
+        output::lightmap::check_texture_path(path).map_err(RunError::BadOutput)?;
+    }
+    if config.lightmap_density.is_some() && !config.wants_lightmap() {
+        return Err(RunError::Options(
+            "--lightmap-density sets the density of a lightmap: give --lightmap FILE.glb or \
+             --lightmap-texture FILE too"
+                .into(),
+        ));
+    }
     if let Some(plot) = &config.plot {
         convergence::check_plot_path(plot).map_err(RunError::BadOutput)?;
     }
@@ -100,6 +113,8 @@ pub fn named_outputs(config: &RunConfig) -> Vec<(&'static str, PathBuf)> {
     let optional = [
         ("--stats", &config.stats),
         ("--export", &config.export),
+        ("--lightmap", &config.lightmap),
+        ("--lightmap-texture", &config.lightmap_texture),
         ("--log", &config.log),
         ("--plot", &config.plot),
         ("--checkpoint", &config.checkpoint),
@@ -122,7 +137,8 @@ pub fn named_outputs(config: &RunConfig) -> Vec<(&'static str, PathBuf)> {
 }
 
 /// Every option that names an output, for messages.
-const OUTPUT_OPTIONS: &str = "the picture (-o), --stats, --export, --log, --plot, --checkpoint, \
+const OUTPUT_OPTIONS: &str = "the picture (-o), --stats, --export, --lightmap, \
+                              --lightmap-texture, --log, --plot, --checkpoint, \
                               --illuminance-out, --workplane-out and --falsecolor";
 
 /// Refuses any output of `config` that is no regular file (a directory,

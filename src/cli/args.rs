@@ -363,6 +363,38 @@ pub struct Args {
     #[arg(help_heading = heading::OUTPUT)]
     pub(crate) export: Option<PathBuf>,
 
+    /// Write the model with its baked light as a lightmap (.glb).
+    ///
+    /// The scene's own model (a glTF's primitives, normals, TEXCOORD_0 and
+    /// materials; an OBJ's faces), not the element mesh, with a second UV
+    /// set (TEXCOORD_1: the model's own, else made by chart packing) and
+    /// the lightmap embedded as every material's emissiveTexture: the
+    /// radiosity tone-mapped as the picture is, so three.js, Blender and
+    /// Godot show the picture's light with no extra code. Runs in batch
+    /// mode, as -o does.
+    #[arg(long, value_name = "FILE.glb")]
+    #[arg(help_heading = heading::OUTPUT)]
+    pub(crate) lightmap: Option<PathBuf>,
+
+    /// Write the bare lightmap texture (.png or .exr).
+    ///
+    /// .png: the 8-bit emissive texture --lightmap embeds. .exr: the
+    /// irradiance (light arriving: (radiosity - emission) / reflectance),
+    /// linear 32-bit float in the scene's radiosity units, for engines
+    /// that multiply a lightmap by their own albedo. Same UVs as
+    /// --lightmap. Runs in batch mode, as -o does.
+    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = heading::OUTPUT)]
+    pub(crate) lightmap_texture: Option<PathBuf>,
+
+    /// Lightmap texels per scene unit of length.
+    ///
+    /// Default: the highest density whose charts fit one 2048x2048
+    /// texture (printed). The texture may be at most 4096 texels a side.
+    #[arg(long, value_name = "D", value_parser = parse_lightmap_density)]
+    #[arg(help_heading = heading::OUTPUT)]
+    pub(crate) lightmap_density: Option<f32>,
+
     /// Write one CSV row per shooting step.
     ///
     /// Columns: step, shooter, unshot fraction, rays, seconds. Runs in batch
@@ -607,7 +639,7 @@ pub struct Args {
     /// the estimated element count and the warnings of loading, after
     /// --emit, --sky and the sides options are applied.
     #[arg(long, help_heading = heading::INPUT, conflicts_with_all = [
-        "output", "export", "log", "plot", "stats", "checkpoint", "resume",
+        "output", "export", "lightmap", "lightmap_texture", "log", "plot", "stats", "checkpoint", "resume",
         "falsecolor", "workplane", "illuminance_at", "mesh_lines", "no_window",
     ])]
     pub(crate) info: bool,
@@ -625,4 +657,14 @@ fn parse_max_memory(text: &str) -> Result<u64, String> {
         ));
     }
     Ok(bytes)
+}
+
+/// `--lightmap-density`: a positive, finite number of texels per unit.
+fn parse_lightmap_density(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(d) if d.is_finite() && d > 0.0 => Ok(d),
+        _ => Err(format!(
+            "expected a positive number of texels per scene unit, got `{text}`"
+        )),
+    }
 }

@@ -615,7 +615,7 @@ fn push_primitive(
 /// The `.glb` container: its header, then the JSON chunk padded with
 /// spaces and the binary chunk `bin` padded with zeros, each to a multiple
 /// of 4 bytes.
-fn glb_container(mut json_chunk: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
+pub(crate) fn glb_container(mut json_chunk: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
     while !json_chunk.len().is_multiple_of(4) {
         json_chunk.push(b' ');
     }

@@ -23,6 +23,7 @@ pub mod convergence;
 pub mod daylight_factor;
 pub mod illuminance;
 pub mod image;
+pub mod lightmap;
 pub mod mesh_export;
 
 pub use self::image::{

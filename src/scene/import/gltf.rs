@@ -83,6 +83,7 @@
 
 mod glb;
 mod indices;
+pub mod source;
 
 use super::obj::{is_degenerate, name_list, Tally, MAX_MTL_REFLECTANCE};
 use super::texture;
