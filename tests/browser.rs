@@ -1,7 +1,8 @@
-//! The baked light in a glTF export looks in a web browser as it does in
-//! the program's own picture: `scripts/browser/render.mjs` loads the file
-//! with three.js's `GLTFLoader` in headless Chromium and renders the same
-//! camera, and the two pictures are compared over 4 × 4-pixel blocks.
+//! The baked light in a glTF export, and in a lightmapped model, looks in a
+//! web browser as it does in the program's own picture:
+//! `scripts/browser/render.mjs` loads the file with three.js's
+//! `GLTFLoader` in headless Chromium and renders the same camera, and the
+//! two pictures are compared over 4 × 4-pixel blocks.
 //!
 //! Needs `node`, Debian's `chromium` and the script's `npm` packages
 //! (`.ci/run` installs all three and sets `RADIOSITY_REQUIRE_BROWSER`, so
@@ -144,4 +145,61 @@ fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
         shifted * 100.0
     );
     assert!(flipped > 5.0 * MAX_ERROR && shifted > MAX_ERROR);
+}
+
+/// `--lightmap`'s model shows in three.js, loaded as it is (its own
+/// materials, no light added, the lightmap read as the emissive texture on
+/// the second UV set), as the program's picture of the same view: a
+/// texture upside down or on the wrong UV set would be far off.
+#[test]
+fn the_lightmapped_cornell_box_looks_in_three_js_as_in_the_program() {
+    if let Some(why) = missing() {
+        assert!(
+            std::env::var_os("RADIOSITY_REQUIRE_BROWSER").is_none(),
+            "the browser check must run here: {why}"
+        );
+        eprintln!("\n**************** SKIPPED: browser test: {why} ****************\n");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let camera = [
+        "--eye",
+        "278,273,-800",
+        "--look-at",
+        "278,273,0",
+        "--up",
+        "0,1,0",
+        "--fov",
+        "39.31",
+        "--size",
+        "320x240",
+    ];
+    let cornell = scene("cornell.sc");
+    let mut args = vec![
+        cornell.to_str().unwrap(),
+        "--lightmap",
+        "baked.glb",
+        "-o",
+        "c.png",
+    ];
+    args.extend(["--aa", "1", "-q", "--no-window"]);
+    args.extend(camera);
+    let out = run_in(dir.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = Command::new("node")
+        .arg(root().join("scripts/browser/render.mjs"))
+        .args(["baked.glb", "three.png", "--show", "file"])
+        .args(camera)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let program = image::open(dir.path().join("c.png")).unwrap().to_rgb8();
+    let three = image::open(dir.path().join("three.png")).unwrap().to_rgb8();
+    let error = block_error(&program, &three);
+    eprintln!(
+        "three.js's lightmapped model against the program: {:.2} % relative block error",
+        error * 100.0
+    );
+    assert!(error < MAX_ERROR, "{:.2} %", error * 100.0);
 }
