@@ -13,12 +13,14 @@
 # (docs/accuracy.md gives the commands) and the scaling plots from
 # `cargo run --release --example scaling_plot` on the CSV files in docs/.
 # window.png and window-mesh.png are screenshots of the window and are not
-# made here.
+# made here. lightmap-threejs.png is the --lightmap model rendered by
+# three.js in headless Chromium (scripts/browser/render.mjs).
 set -u
 cd "$(dirname "$0")/.."
 
 [[ -n "${NO_BUILD:-}" ]] || cargo build --release --quiet || exit 1
-bin=$PWD/target/release/radiosity
+root=$PWD
+bin=$root/target/release/radiosity
 out=$PWD/docs/images
 base=scenes/cameras/cornell-base.sc
 
@@ -45,6 +47,7 @@ pictures=(
   "cornell-base-adaptive-mesh|scenes/cornell.sc --camera $base --adaptive --mesh-lines -o @"
   "office-falsecolor|scenes/office.sc -o office.png --units m --ies luminaire=scenes/luminaires/panel.ies --workplane 0.75,0.1 --workplane-out office-workplane --falsecolor @ --falsecolor-of illuminance --falsecolor-scale linear --falsecolor-max 1000"
   "convergence|room.sc -o room.png --log steps.csv --plot @"
+  "lightmap-threejs|scenes/cornell.sc --lightmap baked.glb -o cornell.png"
 )
 
 wanted=("$@")
@@ -60,6 +63,13 @@ for entry in "${pictures[@]}"; do
     echo "!! $name failed" >&2
     failed=1
     continue
+  fi
+  # The lightmapped model as three.js shows it in headless Chromium
+  # (scripts/browser: npm ci there once), from the scene's own camera.
+  if [[ $name == lightmap-threejs ]] && ! node "$root/scripts/browser/render.mjs" baked.glb \
+    "$out/$name.png" --show file --eye 278,273,-800 --look-at 278,273,0 --fov 39.31 --size 360x360; then
+    echo "!! $name: the browser render failed" >&2
+    failed=1
   fi
   # The office's work-plane plan is written beside its false-colour view.
   if [[ $name == office-falsecolor ]]; then
