@@ -77,15 +77,19 @@ fn block_error(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
 /// exposed differently is well over it (checked below).
 const MAX_ERROR: f64 = 0.01;
 
-#[test]
-fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
+/// The Cornell box solved with `output` (the option and file that makes
+/// the `.glb`) and written as `-o c.png`, then `c.glb`'s browser picture
+/// with `render.mjs --show show`, both at one camera: the program's
+/// picture and the browser's. `None` (after saying so) when the browser
+/// check cannot run here and need not.
+fn program_and_browser(output: &str, show: &str) -> Option<(image::RgbImage, image::RgbImage)> {
     if let Some(why) = missing() {
         assert!(
             std::env::var_os("RADIOSITY_REQUIRE_BROWSER").is_none(),
             "the browser check must run here: {why}"
         );
         eprintln!("\n**************** SKIPPED: browser test: {why} ****************\n");
-        return;
+        return None;
     }
     let dir = tempfile::tempdir().unwrap();
     let camera = [
@@ -101,20 +105,14 @@ fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
         "320x240",
     ];
     let cornell = scene("cornell.sc");
-    let mut args = vec![
-        cornell.to_str().unwrap(),
-        "--export",
-        "c.glb",
-        "-o",
-        "c.png",
-    ];
+    let mut args = vec![cornell.to_str().unwrap(), output, "c.glb", "-o", "c.png"];
     args.extend(["--aa", "1", "-q", "--no-window"]);
     args.extend(camera);
     let out = run_in(dir.path(), &args);
     assert!(out.status.success(), "{}", stderr(&out));
     let out = Command::new("node")
         .arg(root().join("scripts/browser/render.mjs"))
-        .args(["c.glb", "three.png", "--show", "colours"])
+        .args(["c.glb", "three.png", "--show", show])
         .args(camera)
         .current_dir(dir.path())
         .output()
@@ -122,6 +120,14 @@ fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
     assert!(out.status.success(), "{}", stderr(&out));
     let program = image::open(dir.path().join("c.png")).unwrap().to_rgb8();
     let three = image::open(dir.path().join("three.png")).unwrap().to_rgb8();
+    Some((program, three))
+}
+
+#[test]
+fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
+    let Some((program, three)) = program_and_browser("--export", "colours") else {
+        return;
+    };
     let error = block_error(&program, &three);
     eprintln!(
         "three.js against the program: {:.2} % relative block error",
@@ -153,49 +159,9 @@ fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
 /// texture upside down or on the wrong UV set would be far off.
 #[test]
 fn the_lightmapped_cornell_box_looks_in_three_js_as_in_the_program() {
-    if let Some(why) = missing() {
-        assert!(
-            std::env::var_os("RADIOSITY_REQUIRE_BROWSER").is_none(),
-            "the browser check must run here: {why}"
-        );
-        eprintln!("\n**************** SKIPPED: browser test: {why} ****************\n");
+    let Some((program, three)) = program_and_browser("--lightmap", "file") else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let camera = [
-        "--eye",
-        "278,273,-800",
-        "--look-at",
-        "278,273,0",
-        "--up",
-        "0,1,0",
-        "--fov",
-        "39.31",
-        "--size",
-        "320x240",
-    ];
-    let cornell = scene("cornell.sc");
-    let mut args = vec![
-        cornell.to_str().unwrap(),
-        "--lightmap",
-        "baked.glb",
-        "-o",
-        "c.png",
-    ];
-    args.extend(["--aa", "1", "-q", "--no-window"]);
-    args.extend(camera);
-    let out = run_in(dir.path(), &args);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let out = Command::new("node")
-        .arg(root().join("scripts/browser/render.mjs"))
-        .args(["baked.glb", "three.png", "--show", "file"])
-        .args(camera)
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", stderr(&out));
-    let program = image::open(dir.path().join("c.png")).unwrap().to_rgb8();
-    let three = image::open(dir.path().join("three.png")).unwrap().to_rgb8();
+    };
     let error = block_error(&program, &three);
     eprintln!(
         "three.js's lightmapped model against the program: {:.2} % relative block error",
