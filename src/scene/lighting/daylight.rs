@@ -378,21 +378,7 @@ fn is_upper(t: &[DVec3; 3]) -> bool {
 /// The spherical triangle `t` split in four `levels` times (midpoints
 /// pushed out to the sphere).
 fn split(t: [DVec3; 3], levels: u32) -> Vec<[DVec3; 3]> {
-    let mut out = vec![t];
-    for _ in 0..levels {
-        out = out
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (
-                    (a + b).normalize(),
-                    (b + c).normalize(),
-                    (c + a).normalize(),
-                );
-                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    out
+    super::sky::split_on_sphere(vec![t], levels)
 }
 
 /// The solid angle of the spherical triangle of unit vectors `a`, `b`,

@@ -170,8 +170,25 @@ pub(super) fn geodesic_sphere(subdivisions: u32) -> Vec<[DVec3; 3]> {
         [8, 6, 7],
         [9, 8, 1],
     ];
-    let mut triangles: Vec<[DVec3; 3]> = FACES.iter().map(|f| f.map(|i| v[i])).collect();
-    for _ in 0..subdivisions {
+    let mut triangles = split_on_sphere(
+        FACES.iter().map(|f| f.map(|i| v[i])).collect(),
+        subdivisions,
+    );
+    // Inward: the area vector points towards the centre.
+    for t in &mut triangles {
+        let [a, b, c] = *t;
+        if (b - a).cross(c - a).dot(a + b + c) > 0.0 {
+            *t = [a, c, b];
+        }
+    }
+    triangles
+}
+
+/// Spherical triangles of the unit sphere, each split in four `levels`
+/// times, the edge midpoints pushed out to the sphere; in the order each
+/// triangle's four parts follow one another.
+pub(super) fn split_on_sphere(mut triangles: Vec<[DVec3; 3]>, levels: u32) -> Vec<[DVec3; 3]> {
+    for _ in 0..levels {
         triangles = triangles
             .iter()
             .flat_map(|&[a, b, c]| {
@@ -183,13 +200,6 @@ pub(super) fn geodesic_sphere(subdivisions: u32) -> Vec<[DVec3; 3]> {
                 [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
             })
             .collect();
-    }
-    // Inward: the area vector points towards the centre.
-    for t in &mut triangles {
-        let [a, b, c] = *t;
-        if (b - a).cross(c - a).dot(a + b + c) > 0.0 {
-            *t = [a, c, b];
-        }
     }
     triangles
 }
