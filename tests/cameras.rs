@@ -411,7 +411,9 @@ fn info_reads_every_bundled_scene_and_a_downloaded_model() {
         for label in [
             "scene: ",
             "materials (",
-            "emitters (",
+            // "emitters (N)", or for a scene lit by a sky alone (the
+            // daylight office) "emitters: none (…give --sky)".
+            "emitters",
             "bounds: ",
             "camera (",
             "lenmax: ",
@@ -421,6 +423,13 @@ fn info_reads_every_bundled_scene_and_a_downloaded_model() {
             assert!(text.contains(label), "{scene:?}: no {label:?} in\n{text}");
         }
     }
+    let office = run_in(
+        dir.path(),
+        &[common::scene("office.sc").to_str().unwrap(), "--info"],
+    );
+    assert!(String::from_utf8(office.stdout)
+        .unwrap()
+        .contains("emitters ("));
     let out = run_in(
         dir.path(),
         &[scenes.last().unwrap().to_str().unwrap(), "--info"],
