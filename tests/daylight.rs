@@ -3,12 +3,8 @@
 
 mod common;
 
+use common::daylight::*;
 use common::*;
-use std::path::Path;
-
-/// An open floor 10 × 10 m of reflectance 0.5 at y = 0, facing up.
-const FLOOR: &str = "material floor\n  color 0.5 0.5 0.5\n  k_diffrefl 1\nend\n\
-polygon floor\n  vertex 0 0 0\n  vertex 10 0 0\n  vertex 10 0 -10\n  vertex 0 0 -10\nend\n";
 
 /// The `work plane at ...` line a run printed, as (Eavg, Emin, Emax).
 fn workplane_figures(out: &std::process::Output) -> (f64, f64, f64) {
@@ -27,24 +23,6 @@ fn workplane_figures(out: &std::process::Output) -> (f64, f64, f64) {
             .unwrap()
     };
     (value("Eavg "), value("Emin "), value("Emax "))
-}
-
-fn run_floor(dir: &Path, sky: &[&str]) -> std::process::Output {
-    write(dir, "floor.sc", FLOOR);
-    let args = [
-        &[
-            "floor.sc",
-            "--units",
-            "m",
-            "--workplane",
-            "0,1",
-            "-o",
-            "f.png",
-        ][..],
-        sky,
-    ]
-    .concat();
-    run_in(dir, &args)
 }
 
 /// The horizontal illuminance of an unobstructed floor under a standard

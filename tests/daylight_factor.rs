@@ -4,29 +4,8 @@
 
 mod common;
 
+use common::daylight::*;
 use common::*;
-
-/// An open floor 10 × 10 m of reflectance 0.5 at y = 0, facing up.
-const FLOOR: &str = "material floor\n  color 0.5 0.5 0.5\n  k_diffrefl 1\nend\n\
-polygon floor\n  vertex 0 0 0\n  vertex 10 0 0\n  vertex 10 0 -10\n  vertex 0 0 -10\nend\n";
-
-fn run_floor(dir: &std::path::Path, sky: &[&str]) -> std::process::Output {
-    write(dir, "floor.sc", FLOOR);
-    let args = [
-        &[
-            "floor.sc",
-            "--units",
-            "m",
-            "--workplane",
-            "0,1",
-            "-o",
-            "f.png",
-        ][..],
-        sky,
-    ]
-    .concat();
-    run_in(dir, &args)
-}
 
 /// The `DF mean … %, DF min … %` figures a run printed.
 fn daylight_factors(out: &std::process::Output) -> (f64, f64) {

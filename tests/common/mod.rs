@@ -4,6 +4,7 @@
 
 #![allow(dead_code)]
 
+pub mod daylight;
 pub mod scenes;
 
 use std::path::{Path, PathBuf};

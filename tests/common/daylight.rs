@@ -1,0 +1,31 @@
+//! The open floor the daylight tests solve under a sky: a surface nothing
+//! shades, so its illuminance is the sky's own horizontal illuminance.
+
+use super::{run_in, write};
+use std::path::Path;
+use std::process::Output;
+
+/// An open floor 10 × 10 m of reflectance 0.5 at y = 0, facing up.
+pub const FLOOR: &str = "material floor\n  color 0.5 0.5 0.5\n  k_diffrefl 1\nend\n\
+polygon floor\n  vertex 0 0 0\n  vertex 10 0 0\n  vertex 10 0 -10\n  vertex 0 0 -10\nend\n";
+
+/// Writes [`FLOOR`] into `dir` and solves it in metres with a work plane
+/// 1 m apart at the floor (`--workplane 0,1`), under the sky options
+/// `sky` (`["--sky", "cie-overcast"]` and so on).
+pub fn run_floor(dir: &Path, sky: &[&str]) -> Output {
+    write(dir, "floor.sc", FLOOR);
+    let args = [
+        &[
+            "floor.sc",
+            "--units",
+            "m",
+            "--workplane",
+            "0,1",
+            "-o",
+            "f.png",
+        ][..],
+        sky,
+    ]
+    .concat();
+    run_in(dir, &args)
+}
