@@ -292,6 +292,8 @@ pub struct StepReport {
     pub rays: u64,
     /// Sample–vertex pairs whose visibility mattered (both cosines
     /// positive); with shaft culling, those in clear shafts cast no ray.
+    /// A shooter whose probes found it wholly hidden from a vertex
+    /// ([`accel::probes`]) counts no pair there.
     pub pairs: u64,
     /// Polygons that received in this step.
     pub receivers: u64,
@@ -442,9 +444,10 @@ pub struct Progressive<'a> {
     /// [`shared::ALONE`] ([`shared`]); empty when receivers are not
     /// shared.
     leaders: Vec<u32>,
-    /// Per polygon: a sky facet's probe samples ([`accel::probes`]), empty for
-    /// every other polygon and when probing is off.
-    probes: Vec<Vec<u32>>,
+    /// Per polygon: a sky facet's probes and their regions
+    /// ([`accel::probes::SkyProbes`]), `None` for every other polygon and
+    /// when probing is off.
+    probes: Vec<Option<accel::probes::SkyProbes>>,
     /// Per polygon: where it is far enough to be probed when it shoots
     /// alone, and its probes ([`far_shooters`]); `None` for sky facets,
     /// polygons of few samples and when the approximation is off.

@@ -62,23 +62,20 @@ pub(super) fn crowded(
     }
 }
 
-/// Per polygon, a sky facet's probe samples among its `samples`
-/// ([`probes`]); empty for every other polygon and unless the solve
+/// Per polygon, a sky facet's probe samples among its `samples` and
+/// their regions ([`probes::SkyProbes`]); `None` for every other polygon and unless the solve
 /// `approximate`s receivers.
 pub(super) fn sky_probes(
     mesh: &Mesh,
     samples: &[Vec<ShooterSample>],
     approximate: bool,
-) -> Vec<Vec<u32>> {
+) -> Vec<Option<probes::SkyProbes>> {
     mesh.polygons
         .iter()
         .zip(samples)
         .map(|(pm, own)| {
-            if pm.sky && approximate {
-                probes::spread(own, crate::solver::tuning::SKY_PROBES)
-            } else {
-                Vec::new()
-            }
+            (pm.sky && approximate)
+                .then(|| probes::SkyProbes::new(own, crate::solver::tuning::SKY_PROBES))
         })
         .collect()
 }

@@ -27,8 +27,9 @@ use crate::scene::PolygonId;
 use crate::solver::accel::cluster::Clusters;
 use crate::solver::accel::facets::Facets;
 use crate::solver::accel::facets::Scratch;
+use crate::solver::accel::probes::{self, Probed};
 use crate::solver::accel::receivers::CoarseGrid;
-use crate::solver::accel::{probes, receivers, shared, subcells};
+use crate::solver::accel::{receivers, shared, subcells};
 use crate::solver::kernel::distribution;
 use crate::solver::tuning::{
     LINEAR_CANDIDATES, PARALLEL_CHARGES, PAR_RUN, REFINE_MAX, SHOOTER_GROUP,
@@ -82,7 +83,7 @@ impl<'a> Progressive<'a> {
             let split = subcells::Split::of_polygon(&p.subcells[i], &p.subcell_readings);
             // The exact `Δrad` at receiving vertex `l` of polygon `j`, with
             // the pairs and rays it took.
-            let probes = &p.probes[i][..];
+            let sky_probes = p.probes[i].as_ref();
             let far_shooter = p.far_shooters[i].as_ref();
             let exact = |l: usize, j: PolygonId, scratch: &mut Scratch| -> (Rgb, u64, u64) {
                 let x = mesh.sample_positions[l];
@@ -123,11 +124,19 @@ impl<'a> Progressive<'a> {
                 // A sky facet's probes, when they agree, stand for all its
                 // directions; so do a far shooter's for all its samples.
                 let far_probes = far_shooter.and_then(|f| f.probes_from(x));
-                let verdict = match (probes, far_probes) {
-                    ([], None) => None,
-                    ([], Some(far)) => probes::verdict(far, samples, x, nx, &mut ray),
-                    (sky, _) => probes::verdict(sky, samples, x, nx, &mut ray),
+                let probed = match (sky_probes, far_probes) {
+                    (None, None) => Probed::Unknown,
+                    (None, Some(far)) => match probes::verdict(far, samples, x, nx, &mut ray) {
+                        Some(blocked) => Probed::Whole(blocked),
+                        None => Probed::Unknown,
+                    },
+                    (Some(sky), _) => sky.ask(samples, x, nx, &mut ray),
                 };
+                // Wholly hidden: nothing arrives, whatever the cosines (the
+                // sum below would add nothing), and no pair is counted.
+                if probed == Probed::Whole(true) {
+                    return (Rgb::BLACK, 0, rays);
+                }
                 let (f, pairs) = distribution::shot_point_to_samples(
                     directional,
                     x,
@@ -137,9 +146,14 @@ impl<'a> Progressive<'a> {
                     |k| shot[k],
                     split.as_ref(),
                     near_field,
-                    |k, s| match verdict {
-                        Some(blocked) => blocked,
-                        None => ray(k, s),
+                    |k, s| {
+                        let seen = match (sky_probes, probed) {
+                            (_, Probed::Unknown) => None,
+                            (Some(sky), probed) => sky.seen(probed, k),
+                            (None, Probed::Whole(blocked)) => Some(blocked),
+                            (None, Probed::Regions { .. }) => None,
+                        };
+                        seen.unwrap_or_else(|| ray(k, s))
                     },
                 );
                 (g.reflectance[j.index()] * f, pairs, rays)

@@ -345,9 +345,9 @@ fn the_checkpoint_fingerprint_covers_the_sky() {
 /// post (0.1 × 0.1, 1.5 tall) out in the open, a small occluder the
 /// probes might miss. The floor's vertices agree within 0.5 % relative
 /// L1 and each within 2 % of the brightest, with fewer rays (measured:
-/// 0.07 %, 0.6 % and 0.52 × the rays; much of this floor sees the sky's
-/// edge past the roof, where probes disagree), and the same bits on 1
-/// and 2 threads.
+/// 0.17 %, 0.74 % and 0.29 × the rays; much of this floor sees the sky's
+/// edge past the roof, where probes disagree and their regions answer
+/// away from the edge), and the same bits on 1 and 2 threads.
 #[test]
 fn sky_probes_match_asking_every_direction() {
     let roof = [[-1., 1., -1.], [2., 1., -1.], [2., 1., 5.], [-1., 1., 5.]];
@@ -395,7 +395,7 @@ fn sky_probes_match_asking_every_direction() {
     assert!(diff / total < 0.005, "floor relL1 {}", diff / total);
     assert!(worst < 0.02, "worst vertex {worst} of the peak");
     assert!(
-        (probed_rays as f64) < 0.6 * every_rays as f64,
+        (probed_rays as f64) < 0.4 * every_rays as f64,
         "probes saved too few rays: {probed_rays} vs {every_rays}"
     );
     let threads = |n| {
