@@ -14,8 +14,10 @@
 #
 # Environment: RADIOSITY (default target/release/radiosity), BLENDER
 # (default blender), WORK (default target/blender-check), ENGINE (cycles,
-# the default, or eevee), SAMPLES (default 16). Needs Blender 3.x or later
-# with its glTF importer (Debian: apt-get install blender python3-numpy).
+# the default, or eevee), SAMPLES (default 16), BLENDER_OPTIONS (more options for
+# render_lightmap.py, e.g. "--view-transform Filmic"). Needs Blender 3.x
+# or later with its glTF importer (Debian: apt-get install blender
+# python3-numpy).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 radiosity=${RADIOSITY:-target/release/radiosity}
@@ -23,8 +25,9 @@ blender=${BLENDER:-blender}
 work=${WORK:-target/blender-check}
 engine=${ENGINE:-cycles}
 samples=${SAMPLES:-16}
+options=${BLENDER_OPTIONS:-}
 if (($# < 1)); then
-  sed -n '2,18s/^# \{0,1\}//p' "$0" >&2
+  sed -n '2,20s/^# \{0,1\}//p' "$0" >&2
   exit 2
 fi
 scene=$1
@@ -37,10 +40,10 @@ if [[ $camera != --eye* ]]; then
   echo "check_lightmap.sh: error: --info names no camera" >&2
   exit 1
 fi
-# shellcheck disable=SC2086 # the camera options are meant to be word-split
+# shellcheck disable=SC2086 # the camera and options are meant to be word-split
 "$blender" -b --factory-startup --python "$here/render_lightmap.py" -- \
   "$work/model.glb" "$work/blender-$engine.png" $camera \
-  --engine "$engine" --samples "$samples" --compare "$work/picture.png" \
+  --engine "$engine" --samples "$samples" $options --compare "$work/picture.png" \
   >"$work/blender.log" 2>&1 || {
   tail -n 30 "$work/blender.log" >&2
   exit 1
