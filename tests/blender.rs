@@ -17,11 +17,13 @@ use common::*;
 use std::path::PathBuf;
 use std::process::Command;
 
-/// The Blender to run, if there is one.
+/// The Blender to run (`BLENDER`, else `blender` on the `PATH`), if
+/// there is one.
 fn blender() -> Option<PathBuf> {
-    std::env::var_os("BLENDER")
-        .map(PathBuf::from)
-        .or_else(|| which("blender"))
+    match std::env::var_os("BLENDER") {
+        Some(path) => Some(PathBuf::from(path)).filter(|p| p.is_file()),
+        None => which("blender"),
+    }
 }
 
 /// Says loudly that the Blender check did not run, and why.
