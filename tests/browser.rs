@@ -11,6 +11,7 @@
 
 mod common;
 
+use common::pictures::*;
 use common::*;
 use std::path::PathBuf;
 use std::process::Command;
@@ -34,55 +35,17 @@ fn missing() -> Option<String> {
     }
 }
 
-/// Mean absolute difference of 4 × 4-pixel block means over the blocks
-/// either picture lights, relative to the first picture's mean there, in
-/// linear light (sRGB codes decoded), the three channels together.
-fn block_error(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let linear = |code: u8| {
-        let e = f64::from(code) / 255.0;
-        if e <= 0.04045 {
-            e / 12.92
-        } else {
-            ((e + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    let (w, h) = a.dimensions();
-    let (mut diff, mut sum) = (0.0, 0.0);
-    for by in 0..h / 4 {
-        for bx in 0..w / 4 {
-            let mut block = [0.0f64; 2];
-            for (k, picture) in [a, b].into_iter().enumerate() {
-                for y in by * 4..by * 4 + 4 {
-                    for x in bx * 4..bx * 4 + 4 {
-                        block[k] += picture
-                            .get_pixel(x, y)
-                            .0
-                            .iter()
-                            .map(|&c| linear(c))
-                            .sum::<f64>();
-                    }
-                }
-            }
-            diff += (block[0] - block[1]).abs();
-            sum += block[0];
-        }
-    }
-    diff / sum
-}
-
-/// The largest relative block error accepted. The two rasterisers differ
-/// only at polygon edges (which pixel an edge's centre falls in) and in
-/// rounding; a picture upside down, mirrored, shifted by a pixel or
-/// exposed differently is well over it (checked below).
-const MAX_ERROR: f64 = 0.01;
-
-/// The Cornell box solved with `output` (the option and file that makes
-/// the `.glb`) and written as `-o c.png`, then `c.glb`'s browser picture
-/// with `render.mjs --show show`, both at one camera: the program's
-/// picture and the browser's. `None` (after saying so) when the browser
-/// check cannot run here and need not.
-fn program_and_browser(output: &str, show: &str) -> Option<(image::RgbImage, image::RgbImage)> {
+/// `scene` solved with `output` (the option and file that makes the
+/// `.glb`) and written as `-o c.png`, then `c.glb`'s browser picture with
+/// `render.mjs --show show`, both at `view`: the program's picture and the
+/// browser's. `None` (after saying so) when the browser check cannot run
+/// here and need not.
+fn program_and_browser(
+    scene_file: &str,
+    view: [&str; 10],
+    output: &str,
+    show: &str,
+) -> Option<(image::RgbImage, image::RgbImage)> {
     if let Some(why) = missing() {
         assert!(
             std::env::var_os("RADIOSITY_REQUIRE_BROWSER").is_none(),
@@ -92,28 +55,16 @@ fn program_and_browser(output: &str, show: &str) -> Option<(image::RgbImage, ima
         return None;
     }
     let dir = tempfile::tempdir().unwrap();
-    let camera = [
-        "--eye",
-        "278,273,-800",
-        "--look-at",
-        "278,273,0",
-        "--up",
-        "0,1,0",
-        "--fov",
-        "39.31",
-        "--size",
-        "320x240",
-    ];
-    let cornell = scene("cornell.sc");
-    let mut args = vec![cornell.to_str().unwrap(), output, "c.glb", "-o", "c.png"];
+    let path = scene(scene_file);
+    let mut args = vec![path.to_str().unwrap(), output, "c.glb", "-o", "c.png"];
     args.extend(["--aa", "1", "-q", "--no-window"]);
-    args.extend(camera);
+    args.extend(view);
     let out = run_in(dir.path(), &args);
     assert!(out.status.success(), "{}", stderr(&out));
     let out = Command::new("node")
         .arg(root().join("scripts/browser/render.mjs"))
         .args(["c.glb", "three.png", "--show", show])
-        .args(camera)
+        .args(view)
         .current_dir(dir.path())
         .output()
         .unwrap();
@@ -125,7 +76,9 @@ fn program_and_browser(output: &str, show: &str) -> Option<(image::RgbImage, ima
 
 #[test]
 fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
-    let Some((program, three)) = program_and_browser("--export", "colours") else {
+    let Some((program, three)) =
+        program_and_browser("cornell.sc", CORNELL_VIEW, "--export", "colours")
+    else {
         return;
     };
     let error = block_error(&program, &three);
@@ -133,7 +86,7 @@ fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
         "three.js against the program: {:.2} % relative block error",
         error * 100.0
     );
-    assert!(error < MAX_ERROR, "{:.2} %", error * 100.0);
+    assert!(error < MAX_BLOCK_ERROR, "{:.2} %", error * 100.0);
     // The measure tells a wrong picture apart: the same picture upside
     // down, or shifted by two pixels, is far off.
     let flipped = image::imageops::flip_vertical(&three);
@@ -150,22 +103,32 @@ fn the_exported_cornell_box_looks_in_three_js_as_in_the_program() {
         flipped * 100.0,
         shifted * 100.0
     );
-    assert!(flipped > 5.0 * MAX_ERROR && shifted > MAX_ERROR);
+    assert!(flipped > 5.0 * MAX_BLOCK_ERROR && shifted > MAX_BLOCK_ERROR);
 }
 
 /// `--lightmap`'s model shows in three.js, loaded as it is (its own
 /// materials, no light added, the lightmap read as the emissive texture on
 /// the second UV set), as the program's picture of the same view: a
-/// texture upside down or on the wrong UV set would be far off.
+/// texture upside down or on the wrong UV set would be far off. Two
+/// scenes: the Cornell box (16 charts) and the room with the table (43
+/// charts, many of them small: the table's legs and the box on it).
 #[test]
-fn the_lightmapped_cornell_box_looks_in_three_js_as_in_the_program() {
-    let Some((program, three)) = program_and_browser("--lightmap", "file") else {
-        return;
-    };
-    let error = block_error(&program, &three);
-    eprintln!(
-        "three.js's lightmapped model against the program: {:.2} % relative block error",
-        error * 100.0
-    );
-    assert!(error < MAX_ERROR, "{:.2} %", error * 100.0);
+fn the_lightmapped_scenes_look_in_three_js_as_in_the_program() {
+    for (scene_file, view) in [("cornell.sc", CORNELL_VIEW), ("rtable.sc", RTABLE_VIEW)] {
+        let Some((program, three)) = program_and_browser(scene_file, view, "--lightmap", "file")
+        else {
+            return;
+        };
+        let error = block_error(&program, &three);
+        eprintln!(
+            "{scene_file}: three.js's lightmapped model against the program: \
+             {:.2} % relative block error",
+            error * 100.0
+        );
+        assert!(
+            error < MAX_BLOCK_ERROR,
+            "{scene_file}: {:.2} %",
+            error * 100.0
+        );
+    }
 }

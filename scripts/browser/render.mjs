@@ -10,7 +10,8 @@
 //
 // --show file (the default): the file's own materials with no light
 // added, so what shows is what the file emits (a baked lightmap in
-// `emissiveTexture`). --show colours: every mesh drawn unlit in its
+// `emissiveTexture`): the renderer as the guide's three.js snippet makes
+// it, with its defaults. --show colours: every mesh drawn unlit in its
 // COLOR_0 vertex colours (the program's `--export` baked light).
 //
 // Chromium is /usr/bin/chromium (Debian's `chromium` package) unless
@@ -81,8 +82,8 @@ const settings = ${JSON.stringify({ eye, lookAt, up, fov, width, height, show: o
 const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
 renderer.setSize(settings.width, settings.height);
-renderer.outputColorSpace = THREE.SRGBColorSpace;
-renderer.toneMapping = THREE.NoToneMapping;
+// Colour space and tone mapping stay at three.js's defaults (sRGB output,
+// no tone mapping), as a page that only loads the file has them.
 renderer.setClearColor(0x000000, 1);
 document.body.appendChild(renderer.domElement);
 const camera = new THREE.PerspectiveCamera(settings.fov, settings.width / settings.height, 1e-3, 1e7);

@@ -5,6 +5,7 @@
 #![allow(dead_code)]
 
 pub mod daylight;
+pub mod pictures;
 pub mod scenes;
 
 use std::path::{Path, PathBuf};
