@@ -64,8 +64,9 @@ fn an_open_floor_receives_the_skys_horizontal_illuminance() {
 }
 
 /// A standard sky needs a unit and, if shaped by the sun, the sun; the
-/// sun and north mean nothing without such a sky: each refused with
-/// exit code 2 and a message naming what is missing.
+/// sun means nothing under an overcast sky not shaped by it, and north
+/// nothing without a sun: each refused with exit code 2 and a message
+/// naming what is missing.
 #[test]
 fn standard_skies_refuse_what_they_cannot_use() {
     let dir = tempfile::tempdir().unwrap();
@@ -81,7 +82,7 @@ fn standard_skies_refuse_what_they_cannot_use() {
         ),
         (
             &["--units", "m", "--sky", "cie-overcast", "--sun", "180,40"],
-            "--sun needs a standard sky that depends on the sun",
+            "--sun has no effect under --sky cie-overcast",
         ),
         (
             &["--units", "m", "--sky", "cie:1", "--north", "20"],

@@ -707,8 +707,8 @@ mod tests {
 
     #[test]
     fn the_sun_from_a_date_time_and_place() {
-        // Greenwich at 15:00 UTC on the summer solstice: high in the
-        // south-west (NOAA's calculator: azimuth 242.1°, elevation 47.2°).
+        // Greenwich at 15:00 UTC on the June solstice: high in the
+        // west-south-west.
         let sun = parse_sun("2026-06-21,15:00,51.48,-0.0").unwrap();
         let (az, alt) = (
             sun.position.azimuth.to_degrees(),
