@@ -325,7 +325,7 @@ pub struct Args {
     #[arg(help_heading = heading::LIGHT)]
     pub(crate) sky: Option<SkyArg>,
 
-    /// The sun: AZ,ALT[,Nlx] or DATE,TIME,LAT,LON[,ZONE][,Nlx].
+    /// Light the scene with the sun, placed by angles or by a date and place.
     ///
     /// AZ,ALT: degrees clockwise from north (90 is east), degrees above
     /// the horizon (0 to 90). DATE,TIME,LAT,LON: a date YYYY-MM-DD, the

@@ -184,40 +184,7 @@ impl Progressive<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{HorizonFrame, SunPosition};
-    use crate::testutil::{grey, polygon, regular_mesh, scene};
-
-    /// A floor 0..4 × 0..4 (z = 0, facing +z) under a black square plate
-    /// 1..3 × 1..3 at height 1, facing down, the sun overhead.
-    fn floor_under_a_plate() -> Scene {
-        let mut s = scene(
-            vec![
-                polygon(
-                    0,
-                    &[
-                        [0.0, 0.0, 0.0],
-                        [4.0, 0.0, 0.0],
-                        [4.0, 4.0, 0.0],
-                        [0.0, 4.0, 0.0],
-                    ],
-                ),
-                polygon(
-                    1,
-                    &[
-                        [1.0, 1.0, 1.0],
-                        [1.0, 3.0, 1.0],
-                        [3.0, 3.0, 1.0],
-                        [3.0, 1.0, 1.0],
-                    ],
-                ),
-            ],
-            vec![grey("floor", 0.0, 0.5), grey("plate", 0.0, 0.0)],
-        );
-        s.camera.up = Vec3::Z;
-        let frame = HorizonFrame::new(Vec3::Z, 0.0);
-        s.sun = Sun::new(SunPosition::from_degrees(0.0, 90.0), 1000.0, &frame);
-        s
-    }
+    use crate::testutil::{floor_under_a_plate, regular_mesh};
 
     #[test]
     fn points_in_the_open_get_the_full_sun_and_points_under_the_plate_none() {
