@@ -19,8 +19,8 @@
 //! the rays go, so it does not block them.
 //!
 //! Before the first step every element vertex `l` of a reflecting polygon
-//! gets `b_l += ρ E(x_l)`, and its unshot radiosity the same
-//! ([`Progressive::receive_sun`]): the steps then reflect the sunlight as
+//! gets `b_l += ρ E(x_l)`, and its unshot radiosity the same (when
+//! [`Progressive::new`] starts the solve): the steps then reflect the sunlight as
 //! any light they received, and the window shows it from the first
 //! picture. The final gather adds `E` at its points with the same rays
 //! ([`super::final_gather`]), and a refined mesh's new vertices get it as
