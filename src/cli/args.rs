@@ -344,7 +344,7 @@ pub struct Args {
     /// puts the sun below the horizon gives a warning and no sun light.
     #[arg(
         long,
-        value_name = "AZ,ALT[,Nlx]|DATE,TIME,LAT,LON[,ZONE][,Nlx]",
+        value_name = "AZ,ALT|DATE,...",
         value_parser = parse_sun,
         allow_hyphen_values = true
     )]
