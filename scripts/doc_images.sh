@@ -47,6 +47,7 @@ pictures=(
   "cornell-base-adaptive-mesh|scenes/cornell.sc --camera $base --adaptive --mesh-lines -o @"
   "office-falsecolor|scenes/office.sc -o office.png --units m --ies luminaire=scenes/luminaires/panel.ies --workplane 0.75,0.1 --workplane-out office-workplane --falsecolor @ --falsecolor-of illuminance --falsecolor-scale linear --falsecolor-max 1000"
   "convergence|room.sc -o room.png --log steps.csv --plot @"
+  "daylight-office-sun|scenes/daylight-office.sc --units m --sky cie-clear --sun 2026-03-20,12:00,51.48,-0.0 --workplane 0.85,0.25 -o @"
   "lightmap-threejs|scenes/cornell.sc --lightmap baked.glb -o cornell.png"
 )
 

@@ -164,14 +164,20 @@ pub struct DaylightConfig {
     /// `--sky cie-...`: the standard sky and its level, if asked for
     /// (never with a uniform [`RunConfig::sky`]).
     pub sky: Option<(crate::scene::SkyModel, Option<crate::scene::SkyLevel>)>,
-    /// `--sun`: where the sun is.
+    /// `--sun`: where the sun is (below the horizon only when a date put
+    /// it there).
     pub sun: Option<crate::scene::SunPosition>,
+    /// `--sun`'s day of the year, when it gave a date.
+    pub sun_day: Option<u32>,
+    /// `--sun`'s direct normal illuminance (`,Nlx`), lux, when given.
+    pub sun_lux: Option<f64>,
     /// `--north`: true north clockwise from the model's north, radians.
     pub north: f64,
 }
 
 impl DaylightConfig {
     /// The standard sky made definite, `None` when none is asked for.
+    /// A sky shaped by the sun needs it above the horizon.
     pub fn resolve(
         &self,
     ) -> Result<Option<crate::scene::DaylightSky>, crate::scene::DaylightError> {
@@ -180,6 +186,34 @@ impl DaylightConfig {
                 crate::scene::DaylightSky::new(model, level, self.sun, self.north)
             })
             .transpose()
+    }
+
+    /// Whether `--sun` lights the scene itself: a sun is given, and no
+    /// standard sky or one that has a sun ([`crate::scene::SkyModel::has_sun`]:
+    /// not under the overcast types, where `--sun` only shapes the sky).
+    /// A sun below the horizon still "shines" here; it gives no light
+    /// ([`DaylightConfig::sun_light`]).
+    pub fn sun_shines(&self) -> bool {
+        self.sun.is_some() && self.sky.is_none_or(|(model, _)| model.has_sun())
+    }
+
+    /// The direct normal illuminance of the sun, lux: as given, else the
+    /// IES clear-sky figure for its altitude (and day, when a date gave
+    /// it, [`crate::scene::clear_sky_normal_illuminance`]); `None` when the
+    /// sun does not shine ([`DaylightConfig::sun_shines`]).
+    pub fn sun_normal_lux(&self) -> Option<f64> {
+        let sun = self.sun.filter(|_| self.sun_shines())?;
+        Some(self.sun_lux.unwrap_or_else(|| {
+            crate::scene::clear_sky_normal_illuminance(sun.altitude, self.sun_day)
+        }))
+    }
+
+    /// The sun as a light in the frame of a model whose camera's up is
+    /// `camera_up` ([`crate::scene::HorizonFrame`]): `None` when it does
+    /// not shine or stands below the horizon.
+    pub fn sun_light(&self, camera_up: glam::Vec3) -> Option<crate::scene::Sun> {
+        let frame = crate::scene::HorizonFrame::new(camera_up, self.north);
+        crate::scene::Sun::new(self.sun?, self.sun_normal_lux()?, &frame)
     }
 }
 

@@ -68,6 +68,12 @@ pub enum PrepareError {
          illuminance in lux (glTF scenes are in metres; OBJ and .sc have no unit)"
     )]
     SkyNoUnits(String, String),
+    /// The sun on a scene without a unit: its illuminance is in lux.
+    #[error(
+        "--sun needs --units for {0}: the sun's illuminance is in lux \
+         (glTF scenes are in metres; OBJ and .sc have no unit)"
+    )]
+    SunNoUnits(String),
     /// A standard sky cannot be made as asked.
     #[error("{0}")]
     Daylight(#[from] crate::scene::DaylightError),
@@ -264,10 +270,18 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
                     config.scene.display_name(),
                 ));
             }
-            Some(SkyLight::Daylight(daylight, 0.0))
+            // The ground below the horizon is lit by the sun too.
+            let sun = config.daylight.sun_light(scene.camera.up);
+            Some(SkyLight::Daylight(
+                daylight,
+                sun.map_or(0.0, |s| s.horizontal_illuminance()),
+            ))
         }
         None => config.sky.map(SkyLight::Uniform),
     };
+    if config.daylight.sun_shines() && config.units().is_none() {
+        return Err(PrepareError::SunNoUnits(config.scene.display_name()));
+    }
     let options = RepairOptions {
         sides: config.sides,
         sky,
@@ -286,6 +300,11 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
             RepairError::Memory(e) => PrepareError::Memory(e),
             RepairError::Interrupted(c) => PrepareError::Interrupted(c),
         })?;
+    // In the sky's frame: the camera as the sky saw it, before overrides.
+    scene.sun = config.daylight.sun_light(scene.camera.up);
+    if let Some(warning) = sun_below_horizon(config) {
+        scene.warnings.push(warning);
+    }
     if let Some(warning) = scene.nothing_emits_warning(&config.scene.display_name()) {
         scene.warnings.push(warning);
     }
@@ -442,6 +461,23 @@ pub fn declared_inputs(config: &RunConfig) -> InputSet {
         inputs.declare(resume, InputKind::Checkpoint);
     }
     inputs
+}
+
+/// The warning that `--sun` puts the sun below the horizon (a date at
+/// night), where it gives no light; `None` otherwise.
+fn sun_below_horizon(config: &RunConfig) -> Option<crate::scene::Warning> {
+    let sun = config.daylight.sun.filter(|s| s.altitude < 0.0)?;
+    config.daylight.sun_shines().then(|| {
+        crate::scene::Warning::file(
+            &config.scene.display_name(),
+            format!(
+                "--sun puts the sun {:.1}° below the horizon at that time (azimuth {:.1}°): \
+                 it gives no light",
+                -sun.altitude.to_degrees(),
+                sun.azimuth.to_degrees()
+            ),
+        )
+    })
 }
 
 #[cfg(test)]

@@ -89,6 +89,7 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
         warnings: Vec::new(),
         groups: Vec::new(),
         luminaires: Vec::new(),
+        sun: None,
     }
 }
 
@@ -273,4 +274,40 @@ pub fn tiled_box(shadowed: bool, n: usize) -> Scene {
         })
         .collect();
     scene(polygons, s.materials)
+}
+
+/// A floor 0..4 × 0..4 (z = 0, facing +z) under a black square plate
+/// 1..3 × 1..3 at height 1, facing down, the sun overhead.
+pub fn floor_under_a_plate() -> Scene {
+    let mut s = scene(
+        vec![
+            polygon(
+                0,
+                &[
+                    [0.0, 0.0, 0.0],
+                    [4.0, 0.0, 0.0],
+                    [4.0, 4.0, 0.0],
+                    [0.0, 4.0, 0.0],
+                ],
+            ),
+            polygon(
+                1,
+                &[
+                    [1.0, 1.0, 1.0],
+                    [1.0, 3.0, 1.0],
+                    [3.0, 3.0, 1.0],
+                    [3.0, 1.0, 1.0],
+                ],
+            ),
+        ],
+        vec![grey("floor", 0.0, 0.5), grey("plate", 0.0, 0.0)],
+    );
+    s.camera.up = Vec3::Z;
+    let frame = crate::scene::HorizonFrame::new(Vec3::Z, 0.0);
+    s.sun = crate::scene::Sun::new(
+        crate::scene::SunPosition::from_degrees(0.0, 90.0),
+        1000.0,
+        &frame,
+    );
+    s
 }

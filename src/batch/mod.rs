@@ -30,6 +30,7 @@
 //! says which step, shooter and phase failed ([`failure`]).
 
 pub mod checkpoint;
+pub mod daylight;
 pub mod failure;
 pub mod outputs;
 pub mod photometry;
@@ -253,6 +254,14 @@ pub struct RunStats {
     /// scene was lit by a sky (not written otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sky: Option<[f64; 3]>,
+    /// The standard sky (`--sky cie-...`): its name, horizontal
+    /// illuminance and zenith luminance (not written otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub daylight_sky: Option<daylight::SkyStats>,
+    /// The sun that lit the scene (`--sun`): where it was and how bright
+    /// (not written otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sun: Option<daylight::SunStats>,
     /// The lenmax used, in scene units.
     pub lenmax: f32,
     /// Shooting steps taken.
@@ -796,6 +805,8 @@ fn run_stats(
         elements: drawn(mesh).0,
         vertices: drawn(mesh).1,
         sky: prepared.scene.sky().map(|s| s.to_array()),
+        daylight_sky: daylight::sky_stats(config),
+        sun: daylight::sun_stats(&prepared.scene),
         lenmax: prepared.lenmax,
         steps: totals.steps,
         rays: totals.rays,
@@ -1000,11 +1011,12 @@ pub fn summary(stats: &RunStats) -> String {
         // No steps, no unshot power: there was nothing to solve.
         return format!("{}: nothing emits, nothing solved → {written}", stats.scene);
     }
-    let sky = match stats.sky {
-        Some([r, g, b]) if r == g && g == b => format!(" under a sky of {}", short(r)),
-        Some([r, g, b]) => format!(" under a sky of {},{},{}", short(r), short(g), short(b)),
-        None => String::new(),
+    let uniform = match stats.sky {
+        Some([r, g, b]) if r == g && g == b => Some(short(r)),
+        Some([r, g, b]) => Some(format!("{},{},{}", short(r), short(g), short(b))),
+        None => None,
     };
+    let sky = daylight::summary_words(stats.daylight_sky.as_ref(), uniform, stats.sun.as_ref());
     format!(
         "{}{sky}: {steps}, {:.2} s solving, {:.1} M rays, {:.3}% unshot{}, {} → {written}",
         stats.scene,

@@ -325,13 +325,29 @@ pub struct Args {
     #[arg(help_heading = heading::LIGHT)]
     pub(crate) sky: Option<SkyArg>,
 
-    /// Where the sun is: AZIMUTH,ALTITUDE.
+    /// Light the scene with the sun, placed by angles or by a date and place.
     ///
-    /// Degrees clockwise from north (90 is east), degrees above the
-    /// horizon (0 to 90). Shapes the luminance of the standard skies that
-    /// depend on the sun (--sky cie-clear, cie:N); the sun's own direct
-    /// light is not added.
-    #[arg(long, value_name = "AZ,ALT", value_parser = parse_sun, allow_hyphen_values = true)]
+    /// AZ,ALT: degrees clockwise from north (90 is east), degrees above
+    /// the horizon (0 to 90). DATE,TIME,LAT,LON: a date YYYY-MM-DD, the
+    /// local standard time HH:MM[:SS] (no daylight saving), latitude and
+    /// longitude in degrees (north and east positive), optionally ZONE, the
+    /// hours from UTC (default: the longitude's nominal zone, LON/15
+    /// rounded); the position by NOAA's solar calculator. Nlx is the direct
+    /// normal illuminance, lux on a plane facing the sun (default: the IES
+    /// clear-sky formula 127500 lx * exp(-0.21 / sin ALT), corrected for
+    /// the earth-sun distance when a date is given). The sun is a parallel
+    /// light with a disc of 0.53 degrees whose direct light, shadows and
+    /// penumbrae included, the solver starts from; it shines alone or with
+    /// --sky V, cie-clear and cie:6 to cie:15. Under the overcast skies
+    /// (cie-overcast, cie:1 to cie:5) there is no sun: --sun only shapes
+    /// cie:2 and cie:4, and an Nlx is refused. Needs --units. A date that
+    /// puts the sun below the horizon gives a warning and no sun light.
+    #[arg(
+        long,
+        value_name = "AZ,ALT|DATE,...",
+        value_parser = parse_sun,
+        allow_hyphen_values = true
+    )]
     #[arg(help_heading = heading::LIGHT)]
     pub(crate) sun: Option<SunArg>,
 

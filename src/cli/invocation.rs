@@ -121,12 +121,22 @@ pub enum UsageError {
          defined under the CIE overcast sky"
     )]
     DaylightFactorSky,
-    /// `--sun` without a standard sky shaped by it.
+    /// `--sun` under an overcast sky that does not depend on the sun
+    /// (`cie-overcast`, `cie:1`, `cie:3`, `cie:5`): it has no sun to give
+    /// and nothing to shape.
     #[error(
-        "--sun needs a standard sky that depends on the sun (--sky cie-clear or cie:N, \
-         N other than 1, 3, 5)"
+        "--sun has no effect under --sky {0}: an overcast sky has no sun, and its luminance \
+         does not depend on where the sun is; drop --sun, or choose --sky cie-clear or \
+         cie:6 to cie:15 for sunlight"
     )]
-    SunWithoutSky,
+    SunWithoutSky(String),
+    /// `--sun` with an illuminance under an overcast sky: it has no sun.
+    #[error(
+        "--sun gives the sun an illuminance, but --sky {0} is overcast and has no sun \
+         (under cie:2 and cie:4 --sun only shapes the sky): drop the `,Nlx`, or choose \
+         --sky cie-clear or cie:6 to cie:15 for sunlight"
+    )]
+    SunUnderOvercast(String),
     /// `--falsecolor-max` is not a positive finite number.
     #[error("--falsecolor-max must be a positive number, got {0}")]
     FalsecolorMax(f64),
@@ -313,10 +323,20 @@ impl TryFrom<Args> for Invocation {
                 _ => None,
             },
             sun: args.sun.map(|s| s.position),
+            sun_day: args.sun.and_then(|s| s.day),
+            sun_lux: args.sun.and_then(|s| s.normal_lux),
             north: args.north.unwrap_or(0.0).to_radians(),
         };
-        if args.sun.is_some() && daylight.sky.is_none_or(|(m, _)| !m.needs_sun()) {
-            return Err(UsageError::SunWithoutSky);
+        // Under the overcast types the sun has no light of its own: it
+        // shapes the skies that depend on it (cie:2, cie:4), and is refused
+        // where it would do nothing or was given a brightness.
+        if let (Some(sun), Some((model, _))) = (args.sun, daylight.sky) {
+            if !model.has_sun() && sun.normal_lux.is_some() {
+                return Err(UsageError::SunUnderOvercast(model.name()));
+            }
+            if !model.has_sun() && !model.needs_sun() {
+                return Err(UsageError::SunWithoutSky(model.name()));
+            }
         }
         daylight.resolve()?;
         if args.daylight_factor

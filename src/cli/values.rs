@@ -4,7 +4,10 @@
 //! (exit code 2) naming the option.
 
 use crate::color::Rgb;
-use crate::scene::{SkyLevel, SkyModel, SunPosition, MAX_COORDINATE, MAX_EMISSION};
+use crate::scene::{
+    days_in_month, solar_position, SkyLevel, SkyModel, SunPosition, SunTime, MAX_COORDINATE,
+    MAX_EMISSION, MAX_SUN_LUX,
+};
 use crate::solver::hemicube::HemicubeRes;
 use crate::solver::ShooterSamples;
 
@@ -46,13 +49,29 @@ pub enum ValueError {
          or `,3000cd` (zenith luminance in cd/m²), got `{0}`"
     )]
     StandardSky(String),
-    /// `--sun` is not `AZIMUTH,ALTITUDE`: degrees clockwise from north,
-    /// degrees above the horizon from 0 to 90.
+    /// `--sun` is not `AZIMUTH,ALTITUDE[,Nlx]`: degrees clockwise from
+    /// north, degrees above the horizon from 0 to 90, and optionally the
+    /// direct normal illuminance in lux (`> 0`, at most [`MAX_SUN_LUX`]).
     #[error(
-        "--sun must look like 135,40 (azimuth in degrees clockwise from north, \
-         altitude in degrees from 0 to 90), got `{0}`"
+        "--sun must look like 135,40 or 135,40,80000lx (azimuth in degrees clockwise from \
+         north, altitude in degrees from 0 to 90, optionally the direct normal illuminance \
+         in lux, more than 0 and at most {max:e}), or give a date, got `{0}`",
+        max = MAX_SUN_LUX
     )]
     Sun(String),
+    /// `--sun` starts with a date but is not
+    /// `DATE,TIME,LATITUDE,LONGITUDE[,ZONE][,Nlx]`.
+    #[error(
+        "--sun with a date must look like 2026-06-21,15:00,51.48,-0.0 or \
+         2026-06-21,15:00,51.48,-0.0,1,80000lx: a date YYYY-MM-DD from {min} to {max_year}, \
+         a local standard time HH:MM or HH:MM:SS, the latitude (-90 to 90) and longitude \
+         (-180 to 180, east positive) in degrees, optionally the zone in hours from UTC \
+         (-12 to 14; default the longitude's nominal zone, longitude/15 rounded) and the \
+         direct normal illuminance in lux; got `{0}`",
+        min = MIN_SUN_YEAR,
+        max_year = MAX_SUN_YEAR
+    )]
+    SunDate(String),
     /// `--north` is not a finite number of degrees.
     #[error("--north must be a number of degrees (true north clockwise from the model's north), got `{0}`")]
     North(String),
@@ -352,20 +371,93 @@ pub fn parse_sky(text: &str) -> Result<SkyArg, ValueError> {
     Ok(SkyArg::Standard(model, level))
 }
 
-/// What `--sun` gives: the sun's position.
+/// The first year `--sun` takes a date in: NOAA's algorithm is stated
+/// good from 1800 to 2100, and a little beyond.
+pub const MIN_SUN_YEAR: i32 = 1800;
+
+/// The last year `--sun` takes a date in.
+pub const MAX_SUN_YEAR: i32 = 2200;
+
+/// What `--sun` gives: where the sun is and, if given, how bright.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunArg {
-    /// Where the sun is.
+    /// Where the sun is. The altitude is `0..=π/2` when given as an angle;
+    /// from a date it may be negative (the sun below the horizon).
     pub position: SunPosition,
+    /// The day of the year, when a date was given.
+    pub day: Option<u32>,
+    /// The direct normal illuminance given (`,Nlx`), lux, finite, `> 0`
+    /// and at most [`MAX_SUN_LUX`].
+    pub normal_lux: Option<f64>,
 }
 
-/// Parses `--sun`: `AZIMUTH,ALTITUDE`, the azimuth in degrees clockwise
-/// from north (any finite number), the altitude in degrees from 0 to 90.
+/// Parses `--sun`: `AZIMUTH,ALTITUDE[,Nlx]`, the azimuth in degrees
+/// clockwise from north (any finite number), the altitude in degrees from
+/// 0 to 90; or `DATE,TIME,LATITUDE,LONGITUDE[,ZONE][,Nlx]`, the date
+/// `YYYY-MM-DD` ([`MIN_SUN_YEAR`] to [`MAX_SUN_YEAR`]), the local standard
+/// time `HH:MM[:SS]`, degrees of latitude (north positive) and longitude
+/// (east positive), the zone in hours from UTC (`-12..=14`; default the
+/// longitude's nominal zone, `round(longitude / 15)`), the position then
+/// by [`solar_position`]. `Nlx` is the direct normal illuminance in lux
+/// (case ignored).
 pub fn parse_sun(text: &str) -> Result<SunArg, ValueError> {
-    let bad = || ValueError::Sun(text.to_string());
-    let numbers = text
+    let mut fields: Vec<String> = text
         .split(',')
-        .map(|c| c.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .map(|f| f.trim().to_ascii_lowercase())
+        .collect();
+    // A year of four digits and a dash: a date, right or wrong.
+    let dated = fields.first().is_some_and(|f| {
+        let b = f.as_bytes();
+        b.len() > 5 && b[..4].iter().all(u8::is_ascii_digit) && b[4] == b'-'
+    });
+    let bad = || {
+        if dated {
+            ValueError::SunDate(text.to_string())
+        } else {
+            ValueError::Sun(text.to_string())
+        }
+    };
+    let normal_lux = match fields.last().and_then(|f| f.strip_suffix("lx")) {
+        Some(n) => {
+            let lux = finite(n).filter(|&x| x > 0.0 && x <= MAX_SUN_LUX);
+            fields.pop();
+            Some(lux.ok_or_else(bad)?)
+        }
+        None => None,
+    };
+    if dated {
+        let (year, month, day) = fields.first().and_then(|f| parse_date(f)).ok_or_else(bad)?;
+        let (date_and_place, zone) = match fields.len() {
+            4 => (&fields[..], None),
+            5 => (&fields[..4], Some(finite(&fields[4]).ok_or_else(bad)?)),
+            _ => return Err(bad()),
+        };
+        let hours = parse_clock(&date_and_place[1]).ok_or_else(bad)?;
+        let latitude = finite(&date_and_place[2]).ok_or_else(bad)?;
+        let longitude = finite(&date_and_place[3]).ok_or_else(bad)?;
+        if latitude.abs() > 90.0 || longitude.abs() > 180.0 {
+            return Err(bad());
+        }
+        let zone = zone.unwrap_or_else(|| (longitude / 15.0).round());
+        if !(-12.0..=14.0).contains(&zone) {
+            return Err(bad());
+        }
+        let time = SunTime {
+            year,
+            month,
+            day,
+            hours,
+            zone,
+        };
+        return Ok(SunArg {
+            position: solar_position(&time, latitude, longitude),
+            day: Some(time.day_of_year()),
+            normal_lux,
+        });
+    }
+    let numbers = fields
+        .iter()
+        .map(|f| finite(f))
         .collect::<Option<Vec<f64>>>()
         .ok_or_else(bad)?;
     let [azimuth, altitude] = numbers[..] else {
@@ -376,7 +468,45 @@ pub fn parse_sun(text: &str) -> Result<SunArg, ValueError> {
     }
     Ok(SunArg {
         position: SunPosition::from_degrees(azimuth.rem_euclid(360.0), altitude),
+        day: None,
+        normal_lux,
     })
+}
+
+/// A finite number, or `None`.
+fn finite(text: &str) -> Option<f64> {
+    text.trim().parse::<f64>().ok().filter(|x| x.is_finite())
+}
+
+/// `YYYY-MM-DD`, a real day from [`MIN_SUN_YEAR`] to [`MAX_SUN_YEAR`].
+fn parse_date(text: &str) -> Option<(i32, u32, u32)> {
+    let mut parts = text.split('-');
+    let (y, m, d) = (parts.next()?, parts.next()?, parts.next()?);
+    if parts.next().is_some() || y.len() != 4 || !(1..=2).contains(&m.len()) {
+        return None;
+    }
+    let all_digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    if !(all_digits(y) && all_digits(m) && all_digits(d)) {
+        return None;
+    }
+    let (year, month, day) = (y.parse().ok()?, m.parse().ok()?, d.parse().ok()?);
+    let real = (MIN_SUN_YEAR..=MAX_SUN_YEAR).contains(&year)
+        && (1..=days_in_month(year, month)).contains(&day);
+    real.then_some((year, month, day))
+}
+
+/// `HH:MM` or `HH:MM:SS`, before 24:00, as hours.
+fn parse_clock(text: &str) -> Option<f64> {
+    let parts: Vec<&str> = text.split(':').collect();
+    if !(2..=3).contains(&parts.len()) || parts.iter().any(|p| p.is_empty() || p.len() > 2) {
+        return None;
+    }
+    let numbers: Vec<u32> = parts
+        .iter()
+        .map(|p| p.parse().ok())
+        .collect::<Option<_>>()?;
+    let (h, m, s) = (numbers[0], numbers[1], numbers.get(2).copied().unwrap_or(0));
+    (h < 24 && m < 60 && s < 60).then(|| f64::from(h) + f64::from(m) / 60.0 + f64::from(s) / 3600.0)
 }
 
 /// Parses `--north`: degrees, finite (any sign, read modulo 360).
@@ -555,17 +685,69 @@ mod tests {
         assert_eq!(sun.position, SunPosition::from_degrees(135.0, 40.0));
         let sun = parse_sun("-90,90").unwrap();
         assert_eq!(sun.position, SunPosition::from_degrees(270.0, 90.0));
+        assert_eq!((sun.day, sun.normal_lux), (None, None));
+        let sun = parse_sun("180,45,80000LX").unwrap();
+        assert_eq!(sun.normal_lux, Some(80_000.0));
         for bad in [
             "",
             "135",
             "135,-1",
             "135,91",
             "135,40,80000",
+            "135,40,0lx",
+            "135,40,-5lx",
+            "135,40,2e6lx",
             "135,40,1,2",
             "a,b",
             "inf,3",
         ] {
             assert_eq!(parse_sun(bad), Err(ValueError::Sun(bad.into())), "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_sun_from_a_date_time_and_place() {
+        // Greenwich at 15:00 UTC on the June solstice: high in the
+        // west-south-west.
+        let sun = parse_sun("2026-06-21,15:00,51.48,-0.0").unwrap();
+        let (az, alt) = (
+            sun.position.azimuth.to_degrees(),
+            sun.position.altitude.to_degrees(),
+        );
+        assert!(
+            az > 235.0 && az < 250.0 && alt > 40.0 && alt < 55.0,
+            "{az} {alt}"
+        );
+        assert_eq!((sun.day, sun.normal_lux), (Some(172), None));
+        // The zone defaults to the longitude's nominal one: 15:00 at 30° E
+        // is 15:00 at UTC+2.
+        assert_eq!(
+            parse_sun("2026-06-21,15:00,10,30").unwrap(),
+            parse_sun("2026-06-21,15:00,10,30,2").unwrap()
+        );
+        let given = parse_sun("2026-06-21,15:00:30,51.48,-0.0,1,90000lx").unwrap();
+        assert_eq!(given.normal_lux, Some(90_000.0));
+        // At midnight the sun is below the horizon: parsed all the same.
+        let night = parse_sun("2026-06-21,00:00,51.48,-0.0").unwrap();
+        assert!(night.position.altitude < 0.0);
+        for bad in [
+            "2026-02-30,12:00,50,0",
+            "2026-06-21,24:00,50,0",
+            "2026-06-21,12:60,50,0",
+            "2026-06-21,12,50,0",
+            "2026-06-21,12:00,91,0",
+            "2026-06-21,12:00,50,181",
+            "2026-06-21,12:00,50",
+            "2026-06-21,12:00,50,0,15",
+            "2026-06-21,12:00,50,0,1,2",
+            "2026-06-21,12:00,50,0,0lx",
+            "1700-06-21,12:00,50,0",
+        ] {
+            assert_eq!(
+                parse_sun(bad),
+                Err(ValueError::SunDate(bad.into())),
+                "{bad}"
+            );
         }
         assert_eq!(parse_north("-30"), Ok(330.0));
         assert_eq!(parse_north("x"), Err(ValueError::North("x".into())));

@@ -47,6 +47,10 @@ pub use lighting::emit::{
 };
 pub use lighting::luminaire::{Luminaire, LuminaireError};
 pub use lighting::sky::{SKY_MATERIAL_NAME, SKY_RADIUS_FACTOR, SKY_SUBDIVISIONS};
+pub use lighting::sun::{
+    clear_sky_normal_illuminance, days_in_month, solar_position, Sun, SunTime, CLEAR_EXTINCTION,
+    EXTRATERRESTRIAL_LUX, MAX_SUN_LUX, SUN_DISC_DEGREES, SUN_DISC_GRID, SUN_DISC_SAMPLES,
+};
 pub use lighting::units::{Photometric, Units};
 pub(crate) use polygon::polygon_extent_f32;
 pub use polygon::EXACT_DIAMETER_MAX_VERTICES;
@@ -228,6 +232,10 @@ pub struct Scene {
     /// whose polygons emit with a light distribution instead of
     /// Lambert's cosine. Empty unless asked for.
     pub luminaires: Vec<Luminaire>,
+    /// The sun `--sun` made ([`Sun`]): a parallel light of its own, not a
+    /// polygon, whose direct light the solver shoots once before its
+    /// steps. `None` unless asked for and above the horizon.
+    pub sun: Option<Sun>,
 }
 
 impl Scene {

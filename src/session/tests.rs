@@ -345,3 +345,41 @@ fn a_tilted_thin_wall_is_dark_on_its_unlit_side() {
         assert_eq!(b[v as usize].r, 0.0, "back vertex {v} got light");
     }
 }
+
+/// The sun's light reaches a refined mesh's new vertices as it reached
+/// the old ones: under the overhead sun a floor vertex out of the black
+/// plate's shadow (and its penumbra) holds `ρ E_n` = 500 after every
+/// refinement, one in the shadow 0; and the shadow's edge, where the
+/// light changes, is what gets refined.
+#[test]
+fn refined_passes_keep_the_suns_light() {
+    let s = crate::testutil::floor_under_a_plate();
+    let m = build(&s, 0.5);
+    let vis = Visibility::new(&s);
+    let mut session = Session::new(&s, &m, &vis, options(Some(RefineOptions::default())));
+    run_to_end(&mut session);
+    assert!(session.passes().len() > 1, "{:?}", session.passes());
+    let mesh = session.mesh();
+    assert!(mesh.vertex_count() > m.vertex_count());
+    let mut b = Vec::new();
+    session.solution(&mut b);
+    let (mut open, mut shaded) = (0, 0);
+    for (l, p) in mesh.vertex_polygon.iter().enumerate() {
+        let x = mesh.sample_positions[l];
+        if p.0 != 0 {
+            continue;
+        }
+        // The penumbra reaches tan(0.265°) ≈ 0.005 past the edges.
+        let inside = |lo: f32, hi: f32, margin: f32| {
+            (lo + margin..hi - margin).contains(&x.x) && (lo + margin..hi - margin).contains(&x.y)
+        };
+        if inside(1.0, 3.0, 0.01) {
+            assert_eq!(b[l].r, 0.0, "{x}");
+            shaded += 1;
+        } else if !inside(1.0, 3.0, -0.01) {
+            assert!((b[l].r - 500.0).abs() < 1e-9, "{x}: {}", b[l].r);
+            open += 1;
+        }
+    }
+    assert!(open > 0 && shaded > 0);
+}

@@ -213,6 +213,15 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
             h.word(v.to_bits());
         }
     }
+    // The sun's light is in the state from the start (`--sun`); without
+    // a sun the fingerprint is what it was.
+    if let Some(sun) = &scene.sun {
+        h.bytes(b"sun");
+        for c in sun.direction.to_array() {
+            h.word(u64::from(c.to_bits()));
+        }
+        h.word(sun.normal_illuminance.to_bits());
+    }
     h.bytes(b"mesh");
     h.word(mesh.vertex_count() as u64);
     h.word(mesh.elements.len() as u64);

@@ -33,6 +33,11 @@
 //! Lambert's cosine ([`super::distribution`]); they reflect nothing, so
 //! their radiosity is their emission.
 //!
+//! The sun (`--sun`) is no polygon: its direct light is added at each
+//! point with the rays the solver lit the vertices with
+//! ([`super::sun::SunShot::irradiance`]), the share of its disc the point
+//! sees.
+//!
 //! The result is irradiance in the scene's radiosity units: lux when
 //! emission is luminous exitance in lm/m² (see [`crate::scene::Units`]).
 //! Every point is independent, so [`FinalGather::irradiance_at`] runs in
@@ -75,6 +80,8 @@ pub struct FinalGather<'a> {
     /// polygon (a two-sided face): what [`FinalGather::behind_surfaces`]
     /// needs to tell the back of a surface.
     faces: Vec<(Vec3, bool)>,
+    /// The scene's sun, whose direct light each point adds.
+    sun: Option<super::sun::SunShot>,
 }
 
 impl<'a> FinalGather<'a> {
@@ -141,6 +148,7 @@ impl<'a> FinalGather<'a> {
                 .iter()
                 .map(|pm| (pm.normal, pm.has_back))
                 .collect(),
+            sun: super::sun::SunShot::for_scene(scene),
         }
     }
 
@@ -212,6 +220,10 @@ impl<'a> FinalGather<'a> {
                 }
             };
             sum += e;
+        }
+        if let Some(sun) = &self.sun {
+            let ends = (super::sun::NO_POLYGON, super::sun::NO_POLYGON);
+            sum += Rgb::splat(sun.irradiance(self.visibility, x, n, ends));
         }
         sum
     }

@@ -89,6 +89,7 @@ pub mod method;
 pub mod methods;
 mod setup;
 pub mod step;
+pub mod sun;
 pub mod tuning;
 mod unshot;
 
@@ -527,6 +528,9 @@ pub struct Progressive<'a> {
     state: u64,
     /// The scans a step asks for several times over one state.
     scans: std::sync::Mutex<Scans>,
+    /// The scene's sun, whose direct light the solve starts from
+    /// ([`sun`]); `None` without one.
+    sun: Option<sun::SunShot>,
 }
 
 /// The scans over every vertex that choosing a step, checking for
@@ -684,7 +688,9 @@ impl<'a> Progressive<'a> {
             last_fraction: 1.0,
             state: 0,
             scans: std::sync::Mutex::new(Scans::default()),
+            sun: sun::SunShot::for_scene(scene),
         };
+        solver.receive_sun();
         solver.initial_unshot_power = solver.unshot_power();
         solver
     }
@@ -1008,7 +1014,9 @@ impl<'a> Progressive<'a> {
                     sum += f;
                     rays += asked;
                 }
-                (b + rho * sum, rays)
+                // The sun's light reaches it as it reached the old ones.
+                let sun = self.sun_irradiance(x, normal, j);
+                (b + rho * (sum + Rgb::splat(sun)), rays)
             })
             .collect();
         let rays = gathered.iter().map(|g| g.1).sum::<u64>();

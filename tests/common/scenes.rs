@@ -48,6 +48,7 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
         warnings: Vec::new(),
         groups: Vec::new(),
         luminaires: Vec::new(),
+        sun: None,
     }
 }
 

@@ -711,6 +711,7 @@ impl<'a> Reader<'a> {
             warnings: self.warnings,
             groups,
             luminaires: Vec::new(),
+            sun: None,
         };
         if let Some(warning) = scene.drop_duplicates(file) {
             scene.warnings.push(warning);

@@ -160,6 +160,15 @@ impl SkyModel {
             .is_some_and(|[_, _, c, _, e]| c != 0.0 || e != 0.0)
     }
 
+    /// Whether the sun shines under it (`--sun` then adds its direct
+    /// light): the clear sky and the general skies of types 6 to 15 (partly
+    /// cloudy, clear and turbid); not the overcast sky nor types 1 to 5,
+    /// the overcast ones of ISO 15469:2004, under which `--sun` only shapes
+    /// the sky's luminance.
+    pub fn has_sun(self) -> bool {
+        matches!(self, SkyModel::Cie(n) if n >= 6)
+    }
+
     /// The name the command line gives it.
     pub fn name(self) -> String {
         match self {
@@ -203,12 +212,13 @@ pub enum SkyLevel {
 }
 
 /// Where the sun is: radians, the azimuth clockwise from north, the
-/// altitude above the horizon in `[0, π/2]`.
+/// altitude above the horizon in `[0, π/2]` (below it, negative, only
+/// when a date put it there).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunPosition {
     /// Clockwise from north seen from above (east is `π/2`), radians.
     pub azimuth: f64,
-    /// Above the horizon, radians, `0..=π/2`.
+    /// Above the horizon, radians, `0..=π/2`; `−π/2..0` below it.
     pub altitude: f64,
 }
 
@@ -236,6 +246,14 @@ pub enum DaylightError {
     /// The sky's luminance depends on the sun, and none was given.
     #[error("--sky {0} needs --sun AZIMUTH,ALTITUDE: its luminance depends on where the sun is")]
     NoSun(String),
+    /// The sky's luminance depends on the sun, and the date given puts it
+    /// below the horizon (its altitude in degrees).
+    #[error(
+        "--sky {0} needs the sun above the horizon, and --sun puts it {below:.1}° below: \
+         choose a time of day, or an overcast sky",
+        below = .1.abs()
+    )]
+    SunBelowHorizon(String, f64),
     /// The sky would be darker than nothing or brighter than the program
     /// takes.
     #[error("--sky {0}: a zenith luminance of {1} cd/m² is out of range (more than 0, at most {max:e})", max = MAX_EMISSION / PI)]
@@ -270,7 +288,14 @@ impl DaylightSky {
         north: f64,
     ) -> Result<DaylightSky, DaylightError> {
         let sun = if model.needs_sun() {
-            Some(sun.ok_or_else(|| DaylightError::NoSun(model.name()))?)
+            let sun = sun.ok_or_else(|| DaylightError::NoSun(model.name()))?;
+            if sun.altitude < 0.0 {
+                return Err(DaylightError::SunBelowHorizon(
+                    model.name(),
+                    sun.altitude.to_degrees(),
+                ));
+            }
+            Some(sun)
         } else {
             None
         };

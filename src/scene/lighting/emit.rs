@@ -213,8 +213,12 @@ impl Material {
 
 impl Scene {
     /// True when some polygon's material emits (its emission is not
-    /// black). Unused emitting materials do not count.
+    /// black), or the scene has a sun ([`Scene::sun`]). Unused emitting
+    /// materials do not count.
     pub fn emits(&self) -> bool {
+        if self.sun.is_some() {
+            return true;
+        }
         let emitting: Vec<bool> = self
             .materials
             .iter()

@@ -714,6 +714,7 @@ fn two_sided_scene(
         warnings,
         groups: GroupScan::finish(groups),
         luminaires: Vec::new(),
+        sun: None,
     };
     if let Some(warning) = scene.drop_duplicates(file) {
         scene.warnings.push(warning);

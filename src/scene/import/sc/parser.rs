@@ -951,6 +951,7 @@ impl<'a> Parser<'a> {
             warnings: Vec::new(),
             groups: Vec::new(),
             luminaires: Vec::new(),
+            sun: None,
         })
     }
 
