@@ -97,13 +97,5 @@ fn standard_skies_refuse_what_they_cannot_use() {
             "--sun must look like",
         ),
     ];
-    for (args, says) in cases {
-        let out = run_in(
-            dir.path(),
-            &[&["floor.sc", "-o", "f.png"][..], args].concat(),
-        );
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
-        assert!(!dir.path().join("f.png").exists(), "{args:?}");
-    }
+    assert_refused(dir.path(), &cases);
 }

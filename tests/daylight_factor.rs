@@ -158,14 +158,7 @@ fn the_daylight_factor_needs_a_work_plane_and_the_overcast_sky() {
             "--daylight-factor needs --sky cie-overcast",
         ),
     ];
-    for (args, says) in cases {
-        let out = run_in(
-            dir.path(),
-            &[&["floor.sc", "-o", "f.png"][..], args].concat(),
-        );
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
-    }
+    assert_refused(dir.path(), &cases);
 }
 
 /// The bundled side-lit office, as the guide runs it: the daylight factor

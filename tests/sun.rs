@@ -241,15 +241,7 @@ fn the_sun_refuses_what_it_cannot_use() {
             "--sky cie-clear needs the sun above the horizon",
         ),
     ];
-    for (args, says) in cases {
-        let out = run_in(
-            dir.path(),
-            &[&["floor.sc", "-o", "f.png"][..], args].concat(),
-        );
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
-        assert!(!dir.path().join("f.png").exists(), "{args:?}");
-    }
+    assert_refused(dir.path(), &cases);
     // Under cie:2 the sun only shapes the sky: it runs, and the floor
     // gets the sky's 10,000 lx alone.
     let out = run_floor(dir.path(), &["--sky", "cie:2", "--sun", "180,40"]);

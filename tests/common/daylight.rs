@@ -29,3 +29,16 @@ pub fn run_floor(dir: &Path, sky: &[&str]) -> Output {
     .concat();
     run_in(dir, &args)
 }
+
+/// Runs `floor.sc` (already written into `dir`) with each case's options
+/// and checks the run is refused as bad usage: exit 2, the error saying
+/// the case's text, and no picture written.
+pub fn assert_refused(dir: &Path, cases: &[(&[&str], &str)]) {
+    for (args, says) in cases {
+        let out = run_in(dir, &[&["floor.sc", "-o", "f.png"][..], args].concat());
+        let err = super::stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!dir.join("f.png").exists(), "{args:?}");
+    }
+}
