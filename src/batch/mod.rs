@@ -635,7 +635,7 @@ impl Results<'_, '_> {
         }
         if config.wants_lightmap() {
             cancel.check()?;
-            write_lightmap(config, prepared, solved, exposure, written)?;
+            write_lightmap(config, prepared, solved, exposure, written, cancel)?;
         }
         if let Some(path) = &config.log {
             cancel.check()?;
@@ -672,6 +672,7 @@ fn write_lightmap(
     solved: &Solved<'_>,
     exposure: f32,
     written: &mut Written,
+    cancel: &Cancel,
 ) -> Result<(), RunError> {
     use output::lightmap;
     let t = Instant::now();
@@ -699,8 +700,14 @@ fn write_lightmap(
         &solved.shown,
         &solved.radiosity,
         config.lightmap_density,
+        cancel,
     )
-    .map_err(|why| RunError::Options(format!("cannot bake the lightmap: {why}")))?;
+    .map_err(|why| match why {
+        lightmap::BakeError::Cancelled(c) => RunError::from(c),
+        lightmap::BakeError::Layout(why) => {
+            RunError::Options(format!("cannot bake the lightmap: {why}"))
+        }
+    })?;
     let layout = &baked.layout;
     if config.progress {
         let how = match (layout.generated, config.lightmap_density) {

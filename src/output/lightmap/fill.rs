@@ -16,6 +16,7 @@
 //! stay black.
 
 use super::locate::{barycentric, Locator};
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::render::Frame;
 use crate::scene::import::gltf::source::SourceModel;
@@ -71,14 +72,16 @@ struct Assigned {
 
 /// Fills a `width × height` lightmap of `model` (whose primitives all have
 /// `uv1`) from the solution `locator` reads. `scene` gives the polygons'
-/// emission and reflectance for the irradiance.
+/// emission and reflectance for the irradiance. Stops within a texel's
+/// work per thread once `cancel` is set ([`Cancelled`]).
 pub fn fill(
     model: &SourceModel,
     width: u32,
     height: u32,
     locator: &Locator<'_>,
     scene: &Scene,
-) -> Texture {
+    cancel: &Cancel,
+) -> Result<Texture, Cancelled> {
     let (w, h) = (width as usize, height as usize);
     let mut assigned: Vec<Option<Assigned>> = vec![None; w * h];
     let size = Vec2::new(width as f32, height as f32);
@@ -147,6 +150,9 @@ pub fn fill(
         .par_iter()
         .map(|a| {
             let a = (*a)?;
+            if cancel.is_set() {
+                return None;
+            }
             let s = locator.sample(a.point, a.normal)?;
             let (rho, emission) = reflectance[s.polygon.index()];
             let arriving = s.radiosity - emission;
@@ -159,6 +165,7 @@ pub fn fill(
             Some((s.shown.to_f32(), irradiance.to_f32()))
         })
         .collect();
+    cancel.check()?;
     let unmatched = assigned
         .iter()
         .zip(&values)
@@ -188,12 +195,12 @@ pub fn fill(
         }
         f
     };
-    Texture {
+    Ok(Texture {
         shown: frame(shown),
         irradiance: frame(irradiance),
         owner,
         unmatched,
-    }
+    })
 }
 
 /// One ring of dilation: every empty texel with filled neighbours (of the

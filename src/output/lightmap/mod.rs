@@ -53,6 +53,7 @@ pub mod uv;
 mod tests;
 
 use super::{write_atomically, OutputError};
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::render::{to_srgb8, Exposure};
@@ -79,12 +80,27 @@ pub struct Baked {
     pub texture: Texture,
 }
 
+/// Why [`bake`] made no lightmap.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BakeError {
+    /// The layout is impossible: too dense for the largest texture, or a
+    /// model with no surface.
+    #[error("{0}")]
+    Layout(String),
+    /// The bake's [`Cancel`] was set.
+    #[error("interrupted")]
+    Cancelled(#[from] Cancelled),
+}
+
 /// Lays out and fills the lightmap of `model` from the solution: `mesh`
 /// (built from `scene`, with `visibility` over its polygons), `shown` (the
 /// radiosity the picture draws) and `radiosity` (the solved), one value
 /// per mesh vertex. `density` is texels per scene unit (`None`: the
 /// default, see [`uv::lay_out`]). Errors say why the layout is
-/// impossible (too dense, or a model with no surface).
+/// impossible (too dense, or a model with no surface), or that `cancel`
+/// was set: the layout runs to its end, the filling stops within a
+/// texel's work.
+#[allow(clippy::too_many_arguments)]
 pub fn bake(
     mut model: SourceModel,
     scene: &Scene,
@@ -93,10 +109,12 @@ pub fn bake(
     shown: &[Rgb],
     radiosity: &[Rgb],
     density: Option<f32>,
-) -> Result<Baked, String> {
-    let layout = uv::lay_out(&mut model, density)?;
+    cancel: &Cancel,
+) -> Result<Baked, BakeError> {
+    let layout = uv::lay_out(&mut model, density).map_err(BakeError::Layout)?;
+    cancel.check()?;
     let locator = locate::Locator::new(scene, mesh, visibility, shown, radiosity);
-    let texture = fill::fill(&model, layout.width, layout.height, &locator, scene);
+    let texture = fill::fill(&model, layout.width, layout.height, &locator, scene, cancel)?;
     Ok(Baked {
         model,
         layout,

@@ -6,6 +6,7 @@ use super::fill::{fill, nearest_on_triangle, REACH};
 use super::locate::{barycentric, Locator};
 use super::model::scene_model;
 use super::uv::{lay_out, PADDING};
+use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
 use crate::scene::import::gltf::source::{SourceModel, SourcePrimitive};
 use crate::testutil::{cuboid, grey, polygon, regular_mesh, scene};
@@ -115,7 +116,7 @@ fn every_texel_holds_the_light_of_the_point_it_stands_for() {
     let visibility = Visibility::new(&s);
     let locator = Locator::new(&s, &mesh, &visibility, &radiosity, &radiosity);
     let model = two_chart_floor();
-    let texture = fill(&model, 256, 256, &locator, &s);
+    let texture = fill(&model, 256, 256, &locator, &s, &Cancel::never()).unwrap();
     assert_eq!(texture.unmatched, 0);
     let size = Vec2::splat(256.0);
     let mut inside = 0;
@@ -167,7 +168,7 @@ fn both_sides_of_a_seam_show_the_same_light() {
     let visibility = Visibility::new(&s);
     let locator = Locator::new(&s, &mesh, &visibility, &radiosity, &radiosity);
     let model = two_chart_floor();
-    let texture = fill(&model, 256, 256, &locator, &s);
+    let texture = fill(&model, 256, 256, &locator, &s, &Cancel::never()).unwrap();
     let size = Vec2::splat(256.0);
     let (a, b) = (&model.primitives[0], &model.primitives[1]);
     // The shared edge runs from corner 0 to corner 2 of A, corner 0 to
@@ -240,7 +241,15 @@ fn no_chart_reads_a_texel_of_another() {
     let mut model = scene_model(&s, "box");
     let layout = lay_out(&mut model, Some(24.0)).unwrap();
     assert!(layout.generated && layout.charts >= 6, "{layout:?}");
-    let texture = fill(&model, layout.width, layout.height, &locator, &s);
+    let texture = fill(
+        &model,
+        layout.width,
+        layout.height,
+        &locator,
+        &s,
+        &Cancel::never(),
+    )
+    .unwrap();
     assert_eq!(texture.unmatched, 0);
     let labels = chart_labels(&model);
     let size = Vec2::new(layout.width as f32, layout.height as f32);
@@ -339,4 +348,25 @@ fn probes_are_sized_by_the_model_not_by_the_sky_around_it() {
         let want = light_at(p);
         assert!((sample.radiosity.r - want).abs() < 1e-4 * want, "{x}");
     }
+}
+
+/// A bake whose cancel is set stops filling and says so, and the same
+/// bake not cancelled fills every texel it lays out: the fill consults
+/// the token, so an interrupt during a large bake is honoured within a
+/// texel's work rather than after the whole texture.
+#[test]
+fn a_cancelled_fill_stops_and_says_so() {
+    let s = floor_scene();
+    let (mesh, radiosity) = linear_solution(&s, 0.25);
+    let visibility = Visibility::new(&s);
+    let locator = Locator::new(&s, &mesh, &visibility, &radiosity, &radiosity);
+    let model = two_chart_floor();
+    let cancel = Cancel::new();
+    cancel.set();
+    assert_eq!(
+        fill(&model, 256, 256, &locator, &s, &cancel).err(),
+        Some(Cancelled)
+    );
+    let whole = fill(&model, 256, 256, &locator, &s, &Cancel::new()).unwrap();
+    assert!(whole.shown.covered.iter().any(|&c| c));
 }
