@@ -8,21 +8,8 @@ use common::*;
 
 /// The `work plane at ...` line a run printed, as (Eavg, Emin, Emax).
 fn workplane_figures(out: &std::process::Output) -> (f64, f64, f64) {
-    let text = String::from_utf8_lossy(&out.stdout);
-    let line = text
-        .lines()
-        .find(|l| l.starts_with("work plane at"))
-        .unwrap_or_else(|| panic!("no work plane line in {text:?} ({})", stderr(out)));
-    let value = |key: &str| -> f64 {
-        let at = line.find(key).unwrap_or_else(|| panic!("{key} in {line}")) + key.len();
-        line[at..]
-            .split_whitespace()
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap()
-    };
-    (value("Eavg "), value("Emin "), value("Emax "))
+    let figure = |key| printed_figure(out, "work plane at", key);
+    (figure("Eavg "), figure("Emin "), figure("Emax "))
 }
 
 /// The horizontal illuminance of an unobstructed floor under a standard

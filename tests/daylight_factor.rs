@@ -9,21 +9,8 @@ use common::*;
 
 /// The `DF mean … %, DF min … %` figures a run printed.
 fn daylight_factors(out: &std::process::Output) -> (f64, f64) {
-    let text = String::from_utf8_lossy(&out.stdout);
-    let line = text
-        .lines()
-        .find(|l| l.starts_with("daylight factor at"))
-        .unwrap_or_else(|| panic!("no daylight factor line in {text:?} ({})", stderr(out)));
-    let value = |key: &str| -> f64 {
-        let at = line.find(key).unwrap_or_else(|| panic!("{key} in {line}")) + key.len();
-        line[at..]
-            .split_whitespace()
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap()
-    };
-    (value("DF mean "), value("DF min "))
+    let figure = |key| printed_figure(out, "daylight factor at", key);
+    (figure("DF mean "), figure("DF min "))
 }
 
 /// Under an open roof every point sees the whole sky: a daylight factor

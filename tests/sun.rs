@@ -10,18 +10,7 @@ use std::f64::consts::PI;
 
 /// The `work plane at ...` line's Eavg.
 fn eavg(out: &std::process::Output) -> f64 {
-    let text = String::from_utf8_lossy(&out.stdout);
-    let line = text
-        .lines()
-        .find(|l| l.starts_with("work plane at"))
-        .unwrap_or_else(|| panic!("no work plane line in {text:?} ({})", stderr(out)));
-    let at = line.find("Eavg ").unwrap() + 5;
-    line[at..]
-        .split_whitespace()
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap()
+    printed_figure(out, "work plane at", "Eavg ")
 }
 
 /// An open floor under the sun alone receives its direct light on the

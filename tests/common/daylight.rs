@@ -42,3 +42,23 @@ pub fn assert_refused(dir: &Path, cases: &[(&[&str], &str)]) {
         assert!(!dir.join("f.png").exists(), "{args:?}");
     }
 }
+
+/// The number after `key` (e.g. `"Eavg "`) on the first line of the run's
+/// standard output that starts with `line` (e.g. `"work plane at"`);
+/// panics, with the output, when either is missing.
+pub fn printed_figure(out: &Output, line: &str, key: &str) -> f64 {
+    let text = String::from_utf8_lossy(&out.stdout);
+    let found = text
+        .lines()
+        .find(|l| l.starts_with(line))
+        .unwrap_or_else(|| panic!("no {line:?} line in {text:?} ({})", super::stderr(out)));
+    let at = found
+        .find(key)
+        .unwrap_or_else(|| panic!("no {key:?} in {found}"))
+        + key.len();
+    found[at..]
+        .split_whitespace()
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number after {key:?} in {found}"))
+}
