@@ -276,6 +276,9 @@ pub struct RunStats {
     pub clear_shaft_fraction: f64,
     /// Unshot power left as a fraction of the emitted power.
     pub unshot_fraction: f64,
+    /// Particles the last solve's tail traced (`--tail`), 0 when it
+    /// shot to the end.
+    pub particles: u64,
     /// The exposure the 8-bit picture and the exported display colours
     /// used (dimensionless): `auto_exposure × 2^exposure_stops`.
     pub exposure: f32,
@@ -824,6 +827,7 @@ fn run_stats(
             0.0
         },
         unshot_fraction: session.unshot_fraction(),
+        particles: session.solver().particles(),
         exposure,
         auto_exposure: auto,
         exposure_stops: config.exposure.stops(auto),
@@ -1008,6 +1012,14 @@ pub fn summary(stats: &RunStats) -> String {
             first.vertices, stats.vertices, stats.steps
         ),
         _ => format!("{} steps", stats.steps),
+    };
+    let steps = if stats.particles > 0 {
+        format!(
+            "{steps} (the tail by {:.1} M particles)",
+            stats.particles as f64 / 1e6
+        )
+    } else {
+        steps
     };
     let mut written = stats.output.clone();
     for also in &stats.also_written {

@@ -7,8 +7,8 @@
 
 use super::values::{
     parse_emit, parse_eye, parse_fov, parse_hemicube_res, parse_ies, parse_look_at, parse_north,
-    parse_number, parse_shooter_samples, parse_size, parse_sky, parse_sun, parse_up, parse_whole,
-    parse_workplane, SkyArg, SunArg,
+    parse_number, parse_shooter_samples, parse_size, parse_sky, parse_sun, parse_tail,
+    parse_tail_particles, parse_up, parse_whole, parse_workplane, SkyArg, SunArg,
 };
 use crate::color::Rgb;
 use crate::config;
@@ -17,7 +17,7 @@ use crate::mesh::DEFAULT_INSET;
 use crate::render::antialias;
 use crate::solver::hemicube::HemicubeRes;
 use crate::solver::tuning::{DEFAULT_SETTLE, DEFAULT_THRESHOLD};
-use crate::solver::{FormFactorMethod, Heuristic, ShooterSamples, UnshotScheme};
+use crate::solver::{FormFactorMethod, Heuristic, ShooterSamples, TailOption, UnshotScheme};
 use std::path::PathBuf;
 
 /// The exit codes, shown after both the short and the long help.
@@ -135,6 +135,32 @@ pub struct Args {
     #[arg(long, value_name = "N|all", default_value = "64", value_parser = parse_shooter_samples)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) shooter_samples: ShooterSamples,
+
+    /// When particles carry the light left unshot: `auto`, `off` or an
+    /// unshot fraction.
+    ///
+    /// Once the unshot power falls to the fraction, the light left is shot
+    /// from every surface at once by tracing particles through all their
+    /// bounces, in four steps, instead of by thousands of shooting steps
+    /// each carrying one cluster's sliver of it. It adds noise in the
+    /// share of each point's light that was left (the fraction over one
+    /// minus the reflectance, spread over the model). `auto` (the
+    /// default) turns it on from 0.03 on meshes of 100,000 element
+    /// vertices or more; `off` shoots to the end.
+    // The literals are crate::solver::tuning::TAIL_AUTO_FROM and
+    // TAIL_AUTO_VERTICES; a unit test keeps them equal.
+    #[arg(long, value_name = "F|auto|off", default_value = "auto", value_parser = parse_tail)]
+    #[arg(help_heading = heading::SOLVER)]
+    pub(crate) tail: TailOption,
+
+    /// Particles the tail traces in all, per element vertex.
+    ///
+    /// The noise of the light the tail carries falls as one over the
+    /// square root of this.
+    // The literal is crate::solver::tuning::TAIL_PARTICLES_PER_VERTEX.
+    #[arg(long, value_name = "N", default_value = "16", value_parser = parse_tail_particles)]
+    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
+    pub(crate) tail_particles: f64,
 
     /// Pixels across a hemicube's top face (--form-factor hemicube).
     ///

@@ -366,6 +366,8 @@ impl TryFrom<Args> for Invocation {
                 // A window asks for parts ([`crate::viewer`]); a batch run
                 // has no picture between steps.
                 part_budget: None,
+                tail: args.tail,
+                tail_particles: args.tail_particles,
             },
             size: args.size,
             exposure,

@@ -9,7 +9,7 @@ use crate::scene::{
     MAX_EMISSION, MAX_SUN_LUX,
 };
 use crate::solver::hemicube::HemicubeRes;
-use crate::solver::ShooterSamples;
+use crate::solver::{ShooterSamples, TailOption};
 
 /// An option value that does not parse. clap prints the message after its
 /// own `invalid value 'TEXT' for '--OPTION <NAME>': `; it is still a whole
@@ -22,6 +22,12 @@ pub enum ValueError {
     /// `--shooter-samples` is neither `all` nor a whole number at least 1.
     #[error("--shooter-samples must be `all` or a whole number >= 1, got `{0}`")]
     ShooterSamples(String),
+    /// `--tail` is neither `auto`, `off` nor a fraction in `[0, 1]`.
+    #[error("--tail must be `auto`, `off` or a fraction from 0 to 1 (like 0.03), got `{0}`")]
+    Tail(String),
+    /// `--tail-particles` is not a number above 0 and at most 10⁶.
+    #[error("--tail-particles must be a number above 0 and at most 1e6 (like 16), got `{0}`")]
+    TailParticles(String),
     /// `--emit` is not `NAME=VALUE` with a non-empty name and a radiosity
     /// `V` or `R,G,B`, each channel a number from 0 to
     /// [`MAX_EMISSION`].
@@ -296,6 +302,29 @@ pub fn parse_shooter_samples(text: &str) -> Result<ShooterSamples, ValueError> {
     match text.parse::<u32>() {
         Ok(n) if n >= 1 => Ok(ShooterSamples::AtMost(n)),
         _ => Err(ValueError::ShooterSamples(text.to_string())),
+    }
+}
+
+/// Parses `--tail`: `auto`, `off`, or the unshot fraction from which the
+/// particle tail carries the light left, in `[0, 1]`.
+pub fn parse_tail(text: &str) -> Result<TailOption, ValueError> {
+    match text {
+        "auto" => Ok(TailOption::Auto),
+        "off" => Ok(TailOption::Off),
+        _ => match text.parse::<f64>() {
+            Ok(f) if (0.0..=1.0).contains(&f) => Ok(TailOption::From(f)),
+            _ => Err(ValueError::Tail(text.to_string())),
+        },
+    }
+}
+
+/// Parses `--tail-particles`: particles per element vertex, above 0 and
+/// at most 10⁶ (beyond, one tail of a large model would trace more
+/// particles than a day allows).
+pub fn parse_tail_particles(text: &str) -> Result<f64, ValueError> {
+    match text.parse::<f64>() {
+        Ok(n) if n > 0.0 && n <= 1e6 => Ok(n),
+        _ => Err(ValueError::TailParticles(text.to_string())),
     }
 }
 

@@ -118,6 +118,12 @@ pub trait Method<'a> {
     /// them needed no shadow ray at all.
     fn receiver_pairs(&self) -> (u64, u64);
 
+    /// Particles the method's particle tail has traced so far
+    /// ([`super::step::tail`]); 0 for a method without one.
+    fn particles(&self) -> u64 {
+        0
+    }
+
     /// The mesh it solves on.
     fn mesh(&self) -> &Mesh;
 

@@ -236,6 +236,28 @@ pub struct SolverOptions {
     /// The finished step is bit-identical to one in a piece; `None` (the
     /// default) runs every step in one piece.
     pub part_budget: Option<std::time::Duration>,
+    /// When the light left unshot is carried by particles instead of
+    /// shooting steps ([`step::tail`]).
+    pub tail: TailOption,
+    /// Particles the tail traces over all its steps, per element vertex,
+    /// `> 0` ([`tuning::TAIL_PARTICLES_PER_VERTEX`] by default).
+    pub tail_particles: f64,
+}
+
+/// When a solve hands the light left unshot to the particle tail
+/// ([`step::tail`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TailOption {
+    /// Never: shooting steps to the end (the brute-force twin).
+    Off,
+    /// From [`tuning::TAIL_AUTO_FROM`] of the emitted power on meshes of
+    /// at least [`tuning::TAIL_AUTO_VERTICES`] element vertices, where
+    /// the last light spread thin costs a shooting solve most of its
+    /// steps; never on smaller ones, whose shooting tails are short.
+    Auto,
+    /// Once the unshot power is at most this fraction of the emitted, in
+    /// `[0, 1]`.
+    From(f64),
 }
 
 /// Where unshot radiosity is kept between shooting steps.
@@ -265,6 +287,8 @@ impl Default for SolverOptions {
             unshot: UnshotScheme::Vertex,
             hemicube_res: hemicube::HemicubeRes::default(),
             part_budget: None,
+            tail: TailOption::Auto,
+            tail_particles: tuning::TAIL_PARTICLES_PER_VERTEX,
         }
     }
 }
@@ -307,6 +331,11 @@ pub struct StepReport {
     pub part: u32,
     /// Whether the step is finished (always, without a part budget).
     pub complete: bool,
+    /// Particles traced: 0 for a shooting step, the count of a tail step
+    /// ([`step::tail`]), which shoots every polygon's share at once
+    /// (`shooter` is then the polygon that held the most of it, `rays`
+    /// the particles' rays).
+    pub particles: u64,
 }
 
 /// A solver state that breaks [`Progressive`]'s invariants: found by
@@ -531,6 +560,8 @@ pub struct Progressive<'a> {
     /// The scene's sun, whose direct light the solve starts from
     /// ([`sun`]); `None` without one.
     sun: Option<sun::SunShot>,
+    /// The particle tail's settings and tables ([`step::tail`]).
+    tail: step::tail::Tail,
 }
 
 /// The scans over every vertex that choosing a step, checking for
@@ -689,6 +720,7 @@ impl<'a> Progressive<'a> {
             state: 0,
             scans: std::sync::Mutex::new(Scans::default()),
             sun: sun::SunShot::for_scene(scene),
+            tail: step::tail::Tail::new(options.tail, options.tail_particles, scene, mesh),
         };
         solver.receive_sun();
         solver.initial_unshot_power = solver.unshot_power();
@@ -883,6 +915,12 @@ impl<'a> Progressive<'a> {
     /// them had a clear shaft (no ray cast at all).
     pub fn receiver_pairs(&self) -> (u64, u64) {
         (self.receiver_pairs, self.clear_receiver_pairs)
+    }
+
+    /// Particles the tail has traced in this solve ([`step::tail`]; not
+    /// kept in a checkpoint).
+    pub fn particles(&self) -> u64 {
+        self.tail.particles
     }
 
     /// Why the solve should stop now, or `None` to go on (always while a
@@ -1126,6 +1164,7 @@ impl<'a> Progressive<'a> {
         self.last_fraction = self.unshot_fraction();
         self.steps = state.steps;
         self.rays = state.rays;
+        self.tail.restart();
         Ok(())
     }
 }

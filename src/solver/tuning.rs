@@ -19,6 +19,7 @@
 //! | gathering from a cluster | `step::gather_cluster`, `accel::cluster` | [`WEAK_STRATUM_SHARE`], [`STRATUM_NEAR_RATIO`], [`PLANE_DEPTH_RATIO`], [`TOP_DEPTH_RATIO`], [`RESTING_NEAR_FACTOR`], [`RESTING_TOLERANCE`] |
 //! | delivering a step in parts | `step::parts` | [`CHUNK_WORK`], [`PIECE_WORK`], [`CHUNK_GROWTH`], [`PIECE_GROWTH`], [`CHUNK_TARGET`], [`NEAR_WEIGHT`], [`WINDOW_PART_BUDGET`] |
 //! | the hemicube | `hemicube` | [`DEFAULT_HEMICUBE_RES`], [`HEMICUBE_EDGE_SLACK`], [`HEMICUBE_NEAR_FRACTION`] |
+//! | the particle tail | `step::tail` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
 //!
 //! Structural constants (how many ray slots a cluster step keeps, the
 //! sub-cell grid's side, file-format fields) stay with the code whose
@@ -454,6 +455,45 @@ pub const HEMICUBE_EDGE_SLACK: f32 = 1e-6;
 /// `1/w` stays finite in `f32`.
 pub const HEMICUBE_NEAR_FRACTION: f32 = 1e-5;
 
+/// The unshot fraction at which an automatic tail ([`super::TailOption::Auto`])
+/// takes over from the shooting steps ([`super::step::tail`]). The light
+/// left then is spread over the whole model, where shooting steps each
+/// carry a sliver of it; particles carry it all, with noise in the
+/// share of each vertex's light it makes up.
+pub const TAIL_AUTO_FROM: f64 = 0.03;
+
+/// Element vertices from which an automatic tail is on: below it a
+/// shooting solve's tail takes seconds, and the bundled and generated
+/// scenes keep their noise-free answers.
+pub const TAIL_AUTO_VERTICES: u64 = 100_000;
+
+/// Particles the tail traces over all its steps, per element vertex, by
+/// default (`--tail-particles`).
+pub const TAIL_PARTICLES_PER_VERTEX: f64 = 16.0;
+
+/// Steps over which the tail shoots the light left: each an equal share
+/// of it, so the picture moves between them.
+pub const TAIL_STEPS: u32 = 4;
+
+/// Particles traced by one task: their deposits are summed in task
+/// order, so the bits do not depend on the thread count.
+pub const TAIL_CHUNK: u64 = 1024;
+
+/// Tasks run together between checks for an interrupt; their deposits
+/// are held until summed (about 100 kB a task).
+pub const TAIL_BATCH: u64 = 64;
+
+/// Bounces a particle takes at most: Russian roulette ends nearly every
+/// path long before (a path survives 200 bounces of the most reflective
+/// surface allowed with odds of 1 in 30,000), this only bounds a path
+/// that cannot end.
+pub const TAIL_MAX_BOUNCES: u32 = 200;
+
+/// The most a particle's survival odds at a bounce can be: a surface that
+/// reflects nearly all light would otherwise keep paths going for
+/// thousands of bounces.
+pub const TAIL_SURVIVAL_MAX: f64 = 0.95;
+
 /// Which phase of a step reads a constant of [`INDEX`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
@@ -471,6 +511,8 @@ pub enum Phase {
     Parts,
     /// The hemicube method.
     Hemicube,
+    /// The particle tail.
+    Tail,
 }
 
 /// One constant of the index: its name, the phase that reads it, and its
@@ -762,6 +804,46 @@ pub const INDEX: &[Tuned] = &[
         name: "HEMICUBE_NEAR_FRACTION",
         phase: Phase::Hemicube,
         value: HEMICUBE_NEAR_FRACTION as f64,
+    },
+    Tuned {
+        name: "TAIL_AUTO_FROM",
+        phase: Phase::Tail,
+        value: TAIL_AUTO_FROM,
+    },
+    Tuned {
+        name: "TAIL_AUTO_VERTICES",
+        phase: Phase::Tail,
+        value: TAIL_AUTO_VERTICES as f64,
+    },
+    Tuned {
+        name: "TAIL_PARTICLES_PER_VERTEX",
+        phase: Phase::Tail,
+        value: TAIL_PARTICLES_PER_VERTEX,
+    },
+    Tuned {
+        name: "TAIL_STEPS",
+        phase: Phase::Tail,
+        value: TAIL_STEPS as f64,
+    },
+    Tuned {
+        name: "TAIL_CHUNK",
+        phase: Phase::Tail,
+        value: TAIL_CHUNK as f64,
+    },
+    Tuned {
+        name: "TAIL_BATCH",
+        phase: Phase::Tail,
+        value: TAIL_BATCH as f64,
+    },
+    Tuned {
+        name: "TAIL_MAX_BOUNCES",
+        phase: Phase::Tail,
+        value: TAIL_MAX_BOUNCES as f64,
+    },
+    Tuned {
+        name: "TAIL_SURVIVAL_MAX",
+        phase: Phase::Tail,
+        value: TAIL_SURVIVAL_MAX,
     },
 ];
 

@@ -300,6 +300,15 @@ impl UnshotField {
         }
     }
 
+    /// Scales every value by `k` (in `[0, 1]`): what a step that shot
+    /// `1 − k` of every polygon's unshot light at once leaves
+    /// ([`crate::solver::step::tail`]).
+    pub(crate) fn scale(&mut self, k: f64) {
+        for v in &mut self.values {
+            *v *= k;
+        }
+    }
+
     /// Area-weighted mean unshot radiosity of polygon `j`.
     pub(crate) fn mean(&self, mesh: &Mesh, j: usize) -> Rgb {
         match &self.layout {
@@ -876,6 +885,7 @@ fn point_source(mesh: &Mesh, pm: &PolygonMesh, p: glam::Vec3) -> SampleSource {
 
 /// A polygon's element triangles binned by their bounds in its plane, to
 /// find the triangles that may hold a point without looking at the rest.
+#[derive(Debug)]
 struct Locator {
     /// Every element triangle of the polygon, in element order.
     triangles: Vec<[crate::mesh::VertexId; 3]>,
@@ -978,6 +988,35 @@ impl Locator {
                 SampleSource::Triangle(self.triangles[k as usize].map(|v| v.0), w)
             }
             _ => point_source(mesh, pm, p),
+        }
+    }
+}
+
+/// A polygon's element triangles binned in its plane, to find the one
+/// holding a point: where a particle of the tail lands
+/// ([`crate::solver::step::tail`]).
+#[derive(Debug)]
+pub(crate) struct TriangleLocator(Locator);
+
+impl TriangleLocator {
+    /// The locator of polygon mesh `pm` of `mesh`.
+    pub(crate) fn new(mesh: &Mesh, pm: &PolygonMesh) -> TriangleLocator {
+        TriangleLocator(Locator::new(mesh, pm))
+    }
+
+    /// The element triangle of `pm` holding `p` (or nearest to holding it,
+    /// when rounding puts `p` a hair outside them all): its corners and
+    /// `p`'s barycentric weights there; `None` for a polygon without
+    /// triangles.
+    pub(crate) fn find(
+        &self,
+        mesh: &Mesh,
+        pm: &PolygonMesh,
+        p: glam::Vec3,
+    ) -> Option<([u32; 3], [f32; 3])> {
+        match self.0.source(mesh, pm, p) {
+            SampleSource::Triangle(t, w) => Some((t, w)),
+            _ => None,
         }
     }
 }

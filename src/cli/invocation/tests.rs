@@ -128,6 +128,8 @@ fn every_option_reaches_the_config() {
             unshot: UnshotScheme::Vertex,
             hemicube_res: crate::solver::hemicube::HemicubeRes::default(),
             part_budget: None,
+            tail: crate::solver::TailOption::Auto,
+            tail_particles: crate::solver::tuning::TAIL_PARTICLES_PER_VERTEX,
         }
     );
     assert_eq!(c.size, Some((32, 24)));

@@ -62,6 +62,10 @@ impl<'a> Method<'a> for Progressive<'a> {
         Progressive::receiver_pairs(self)
     }
 
+    fn particles(&self) -> u64 {
+        Progressive::particles(self)
+    }
+
     fn mesh(&self) -> &Mesh {
         Progressive::mesh(self)
     }

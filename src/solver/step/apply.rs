@@ -104,6 +104,7 @@ impl<'a> Progressive<'a> {
             clear_receivers: u.clear,
             part: u.part,
             complete,
+            particles: 0,
         }
     }
 

@@ -27,6 +27,7 @@ pub mod gather;
 pub mod gather_cluster;
 pub mod parts;
 pub mod read;
+pub mod tail;
 
 /// A step begun: what it shoots, how, and how far it has got.
 #[derive(Clone, Debug)]
@@ -136,6 +137,9 @@ impl<'a> Progressive<'a> {
         // A step's first part counts choosing the shooter and reading it
         // (building its strata) against its budget.
         let start = std::time::Instant::now();
+        if self.underway.is_none() && self.tail_due() {
+            return self.tail_step(cancel);
+        }
         if self.underway.is_none() {
             let chosen = self.choose_step()?;
             self.underway = Some(self.begin_chosen(chosen)?);

@@ -27,6 +27,7 @@ mod parts;
 mod resting;
 mod settle;
 mod sky;
+mod tail;
 mod visibility;
 
 /// Exact form factor between two coaxial parallel unit squares one unit

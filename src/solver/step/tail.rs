@@ -1,0 +1,559 @@
+//! The particle tail: once little light is left unshot, a step carries
+//! a share of all of it at once by tracing particles, every bounce.
+//!
+//! Progressive shooting converges fast while a few polygons hold most of
+//! the unshot power, and slowly once the light is spread thin over the
+//! whole model: then each step shoots one cluster's sliver to every
+//! receiver. On a 260,000-vertex room that reflects 0.8, about a thousand
+//! such steps took the last 27 % of the light to 0.1 %. A tail step
+//! instead shoots the unshot radiosity of every polygon together, as
+//! particles (Pattanaik and Mudur 1993; Bekaert's stochastic radiosity
+//! and RenderPark's random walks use the same collision estimator):
+//!
+//! - a particle starts on an element triangle chosen in proportion to its
+//!   unshot power (area times the mean of its corners' `|Δb|`), at a
+//!   uniform point of it, carrying the unshot radiosity interpolated
+//!   there times the power's share (signed: light sent ahead comes back
+//!   as negative particles, [`crate::solver::unshot::Shot`]);
+//! - it leaves in a cosine-weighted direction, and where it first lands
+//!   on the front of a reflecting polygon the power reflected there,
+//!   `ρ · Φ`, is added to the corners of the element triangle it landed
+//!   in, by their barycentric weights;
+//! - it then goes on from there with the reflected power, by Russian
+//!   roulette (survival the largest channel of `ρ`, at most
+//!   [`TAIL_SURVIVAL_MAX`]), until it is absorbed or leaves the model.
+//!
+//! A vertex's radiosity rises by what landed on it over the area its
+//! weight stands for (the integral of its Gouraud hat, a third of each
+//! triangle round it): the expected value is the reflected light
+//! averaged over that hat, the same light the shooting steps put at the
+//! vertex itself, smoothed over its neighbours. The noise falls as one
+//! over the square root of the particles; they are
+//! [`TAIL_PARTICLES_PER_VERTEX`] per element vertex
+//! by default over the whole tail, in [`TAIL_STEPS`] steps (each shoots
+//! an equal share of what was unshot when the tail began, so the picture
+//! moves between them).
+//!
+//! Every particle's random numbers come from its own index, and the
+//! particles' deposits are summed in particle order, so the bits do not
+//! depend on the thread count. The brute-force twin is the shooting
+//! steps themselves (`--tail off`); `src/solver/tests/tail.rs` checks the
+//! tail against them, against the uniform enclosure's closed form and for
+//! energy balance.
+
+use crate::color::Rgb;
+use crate::mesh::Mesh;
+use crate::scene::{PolygonId, Scene};
+use crate::solver::accel::shared::ALONE;
+use crate::solver::tuning::{
+    TAIL_BATCH, TAIL_CHUNK, TAIL_MAX_BOUNCES, TAIL_PARTICLES_PER_VERTEX, TAIL_STEPS,
+    TAIL_SURVIVAL_MAX,
+};
+use crate::solver::unshot::TriangleLocator;
+use crate::solver::{Progressive, StepReport, TailOption};
+use crate::visibility::Visibility;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
+
+/// The tail's settings and what it has done: where it starts, how many
+/// particles it traces, and its tables (built at its first step).
+#[derive(Debug)]
+pub(in crate::solver) struct Tail {
+    /// The unshot fraction at or below which it takes over, `None` when
+    /// it is off.
+    pub(in crate::solver) from: Option<f64>,
+    /// Particles over the whole tail per element vertex, `> 0`.
+    per_vertex: f64,
+    /// Tail steps taken in this solve (0 after a restore: the next
+    /// shoots a [`TAIL_STEPS`]th of what is left).
+    taken: u32,
+    /// Particles traced so far.
+    pub(in crate::solver) particles: u64,
+    /// Per polygon: its other side, when it has one (a two-sided face's
+    /// back copy, or the face a back copy belongs to).
+    twin: Vec<Option<u32>>,
+    tables: OnceLock<Tables>,
+}
+
+impl Tail {
+    /// The tail `option` asks for on `mesh` of `scene`: on from the
+    /// option's fraction, or, when automatic, from
+    /// [`crate::solver::tuning::TAIL_AUTO_FROM`] on meshes of at least
+    /// [`crate::solver::tuning::TAIL_AUTO_VERTICES`] vertices.
+    pub(in crate::solver) fn new(
+        option: TailOption,
+        per_vertex: f64,
+        scene: &Scene,
+        mesh: &Mesh,
+    ) -> Tail {
+        use crate::solver::tuning::{TAIL_AUTO_FROM, TAIL_AUTO_VERTICES};
+        let from = match option {
+            TailOption::Off => None,
+            TailOption::From(f) => Some(f),
+            TailOption::Auto => {
+                (mesh.vertex_count() as u64 >= TAIL_AUTO_VERTICES).then_some(TAIL_AUTO_FROM)
+            }
+        };
+        Tail {
+            from,
+            per_vertex: if per_vertex.is_finite() && per_vertex > 0.0 {
+                per_vertex
+            } else {
+                TAIL_PARTICLES_PER_VERTEX
+            },
+            taken: 0,
+            particles: 0,
+            twin: scene
+                .polygons
+                .iter()
+                .map(|p| p.surface.back.or(p.surface.back_of).map(|b| b.0))
+                .collect(),
+            tables: OnceLock::new(),
+        }
+    }
+
+    /// Whether a restored or carried state starts the count again.
+    pub(in crate::solver) fn restart(&mut self) {
+        self.taken = 0;
+    }
+}
+
+/// What the tail needs of the mesh, built once: every element triangle,
+/// the area each vertex's hat covers, and per polygon a triangle locator.
+#[derive(Debug)]
+struct Tables {
+    /// Every element triangle: its corners and area (square scene units).
+    triangles: Vec<([u32; 3], f64)>,
+    /// Per vertex: `Σ A_T / 3` over the triangles round it, the integral
+    /// of its Gouraud hat, in square scene units.
+    hat: Vec<f64>,
+    /// Per polygon: its triangles' locator, built when a particle first
+    /// lands on it.
+    locators: Vec<OnceLock<TriangleLocator>>,
+    /// How far off a surface a particle starts, in scene units: a
+    /// millionth of the model's size, far above `f32` rounding at its
+    /// coordinates and far below any gap in it.
+    offset: f32,
+}
+
+impl Tables {
+    fn new(mesh: &Mesh) -> Tables {
+        let mut triangles = Vec::new();
+        let mut hat = vec![0.0; mesh.vertex_count()];
+        for e in &mesh.elements {
+            for t in e.triangles() {
+                let [a, b, c] = t.map(|v| mesh.positions[v.index()].as_dvec3());
+                let area = (b - a).cross(c - a).length() * 0.5;
+                for v in t {
+                    hat[v.index()] += area / 3.0;
+                }
+                triangles.push((t.map(|v| v.0), area));
+            }
+        }
+        let (lo, hi) = mesh
+            .polygons
+            .iter()
+            .filter(|pm| !pm.sky)
+            .flat_map(|pm| pm.vertices.clone())
+            .map(|l| mesh.positions[l as usize])
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        let size = (hi - lo).length();
+        Tables {
+            triangles,
+            hat,
+            locators: (0..mesh.polygons.len()).map(|_| OnceLock::new()).collect(),
+            offset: if size.is_finite() && size > 0.0 {
+                size * 1e-6
+            } else {
+                1e-6
+            },
+        }
+    }
+}
+
+/// One particle's deposit: the reflected power that landed at a vertex,
+/// in radiosity × area units.
+type Deposit = (u32, Rgb);
+
+/// A random stream for one particle: SplitMix64 (Steele, Lea and Flood
+/// 2014) from a hash of the step and the particle's index, so that every
+/// particle draws the same numbers on any thread.
+struct Stream(u64);
+
+impl Stream {
+    fn new(step: u64, particle: u64) -> Stream {
+        Stream(
+            step.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ particle.wrapping_mul(0xD1B5_4A32_D192_ED03),
+        )
+    }
+
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[0, 1)`.
+    fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// A cosine-weighted direction about the unit `normal`.
+fn cosine_direction(normal: DVec3, s: &mut Stream) -> DVec3 {
+    let (u1, u2) = (s.uniform(), s.uniform());
+    let r = u1.sqrt();
+    let phi = std::f64::consts::TAU * u2;
+    let (t, b) = normal.any_orthonormal_pair();
+    (t * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize()
+}
+
+/// What one tail step needs to trace: read-only views of the solve.
+struct Tracer<'t> {
+    mesh: &'t Mesh,
+    visibility: &'t Visibility,
+    reflectance: &'t [Rgb],
+    /// Per polygon: whether light landing on it is reflected (not a sky
+    /// facet, not a luminaire with a light distribution).
+    reflects: &'t [bool],
+    twin: &'t [Option<u32>],
+    tables: &'t Tables,
+}
+
+impl Tracer<'_> {
+    /// The polygon whose front a particle travelling along `d` lands on
+    /// when it hits `hit`: `hit`, or its other side, or `None` when it
+    /// meets a back (a one-sided face's, which absorbs).
+    fn receiver(&self, hit: PolygonId, d: Vec3) -> Option<usize> {
+        let facing = |j: usize| self.mesh.polygons[j].normal.dot(d) < 0.0;
+        let j = hit.index();
+        if facing(j) {
+            return Some(j);
+        }
+        self.twin
+            .get(j)
+            .copied()
+            .flatten()
+            .map(|b| b as usize)
+            .filter(|&b| facing(b))
+    }
+
+    /// The element triangle of polygon `j` holding `p`, its corners and
+    /// barycentric weights (`>= 0`, summing to 1).
+    fn landing(&self, j: usize, p: Vec3) -> Option<([u32; 3], [f64; 3])> {
+        let pm = &self.mesh.polygons[j];
+        let locator = self.tables.locators[j].get_or_init(|| TriangleLocator::new(self.mesh, pm));
+        let (corners, w) = locator.find(self.mesh, pm, p)?;
+        let w = w.map(|x| f64::from(x).max(0.0));
+        let sum = w[0] + w[1] + w[2];
+        (sum > 0.0).then(|| (corners, w.map(|x| x / sum)))
+    }
+
+    /// Traces one particle from `origin` on polygon `j` carrying `power`
+    /// (signed, radiosity × area units), appending what it deposits;
+    /// returns the rays it cast.
+    fn trace(
+        &self,
+        mut j: usize,
+        mut origin: Vec3,
+        mut power: Rgb,
+        s: &mut Stream,
+        out: &mut Vec<Deposit>,
+    ) -> u64 {
+        let mut rays = 0;
+        for _ in 0..TAIL_MAX_BOUNCES {
+            let normal = self.mesh.polygons[j].normal.normalize().as_dvec3();
+            let d = cosine_direction(normal, s).as_vec3();
+            let start = origin + normal.as_vec3() * self.tables.offset;
+            rays += 1;
+            let Some((hit, t)) = self.visibility.first_hit(start, d) else {
+                break;
+            };
+            let Some(r) = self.receiver(hit, d) else {
+                break;
+            };
+            if !self.reflects[r] {
+                break;
+            }
+            let at = start + d * t;
+            let Some((corners, w)) = self.landing(r, at) else {
+                break;
+            };
+            let reflected = power * self.reflectance[r];
+            for (c, w) in corners.iter().zip(w) {
+                out.push((*c, reflected * w));
+            }
+            let survival = self.reflectance[r].max_channel().min(TAIL_SURVIVAL_MAX);
+            if survival <= 0.0 || s.uniform() >= survival {
+                break;
+            }
+            power = reflected * (1.0 / survival);
+            j = r;
+            origin = at;
+        }
+        rays
+    }
+}
+
+/// The emitting triangles of one tail step, for choosing where each
+/// particle starts: their cumulative weights and what each carries.
+struct Sources {
+    /// Indices into [`Tables::triangles`] of triangles with unshot light.
+    triangles: Vec<u32>,
+    /// Cumulative weights (area × mean corner `|Δb|`), ascending.
+    cumulative: Vec<f64>,
+    total: f64,
+}
+
+impl<'a> Progressive<'a> {
+    /// Whether the next step is a tail step: the tail is on, its fraction
+    /// reached, no step underway, no emitter still to shoot its own light
+    /// (a lamp's shadows need its own samples), and no sky facet or
+    /// luminaire holding light (they shoot from their own directions).
+    pub(in crate::solver) fn tail_due(&self) -> bool {
+        let Some(from) = self.tail.from else {
+            return false;
+        };
+        if self.underway.is_some() || self.unshot_power() <= 0.0 || self.unshot_fraction() > from {
+            return false;
+        }
+        if self.choose_pending_emitter().is_some() {
+            return false;
+        }
+        self.mesh.polygons.iter().enumerate().all(|(j, pm)| {
+            !(pm.sky || self.directional[j].is_some()) || self.unshot.mean(&self.mesh, j).is_black()
+        })
+    }
+
+    /// Per vertex, its unshot radiosity as the shooters read it: the
+    /// vertex's own value, or its polygon's in the per-polygon scheme.
+    fn unshot_at_vertices(&self) -> Vec<Rgb> {
+        let values = self.unshot.values();
+        if values.len() == self.mesh.vertex_count() {
+            values.to_vec()
+        } else {
+            self.mesh
+                .vertex_polygon
+                .iter()
+                .map(|p| values[p.index()])
+                .collect()
+        }
+    }
+
+    /// One tail step: shoots `share` of every polygon's unshot light by
+    /// particles ([module docs](self)). `None` when cancelled (nothing
+    /// changed) or when nothing is left to shoot.
+    pub(in crate::solver) fn tail_step(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+        let share = 1.0 / f64::from(TAIL_STEPS.saturating_sub(self.tail.taken).max(1));
+        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
+        let unshot = self.unshot_at_vertices();
+        let eligible: Vec<bool> = self
+            .mesh
+            .polygons
+            .iter()
+            .enumerate()
+            .map(|(j, pm)| !pm.sky && self.directional[j].is_none())
+            .collect();
+        let reflects = eligible.clone();
+        // Where particles start.
+        let mut sources = Sources {
+            triangles: Vec::new(),
+            cumulative: Vec::new(),
+            total: 0.0,
+        };
+        let mut per_polygon = vec![0.0f64; self.mesh.polygons.len()];
+        for (k, (corners, area)) in tables.triangles.iter().enumerate() {
+            let j = self.mesh.vertex_polygon[corners[0] as usize].index();
+            if !eligible[j] {
+                continue;
+            }
+            let magnitude: f64 = corners
+                .iter()
+                .map(|&c| {
+                    unshot[c as usize]
+                        .to_array()
+                        .map(f64::abs)
+                        .iter()
+                        .sum::<f64>()
+                        / 3.0
+                })
+                .sum::<f64>()
+                / 3.0;
+            let w = area * magnitude;
+            if w > 0.0 && w.is_finite() {
+                sources.total += w;
+                per_polygon[j] += w;
+                sources.triangles.push(k as u32);
+                sources.cumulative.push(sources.total);
+            }
+        }
+        if sources.total <= 0.0 {
+            return None;
+        }
+        let vertices = self.mesh.vertex_count() as f64;
+        let count =
+            ((self.tail.per_vertex * vertices / f64::from(TAIL_STEPS)).ceil() as u64).max(1);
+        let tracer = Tracer {
+            mesh: &self.mesh,
+            visibility: self.visibility,
+            reflectance: &self.reflectance,
+            reflects: &reflects,
+            twin: &self.tail.twin,
+            tables,
+        };
+        let step_number = self.steps + 1;
+        let scale = share * sources.total / count as f64;
+        // A particle from a triangle of weight `w` and area `A` carries
+        // `Δb(x) · scale · A / w`.
+        // Received power per vertex, summed in particle order.
+        let mut received = vec![Rgb::BLACK; self.mesh.vertex_count()];
+        let mut rays = 0u64;
+        let chunks = count.div_ceil(TAIL_CHUNK);
+        let mut chunk = 0;
+        while chunk < chunks {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let batch_end = (chunk + TAIL_BATCH).min(chunks);
+            let results: Vec<(Vec<Deposit>, u64)> = (chunk..batch_end)
+                .into_par_iter()
+                .map(|c| {
+                    let mut out = Vec::new();
+                    let mut rays = 0;
+                    let first = c * TAIL_CHUNK;
+                    for i in first..(first + TAIL_CHUNK).min(count) {
+                        if cancel.load(Ordering::Relaxed) {
+                            break;
+                        }
+                        let mut s = Stream::new(step_number, i);
+                        let pick = s.uniform() * sources.total;
+                        let n = sources
+                            .cumulative
+                            .partition_point(|&c| c <= pick)
+                            .min(sources.triangles.len() - 1);
+                        let before = if n == 0 {
+                            0.0
+                        } else {
+                            sources.cumulative[n - 1]
+                        };
+                        let weight = sources.cumulative[n] - before;
+                        let (corners, area) = tables.triangles[sources.triangles[n] as usize];
+                        // A uniform point of the triangle.
+                        let (r1, r2) = (s.uniform().sqrt(), s.uniform());
+                        let b = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
+                        let p = corners
+                            .iter()
+                            .zip(b)
+                            .fold(DVec3::ZERO, |acc, (&c, b)| {
+                                acc + tracer.mesh.positions[c as usize].as_dvec3() * b
+                            })
+                            .as_vec3();
+                        let carried = corners
+                            .iter()
+                            .zip(b)
+                            .fold(Rgb::BLACK, |acc, (&c, b)| acc + unshot[c as usize] * b);
+                        // Δb(x) / p(x) with p(x) = weight / (total · area),
+                        // over the step's particles and times its share.
+                        let power = carried * (area * scale / weight);
+                        let j = tracer.mesh.vertex_polygon[corners[0] as usize].index();
+                        rays += tracer.trace(j, p, power, &mut s, &mut out);
+                    }
+                    (out, rays)
+                })
+                .collect();
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            for (out, r) in results {
+                rays += r;
+                for (v, p) in out {
+                    received[v as usize] += p;
+                }
+            }
+            chunk = batch_end;
+        }
+        // A vertex's rise: what landed on its hat over the hat's area;
+        // vertices that receive as one ([`crate::solver::accel::shared`])
+        // pool what landed on them all.
+        let mut hat = tables.hat.clone();
+        if !self.leaders.is_empty() {
+            for l in 0..received.len() {
+                let leader = self.leaders[l];
+                if leader != ALONE {
+                    let (p, a) = (received[l], hat[l]);
+                    received[leader as usize] += p;
+                    hat[leader as usize] += a;
+                }
+            }
+        }
+        let delta: Vec<Rgb> = (0..received.len())
+            .map(|l| {
+                let lead = match self.leaders.get(l) {
+                    Some(&leader) if leader != ALONE => leader as usize,
+                    _ => l,
+                };
+                if hat[lead] > 0.0 {
+                    received[lead] * (1.0 / hat[lead])
+                } else {
+                    Rgb::BLACK
+                }
+            })
+            .collect();
+        if !delta.iter().all(|d| d.is_finite()) {
+            return None;
+        }
+        let shot_power = share * self.net_unshot_power();
+        let shooter = per_polygon
+            .iter()
+            .enumerate()
+            .fold((0, f64::NEG_INFINITY), |best, (j, &w)| {
+                if w > best.1 {
+                    (j, w)
+                } else {
+                    best
+                }
+            })
+            .0;
+        let polygons = per_polygon.iter().filter(|&&w| w > 0.0).count() as u32;
+        // Negative particles (light sent ahead coming back) may take a
+        // dark vertex a hair below zero by their noise.
+        for (b, d) in self.radiosity.iter_mut().zip(&delta) {
+            *b = (*b + *d).max(Rgb::BLACK);
+        }
+        self.unshot.scale(1.0 - share);
+        self.changed();
+        self.tail.taken += 1;
+        self.tail.particles += count;
+        self.steps += 1;
+        self.rays += rays;
+        self.pairs += rays;
+        let fraction = self.unshot_fraction();
+        self.last_fraction = fraction;
+        let receivers = self
+            .mesh
+            .polygons
+            .iter()
+            .filter(|pm| pm.vertices.clone().any(|l| !delta[l as usize].is_black()))
+            .count() as u64;
+        Some(StepReport {
+            step: self.steps,
+            shooter: PolygonId(shooter as u32),
+            polygons,
+            shot_power,
+            unshot_fraction: fraction,
+            rays,
+            pairs: rays,
+            receivers,
+            clear_receivers: 0,
+            part: 1,
+            complete: true,
+            particles: count,
+        })
+    }
+}
