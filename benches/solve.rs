@@ -2,14 +2,15 @@
 //! scenes at their README settings (default lenmax, 64 shooter samples,
 //! 0.1 % threshold, settling), from mesh to converged solution, with
 //! clusters (the default), with clusters stopping at the threshold alone
-//! (`--settle 0`), and without clusters (`--no-clustering`). Rays per
-//! second are printed once per run; criterion reports the time per solve.
+//! (`--settle 0`), without clusters (`--no-clustering`), and with the
+//! particle tail carrying the last 10 % (`--tail 0.1`). Rays per second
+//! are printed once per run; criterion reports the time per solve.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::{self, Scene};
 use radiosity::solver::tuning::DEFAULT_SETTLE;
-use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions};
+use radiosity::solver::{Approximations, Heuristic, Progressive, SolverOptions, TailOption};
 use radiosity::visibility::Visibility;
 use std::path::Path;
 use std::time::Instant;
@@ -22,12 +23,13 @@ fn load(name: &str) -> Scene {
 }
 
 /// One full solve; returns (steps, rays).
-fn solve(scene: &Scene, clustering: bool, settle: f64) -> (u64, u64) {
+fn solve(scene: &Scene, clustering: bool, settle: f64, tail: TailOption) -> (u64, u64) {
     let mesh = mesh::build(scene, &MeshOptions::for_scene(scene)).expect("mesh");
     let visibility = Visibility::new(scene);
     let options = SolverOptions {
         approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
         settle,
+        tail,
         ..SolverOptions::default()
     };
     let mut solver = Progressive::new(scene, &mesh, &visibility, options);
@@ -40,14 +42,26 @@ fn bench_solve(c: &mut Criterion) {
     group.sample_size(10);
     for name in ["rtable.sc", "cornell.sc", "table_chair.sc"] {
         let scene = load(name);
+        let auto = TailOption::Auto;
         let variants = [
-            (true, DEFAULT_SETTLE, name.to_string()),
-            (true, 0.0, format!("{name} --settle 0")),
-            (false, DEFAULT_SETTLE, format!("{name} --no-clustering")),
+            (true, DEFAULT_SETTLE, auto, name.to_string()),
+            (true, 0.0, auto, format!("{name} --settle 0")),
+            (
+                false,
+                DEFAULT_SETTLE,
+                auto,
+                format!("{name} --no-clustering"),
+            ),
+            (
+                true,
+                DEFAULT_SETTLE,
+                TailOption::From(0.1),
+                format!("{name} --tail 0.1"),
+            ),
         ];
-        for (clustering, settle, label) in variants {
+        for (clustering, settle, tail, label) in variants {
             let t = Instant::now();
-            let (steps, rays) = solve(&scene, clustering, settle);
+            let (steps, rays) = solve(&scene, clustering, settle, tail);
             let secs = t.elapsed().as_secs_f64();
             eprintln!(
                 "{label}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
@@ -55,7 +69,9 @@ fn bench_solve(c: &mut Criterion) {
                 secs,
                 rays as f64 / secs / 1e6
             );
-            group.bench_function(&label, |b| b.iter(|| solve(&scene, clustering, settle)));
+            group.bench_function(&label, |b| {
+                b.iter(|| solve(&scene, clustering, settle, tail))
+            });
         }
     }
     group.finish();

@@ -158,7 +158,14 @@ fn configurations() -> Vec<Config> {
 /// which no tail touches).
 fn tail_row(name: &str, unshot: UnshotScheme) -> Config {
     let grid = ShooterSamples::AtMost(radiosity::solver::tuning::DEFAULT_SHOOTER_SAMPLES);
-    let mut config = row(name, FormFactorMethod::Wallace, grid, unshot, true, tail(unshot));
+    let mut config = row(
+        name,
+        FormFactorMethod::Wallace,
+        grid,
+        unshot,
+        true,
+        tail(unshot),
+    );
     config.options.tail = TailOption::From(0.3);
     config.options.tail_particles = 1000.0;
     config

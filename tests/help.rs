@@ -478,3 +478,34 @@ fn a_format_message_lists_only_what_the_option_accepts() {
     }
     assert!(listing(dir.path()).is_empty());
 }
+
+/// `--tail`'s help states the automatic tail's start and mesh size as the
+/// solver's tuning has them, and its refusals name what it takes.
+#[test]
+fn the_tail_help_quotes_the_tuning() {
+    use radiosity::solver::tuning::{TAIL_AUTO_FROM, TAIL_AUTO_VERTICES};
+    let out = run_in(&root(), &["--help"]);
+    let help = stdout(&out)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let thousands = TAIL_AUTO_VERTICES / 1000;
+    let (high, low) = (thousands / 1000, thousands % 1000);
+    let vertices = if high > 0 {
+        format!("{high},{low:03},000")
+    } else {
+        format!("{low},000")
+    };
+    let said =
+        format!("turns it on from {TAIL_AUTO_FROM} on meshes of {vertices} element vertices");
+    assert!(help.contains(&said), "--help lacks {said:?}");
+    for bad in ["1.5", "-0.1", "sometimes"] {
+        let out = run_in(&root(), &["--tail", bad, "--no-window"]);
+        assert_eq!(out.status.code(), Some(2), "--tail {bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--tail must be `auto`, `off` or a fraction"),
+            "{err}"
+        );
+    }
+}

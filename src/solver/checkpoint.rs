@@ -261,6 +261,17 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         super::UnshotScheme::Polygon => 1,
         super::UnshotScheme::Vertex => 2,
     });
+    // When the particle tail takes over, and how many particles it traces.
+    h.bytes(b"tail");
+    match options.tail {
+        super::TailOption::Off => h.word(0),
+        super::TailOption::Auto => h.word(1),
+        super::TailOption::From(f) => {
+            h.word(2);
+            h.word(f.to_bits());
+        }
+    }
+    h.word(options.tail_particles.to_bits());
     h.0
 }
 

@@ -1164,7 +1164,6 @@ impl<'a> Progressive<'a> {
         self.last_fraction = self.unshot_fraction();
         self.steps = state.steps;
         self.rays = state.rays;
-        self.tail.restart();
         Ok(())
     }
 }

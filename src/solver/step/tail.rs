@@ -30,9 +30,10 @@
 //! vertex itself, smoothed over its neighbours. The noise falls as one
 //! over the square root of the particles; they are
 //! [`TAIL_PARTICLES_PER_VERTEX`] per element vertex
-//! by default over the whole tail, in [`TAIL_STEPS`] steps (each shoots
-//! an equal share of what was unshot when the tail began, so the picture
-//! moves between them).
+//! by default over the whole tail, in at most [`TAIL_STEPS`] steps (each
+//! takes the unshot fraction down to the next of the levels `from · k /
+//! TAIL_STEPS`, so the picture moves between them, and a solve resumed
+//! from a checkpoint takes the same steps).
 //!
 //! Every particle's random numbers come from its own index, and the
 //! particles' deposits are summed in particle order, so the bits do not
@@ -66,9 +67,6 @@ pub(in crate::solver) struct Tail {
     pub(in crate::solver) from: Option<f64>,
     /// Particles over the whole tail per element vertex, `> 0`.
     per_vertex: f64,
-    /// Tail steps taken in this solve (0 after a restore: the next
-    /// shoots a [`TAIL_STEPS`]th of what is left).
-    taken: u32,
     /// Particles traced so far.
     pub(in crate::solver) particles: u64,
     /// Per polygon: its other side, when it has one (a two-sided face's
@@ -103,7 +101,6 @@ impl Tail {
             } else {
                 TAIL_PARTICLES_PER_VERTEX
             },
-            taken: 0,
             particles: 0,
             twin: scene
                 .polygons
@@ -114,9 +111,23 @@ impl Tail {
         }
     }
 
-    /// Whether a restored or carried state starts the count again.
-    pub(in crate::solver) fn restart(&mut self) {
-        self.taken = 0;
+    /// The share of the unshot light a tail step shoots when the unshot
+    /// fraction is `fraction` (`> 0`): what takes it down to the next
+    /// of the levels `from · k / TAIL_STEPS` below it, so the tail ends
+    /// in at most [`TAIL_STEPS`] steps. A function of the state alone, so
+    /// a resumed solve takes the same steps as an uninterrupted one.
+    fn share(&self, fraction: f64) -> f64 {
+        let from = self.from.unwrap_or(0.0);
+        // At least an eighth of a level below the fraction: past the
+        // rounding of a level just reached, and no step of a sliver when
+        // the tail begins just above a level.
+        let below = fraction * (1.0 - 0.5 / f64::from(TAIL_STEPS));
+        let level = (0..TAIL_STEPS)
+            .rev()
+            .map(|k| from * f64::from(k) / f64::from(TAIL_STEPS))
+            .find(|&l| l < below)
+            .unwrap_or(0.0);
+        (1.0 - level / fraction).clamp(0.0, 1.0)
     }
 }
 
@@ -350,17 +361,18 @@ impl<'a> Progressive<'a> {
     /// particles ([module docs](self)). `None` when cancelled (nothing
     /// changed) or when nothing is left to shoot.
     pub(in crate::solver) fn tail_step(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
-        let share = 1.0 / f64::from(TAIL_STEPS.saturating_sub(self.tail.taken).max(1));
+        let share = self.tail.share(self.unshot_fraction());
         let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
         let unshot = self.unshot_at_vertices();
-        let eligible: Vec<bool> = self
+        // Sky facets and luminaires neither start particles (the tail is
+        // due only once they hold no light) nor reflect them.
+        let reflects: Vec<bool> = self
             .mesh
             .polygons
             .iter()
             .enumerate()
             .map(|(j, pm)| !pm.sky && self.directional[j].is_none())
             .collect();
-        let reflects = eligible.clone();
         // Where particles start.
         let mut sources = Sources {
             triangles: Vec::new(),
@@ -370,7 +382,7 @@ impl<'a> Progressive<'a> {
         let mut per_polygon = vec![0.0f64; self.mesh.polygons.len()];
         for (k, (corners, area)) in tables.triangles.iter().enumerate() {
             let j = self.mesh.vertex_polygon[corners[0] as usize].index();
-            if !eligible[j] {
+            if !reflects[j] {
                 continue;
             }
             let magnitude: f64 = corners
@@ -528,7 +540,6 @@ impl<'a> Progressive<'a> {
         }
         self.unshot.scale(1.0 - share);
         self.changed();
-        self.tail.taken += 1;
         self.tail.particles += count;
         self.steps += 1;
         self.rays += rays;

@@ -143,3 +143,31 @@ fn a_cancelled_tail_step_changes_nothing() {
     assert_eq!(solver.steps(), steps);
     assert!(solver.step().is_some_and(|r| r.particles > 0));
 }
+
+/// A solve saved during its tail and resumed goes on to the same bits as
+/// the solve that was never stopped: a tail step's share is a function of
+/// the unshot fraction alone.
+#[test]
+fn a_tail_resumed_from_its_state_ends_as_the_uninterrupted_one() {
+    let s = shadowed_box();
+    let mesh = mesh::build(
+        &s,
+        &MeshOptions {
+            lenmax: 0.1,
+            inset: crate::mesh::DEFAULT_INSET,
+        },
+    )
+    .unwrap();
+    let vis = Visibility::new(&s);
+    let options = tail(0.1, 50.0);
+    let run = |solver: &mut Progressive| while !solver.is_done() && solver.step().is_some() {};
+    let mut whole = Progressive::new(&s, &mesh, &vis, options);
+    run(&mut whole);
+    let mut first = Progressive::new(&s, &mesh, &vis, options);
+    while first.step().is_some_and(|r| r.particles == 0) {}
+    let mut resumed = Progressive::new(&s, &mesh, &vis, options);
+    resumed.restore(first.state()).unwrap();
+    run(&mut resumed);
+    assert_eq!(resumed.steps(), whole.steps());
+    assert_eq!(resumed.radiosity(), whole.radiosity());
+}
