@@ -666,3 +666,44 @@ fn a_default_mesh_over_the_vertex_budget_is_coarsened_with_one_line() {
     assert_eq!(stats["lenmax"].as_f64().unwrap() as f32, 0.02);
     assert_eq!(stats["vertices"], 125 * 52 * 52);
 }
+
+/// `--tail` hands the light left to the particle tail, which carries all
+/// of it: the run ends converged with nothing unshot, the summary says
+/// how many particles it traced, and `--stats` has the same count: a
+/// quarter of `--tail-particles` per element vertex in each of at most
+/// four tail steps.
+#[test]
+fn the_particle_tail_carries_the_rest_and_the_summary_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell.sc");
+    let out = run_in(
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--lenmax",
+            "50",
+            "--tail",
+            "0.5",
+            "--tail-particles",
+            "40",
+            "-o",
+            "c.png",
+            "--stats",
+            "s.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stats = read_json(dir.path(), "s.json");
+    let (vertices, particles) = (
+        stats["vertices"].as_u64().unwrap(),
+        stats["particles"].as_u64().unwrap(),
+    );
+    let steps = particles / (10 * vertices);
+    assert_eq!(particles, steps * 10 * vertices, "{particles} {vertices}");
+    assert!((1..=4).contains(&steps), "{steps} tail steps");
+    assert_eq!(stats["unshot_fraction"].as_f64(), Some(0.0));
+    assert_eq!(stats["converged"].as_bool(), Some(true));
+    let said = stderr(&out);
+    let millions = format!("(the tail by {:.1} M particles)", particles as f64 / 1e6);
+    assert!(said.contains(&millions), "{said}");
+}

@@ -194,6 +194,8 @@ struct Progress<'p> {
     step: u64,
     unshot_fraction: f64,
     rays: u64,
+    /// Particles the solve's tail has traced ([`crate::solver::step::tail`]).
+    particles: u64,
     /// Seconds spent shooting (pauses excluded).
     solving: f64,
     stopped: Option<StopReason>,
@@ -312,8 +314,13 @@ fn closing_summary(stem: &str, p: &Progress, emits: bool, written: u32) -> Strin
         1 => ", 1 picture written".into(),
         n => format!(", {n} pictures written"),
     };
+    let tail = if p.particles > 0 {
+        format!(" (the tail by {:.1} M particles)", p.particles as f64 / 1e6)
+    } else {
+        String::new()
+    };
     format!(
-        "{stem}: window closed after {} steps, {:.2} s solving, {:.1} M rays, {:.3}% unshot, {state}{pictures}",
+        "{stem}: window closed after {} steps{tail}, {:.2} s solving, {:.1} M rays, {:.3}% unshot, {state}{pictures}",
         p.step,
         p.solving,
         p.rays as f64 / 1e6,
@@ -386,6 +393,7 @@ fn solve_in_background<'p>(
                 p.step = report.step;
                 p.unshot_fraction = report.unshot_fraction;
                 p.rays = session.totals().rays;
+                p.particles = session.solver().particles();
                 p.solving = solving.as_secs_f64();
             }
             Ok(Event::Stopped(reason)) => {
@@ -1142,5 +1150,16 @@ mod tests {
         assert!(line.ends_with("unshot, not converged"), "{line}");
         let dark = closing_summary("cornell", &p, false, 1);
         assert!(dark.ends_with("nothing emits, 1 picture written"), "{dark}");
+        let tailed = Progress {
+            particles: 4_194_304,
+            ..progress(Some(StopReason::Converged))
+        };
+        let line = closing_summary("room", &tailed, true, 0);
+        assert!(
+            line.starts_with(
+                "room: window closed after 65 steps (the tail by 4.2 M particles), 1.35 s"
+            ),
+            "{line}"
+        );
     }
 }
