@@ -874,7 +874,11 @@ fn solve<'p>(
         }
         Ok(())
     };
-    let mut progress = Progress::new(config.progress, config.solver.threshold);
+    let mut progress = Progress::new(
+        config.progress,
+        config.solver.threshold,
+        session.solver().tail_from(),
+    );
     let mut last_save = Instant::now();
     let start = Instant::now();
     // A resumed solve's sky may have shot already: it is not watched.
@@ -942,7 +946,11 @@ fn solve<'p>(
                 if config.progress {
                     say_pass(session, Some(&report));
                 }
-                progress = Progress::new(config.progress, config.solver.threshold);
+                progress = Progress::new(
+                    config.progress,
+                    config.solver.threshold,
+                    session.solver().tail_from(),
+                );
                 // A fresh solve numbers its steps from 1 again: the log
                 // and plot show only the last one.
                 if session.solver().steps() == 0 {

@@ -124,6 +124,13 @@ pub trait Method<'a> {
         0
     }
 
+    /// The unshot fraction at or below which the particle tail takes
+    /// over ([`super::step::tail`]), as this solve resolved
+    /// [`super::SolverOptions::tail`]; `None` without one.
+    fn tail_from(&self) -> Option<f64> {
+        None
+    }
+
     /// The mesh it solves on.
     fn mesh(&self) -> &Mesh;
 

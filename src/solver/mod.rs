@@ -923,6 +923,13 @@ impl<'a> Progressive<'a> {
         self.tail.particles
     }
 
+    /// The unshot fraction at or below which the particle tail takes
+    /// over, as [`SolverOptions::tail`] resolved on this mesh; `None`
+    /// when it is off.
+    pub fn tail_from(&self) -> Option<f64> {
+        self.tail.from()
+    }
+
     /// Why the solve should stop now, or `None` to go on (always while a
     /// step is under way: [`Progressive::in_step`]).
     pub fn stop_reason(&self) -> Option<StopReason> {

@@ -66,6 +66,10 @@ impl<'a> Method<'a> for Progressive<'a> {
         Progressive::particles(self)
     }
 
+    fn tail_from(&self) -> Option<f64> {
+        Progressive::tail_from(self)
+    }
+
     fn mesh(&self) -> &Mesh {
         Progressive::mesh(self)
     }

@@ -118,16 +118,38 @@ impl Tail {
     /// a resumed solve takes the same steps as an uninterrupted one.
     fn share(&self, fraction: f64) -> f64 {
         let from = self.from.unwrap_or(0.0);
-        // At least an eighth of a level below the fraction: past the
-        // rounding of a level just reached, and no step of a sliver when
-        // the tail begins just above a level.
-        let below = fraction * (1.0 - 0.5 / f64::from(TAIL_STEPS));
-        let level = (0..TAIL_STEPS)
-            .rev()
-            .map(|k| from * f64::from(k) / f64::from(TAIL_STEPS))
-            .find(|&l| l < below)
-            .unwrap_or(0.0);
+        let level = levels_below(from, fraction).next().unwrap_or(0.0);
         (1.0 - level / fraction).clamp(0.0, 1.0)
+    }
+
+    /// The unshot fraction at or below which the tail takes over; `None`
+    /// when it is off (for [`TailOption::Auto`], as this mesh decided).
+    pub(in crate::solver) fn from(&self) -> Option<f64> {
+        self.from
+    }
+}
+
+/// The levels `from · k / TAIL_STEPS` (`k` from `TAIL_STEPS − 1` down to
+/// 0) that a tail step at unshot fraction `fraction` may take it down to,
+/// highest first: those at least an eighth of a level below it, past the
+/// rounding of a level just reached, and no step of a sliver when the
+/// tail begins just above a level.
+fn levels_below(from: f64, fraction: f64) -> impl Iterator<Item = f64> {
+    let below = fraction * (1.0 - 0.5 / f64::from(TAIL_STEPS));
+    (0..TAIL_STEPS)
+        .rev()
+        .map(move |k| from * f64::from(k) / f64::from(TAIL_STEPS))
+        .filter(move |&l| l < below)
+}
+
+/// Tail steps left at unshot fraction `fraction` for a tail from `from`
+/// (0 once nothing is unshot): what a progress bar's estimate of the
+/// time left counts.
+pub fn steps_left(from: f64, fraction: f64) -> u32 {
+    if fraction <= 0.0 {
+        0
+    } else {
+        levels_below(from, fraction).count() as u32
     }
 }
 
