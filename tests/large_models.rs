@@ -15,8 +15,8 @@
 //!   (one element a triangle) gives a picture that is not black, with
 //!   finite radiosity everywhere.
 //!
-//! A full solve of one of these takes minutes to hours (issue 42); two
-//! steps (today each the light of one of the sky's 80 facets) are what
+//! A full solve of one of these takes minutes (`docs/performance.md`);
+//! two steps (each the light of one of the sky's 80 facets) are what
 //! fits in seconds.
 
 mod common;

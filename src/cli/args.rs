@@ -145,7 +145,7 @@ pub struct Args {
     /// each carrying one cluster's sliver of it. It adds noise in the
     /// share of each point's light that was left (the fraction over one
     /// minus the reflectance, spread over the model). `auto` (the
-    /// default) turns it on from 0.03 on meshes of 100,000 element
+    /// default) turns it on from 0.3 on meshes of 100,000 element
     /// vertices or more; `off` shoots to the end.
     // The literals are crate::solver::tuning::TAIL_AUTO_FROM and
     // TAIL_AUTO_VERTICES; a unit test keeps them equal.
@@ -158,7 +158,7 @@ pub struct Args {
     /// The noise of the light the tail carries falls as one over the
     /// square root of this.
     // The literal is crate::solver::tuning::TAIL_PARTICLES_PER_VERTEX.
-    #[arg(long, value_name = "N", default_value = "16", value_parser = parse_tail_particles)]
+    #[arg(long, value_name = "N", default_value = "64", value_parser = parse_tail_particles)]
     #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) tail_particles: f64,
 
