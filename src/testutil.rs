@@ -90,6 +90,7 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
         groups: Vec::new(),
         luminaires: Vec::new(),
         sun: None,
+        sky_pattern: None,
     }
 }
 

@@ -21,6 +21,12 @@
    up carries an `irradiancemeter`; each is rendered BATCHES times at SPP
    samples, in a scene of its own, and the renders averaged.
 
+Mitsuba's readings are kept in DIR/mitsuba-SKY-SPPxBATCHES.csv (SKY
+`overcast` or `uniform`, with the lux) as they come, and a later run in
+the same DIR reads a point's reading from there instead of rendering it
+again: the reference does not depend on the program, so a change to the
+program is checked again in seconds.
+
 Prints each point (x, z, program, Mitsuba, difference), then the mean and
 the largest relative difference and the daylight factors' means over the
 points. The `.sc` reader takes what the daylight office uses (`material`
@@ -165,6 +171,28 @@ def irradiance(mi, scene, spp, batches, seed):
     return float(np.mean(values))
 
 
+def kept_readings(path):
+    """{(x, y, z): lux} of the readings kept in `path` (none if absent);
+    the sky-alone meters are at the keys ("up",) and ("down",)."""
+    kept = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            for row in csv.DictReader(f):
+                key = (row["x"],) if row["y"] == "" else (row["x"], row["y"], row["z"])
+                kept[key] = float(row["lux"])
+    return kept
+
+
+def keep_reading(path, key, lux):
+    """Appends one reading to `path` (written with its header if new)."""
+    new = not os.path.exists(path)
+    with open(path, "a") as f:
+        if new:
+            f.write("x,y,z,lux\n")
+        cells = list(key) + [""] * (3 - len(key))
+        f.write(",".join(cells) + f",{lux!r}\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene")
@@ -183,8 +211,11 @@ def main():
     os.makedirs(a.work, exist_ok=True)
 
     stem = os.path.splitext(os.path.basename(a.scene))[0]
+    # The program runs in DIR: a path to it is made absolute (a bare name
+    # is looked up on PATH).
+    program = os.path.abspath(a.radiosity) if os.sep in a.radiosity else a.radiosity
     subprocess.run(
-        [a.radiosity, os.path.abspath(a.scene), "--units", "m", "--sky",
+        [program, os.path.abspath(a.scene), "--units", "m", "--sky",
          f"{a.lux:g}" if a.uniform else f"cie-overcast,{a.lux:g}lx", "--workplane", f"{a.height:g},{a.spacing:g}",
          "-o", "plane.png", "--no-window", "-q"],
         cwd=a.work, check=True)
@@ -203,11 +234,24 @@ def main():
     mi.set_variant(a.variant)
 
     sky = sky_envmap(a.lux, a.uniform)
+    kept_path = os.path.join(
+        a.work, f"mitsuba-{'uniform' if a.uniform else 'overcast'}-{a.lux:g}lx-"
+        f"{a.spp}x{a.batches}.csv")
+    kept = kept_readings(kept_path)
+
+    def reading(key, build, seed):
+        """The kept reading at `key`, or the render of the scene `build()`
+        makes, kept."""
+        if key not in kept:
+            kept[key] = irradiance(mi, build(), a.spp, a.batches, seed)
+            keep_reading(kept_path, key, kept[key])
+        return kept[key]
+
     # The sky alone: up must read E, down the ground's 0.2 E.
-    up = irradiance(mi, scene_dict(mi, {}, [], sky, [meter(mi, (0, 0, 0), 1, a.spp)]),
-                    a.spp, a.batches, 1)
-    down = irradiance(mi, scene_dict(mi, {}, [], sky, [meter(mi, (0, 0, 0), -1, a.spp)]),
-                      a.spp, a.batches, 2)
+    up = reading(("up",), lambda: scene_dict(
+        mi, {}, [], sky, [meter(mi, (0, 0, 0), 1, a.spp)]), 1)
+    down = reading(("down",), lambda: scene_dict(
+        mi, {}, [], sky, [meter(mi, (0, 0, 0), -1, a.spp)]), 2)
     below = a.lux if a.uniform else GROUND_REFLECTANCE * a.lux
     print(f"sky alone: up {up:.1f} lx (expected {a.lux:g}), down {down:.1f} lx "
           f"(expected {below:g})")
@@ -219,8 +263,8 @@ def main():
     print(f"{'x':>6} {'z':>7} {'program':>9} {'Mitsuba':>9} {'diff':>7}")
     for k, (x, y, z, e) in enumerate(points):
         # One meter a scene: Mitsuba attaches an endpoint to one shape.
-        scene = scene_dict(mi, materials, faces, sky, [meter(mi, (x, y, z), 1, a.spp)])
-        m = irradiance(mi, scene, a.spp, a.batches, 100 + k)
+        m = reading((f"{x:g}", f"{y:g}", f"{z:g}"), lambda: scene_dict(
+            mi, materials, faces, sky, [meter(mi, (x, y, z), 1, a.spp)]), 100 + k)
         diffs.append(e / m - 1.0)
         ours.append(e)
         theirs.append(m)

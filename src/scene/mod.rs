@@ -38,8 +38,8 @@ pub use import::sc::{
 };
 pub use import::{load, load_with};
 pub use lighting::daylight::{
-    DaylightError, DaylightSky, HorizonFrame, SkyLevel, SkyLight, SkyModel, SunPosition,
-    CLEAR_TURBIDITY, DAYLIGHT_RADIUS_FACTOR, DEFAULT_HORIZONTAL_LUX, FACET_SPLITS,
+    DaylightError, DaylightSky, HorizonFrame, SkyLevel, SkyLight, SkyModel, SkyPattern,
+    SunPosition, CLEAR_TURBIDITY, DAYLIGHT_RADIUS_FACTOR, DEFAULT_HORIZONTAL_LUX, FACET_SPLITS,
     GROUND_REFLECTANCE,
 };
 pub use lighting::emit::{
@@ -236,6 +236,11 @@ pub struct Scene {
     /// polygon, whose direct light the solver shoots once before its
     /// steps. `None` unless asked for and above the horizon.
     pub sun: Option<Sun>,
+    /// How the standard sky's luminance varies within its facets
+    /// ([`SkyPattern`]), by which the solver spreads each facet's light
+    /// over its sample directions; `None` without a standard sky (a
+    /// uniform `--sky`'s facets emit evenly).
+    pub sky_pattern: Option<SkyPattern>,
 }
 
 impl Scene {

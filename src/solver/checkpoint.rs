@@ -222,6 +222,28 @@ pub fn fingerprint(scene: &Scene, mesh: &Mesh, options: &SolverOptions) -> u64 {
         }
         h.word(sun.normal_illuminance.to_bits());
     }
+    // A standard sky spreads its facets' light by its luminance
+    // (`--sky cie-...`); without one the fingerprint is what it was.
+    if let Some(p) = &scene.sky_pattern {
+        h.bytes(b"sky pattern");
+        let sky = &p.sky;
+        let model = match sky.model {
+            crate::scene::SkyModel::CieOvercast => 0,
+            crate::scene::SkyModel::Cie(n) => u64::from(n),
+        };
+        h.word(model);
+        let sun = sky.sun.map_or([f64::NAN; 2], |s| [s.azimuth, s.altitude]);
+        for v in [sky.zenith, sky.north, sun[0], sun[1]] {
+            h.word(v.to_bits());
+        }
+        for v in [p.frame.east, p.frame.north, p.frame.up, p.centre] {
+            for c in v.to_array() {
+                h.word(c.to_bits());
+            }
+        }
+        h.word(u64::from(p.facets.0));
+        h.word(u64::from(p.facets.1));
+    }
     h.bytes(b"mesh");
     h.word(mesh.vertex_count() as u64);
     h.word(mesh.elements.len() as u64);

@@ -24,9 +24,11 @@
 //!
 //! A sky facet (one element) is gathered from its own grid of samples
 //! ([`crate::solver::tuning::SKY_FACET_SAMPLES`]), a ray each, as the
-//! solver shoots it: one ray from the centre of a facet of 0.16 sr let a
-//! window in a room's wall pass all of its light or none, and put points
-//! on a work plane 20 % to 70 % off a window's sky component.
+//! solver shoots it, weighted as it by a standard sky's luminance in each
+//! direction ([`super::formfactor::polygon_samples`]): one ray from the
+//! centre of a facet of 0.16 sr let a window in a room's wall pass all of
+//! its light or none, and put points on a work plane 20 % to 70 % off a
+//! window's sky component.
 //!
 //! Luminaires with a light distribution ([`crate::scene::Luminaire`]) are
 //! gathered with their intensity in the direction of the point instead of
@@ -44,7 +46,7 @@
 //! parallel and gives the same bits whatever the thread count.
 
 use super::distribution::Directional;
-use super::formfactor::{shooter_samples, weighted_point_to_samples, SampleSet, ShooterSample};
+use super::formfactor::{polygon_samples, weighted_point_to_samples, SampleSet, ShooterSample};
 use super::tuning::{LINEAR_CANDIDATES, SHAFT_MIN_VERTICES};
 use crate::cancel::{Cancel, Cancelled};
 use crate::color::Rgb;
@@ -128,7 +130,7 @@ impl<'a> FinalGather<'a> {
             // scene's vertices with it.
             if let Some(polygon) = scene.polygons.get(i).filter(|_| pm.sky) {
                 let set = SampleSet::for_polygon(SampleSet::Centre, polygon);
-                samples = shooter_samples(polygon, pm, mesh, set);
+                samples = polygon_samples(scene, i, pm, mesh, set);
                 values = vec![values[0]; samples.len()];
             }
             sources.push(Source {

@@ -36,7 +36,9 @@
 //!
 //! A sky (`--sky`, [`crate::scene::Scene::add_sky`]) is an enclosure of
 //! emitting facets that reflect nothing: each shoots like any emitter, from
-//! its own grid of [`crate::solver::tuning::SKY_FACET_SAMPLES`] points, and its unshot
+//! its own grid of [`crate::solver::tuning::SKY_FACET_SAMPLES`] points (a
+//! standard sky's weighted by its luminance in each direction,
+//! [`formfactor::polygon_samples`]), and its unshot
 //! power counts as the light it can bring to the scene, not its own (see
 //! [`Progressive::unshot_power`]).
 //!
@@ -115,7 +117,7 @@ use crate::visibility::Visibility;
 use cluster::{Cell, Clusters, Strata};
 use facets::Facets;
 use far_shooters::FarShooter;
-use formfactor::{shooter_samples, SampleSet, ShooterSample};
+use formfactor::{polygon_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use receivers::CoarseGrid;
 use subcells::SubCells;
@@ -611,12 +613,12 @@ impl<'a> Progressive<'a> {
             .iter()
             .map(|p| SampleSet::for_polygon(set, p))
             .collect();
-        let samples: Vec<Vec<ShooterSample>> = scene
+        let samples: Vec<Vec<ShooterSample>> = mesh
             .polygons
             .iter()
-            .zip(&mesh.polygons)
             .zip(&sets)
-            .map(|((p, pm), &set)| shooter_samples(p, pm, mesh, set))
+            .enumerate()
+            .map(|(i, (pm, &set))| polygon_samples(scene, i, pm, mesh, set))
             .collect();
         let radiosity = mesh
             .vertex_polygon

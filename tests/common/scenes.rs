@@ -49,6 +49,7 @@ pub fn scene(polygons: Vec<Polygon>, materials: Vec<Material>) -> Scene {
         groups: Vec::new(),
         luminaires: Vec::new(),
         sun: None,
+        sky_pattern: None,
     }
 }
 

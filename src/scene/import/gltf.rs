@@ -712,6 +712,7 @@ impl<'a> Reader<'a> {
             groups,
             luminaires: Vec::new(),
             sun: None,
+            sky_pattern: None,
         };
         if let Some(warning) = scene.drop_duplicates(file) {
             scene.warnings.push(warning);

@@ -60,6 +60,7 @@ impl Scene {
         let triangles = geodesic_sphere(SKY_SUBDIVISIONS);
         let emissions = vec![radiosity];
         self.add_enclosure(triangles, emissions, SKY_RADIUS_FACTOR)
+            .map(|_| ())
     }
 
     /// Adds the enclosure of the unit triangles `triangles` (each facing
@@ -67,13 +68,14 @@ impl Scene {
     /// the scene's half-diagonal in radius, appended
     /// after every other polygon with [`Surface::sky`] set: one material
     /// named [`SKY_MATERIAL_NAME`] a facet emitting `emissions[i]`, or one
-    /// for all when `emissions` holds a single value.
+    /// for all when `emissions` holds a single value. Returns the
+    /// enclosure's centre, in scene units.
     pub(super) fn add_enclosure(
         &mut self,
         triangles: Vec<[DVec3; 3]>,
         emissions: Vec<Rgb>,
         radius_factor: f32,
-    ) -> Result<(), PolygonError> {
+    ) -> Result<DVec3, PolygonError> {
         let (lo, hi) = self.bounds();
         let centre = ((lo + hi) * 0.5).as_dvec3();
         let half_diagonal = match (hi - lo).length() * 0.5 {
@@ -103,7 +105,7 @@ impl Scene {
             });
         }
         self.polygons.extend(facets);
-        Ok(())
+        Ok(centre)
     }
 
     /// The radiosity of the sky [`Scene::add_sky`] added, or for a sky

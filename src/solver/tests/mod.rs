@@ -16,6 +16,7 @@ use crate::testutil::{
 
 mod clusters;
 mod crowded;
+mod daylight_sky;
 mod determinism;
 mod emitter_order;
 mod energy;

@@ -715,6 +715,7 @@ fn two_sided_scene(
         groups: GroupScan::finish(groups),
         luminaires: Vec::new(),
         sun: None,
+        sky_pattern: None,
     };
     if let Some(warning) = scene.drop_duplicates(file) {
         scene.warnings.push(warning);

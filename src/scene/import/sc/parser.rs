@@ -952,6 +952,7 @@ impl<'a> Parser<'a> {
             groups: Vec::new(),
             luminaires: Vec::new(),
             sun: None,
+            sky_pattern: None,
         })
     }
 
