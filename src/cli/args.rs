@@ -159,7 +159,7 @@ pub struct Args {
     /// square root of this.
     // The literal is crate::solver::tuning::TAIL_PARTICLES_PER_VERTEX.
     #[arg(long, value_name = "N", default_value = "64", value_parser = parse_tail_particles)]
-    #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
+    #[arg(help_heading = heading::SOLVER)]
     pub(crate) tail_particles: f64,
 
     /// Pixels across a hemicube's top face (--form-factor hemicube).
