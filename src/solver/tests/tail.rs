@@ -3,6 +3,7 @@
 //! end), and its bits on any thread count.
 
 use super::*;
+use crate::testutil::regular_mesh;
 
 /// Tail options: from `from` of the emitted power, `particles` per
 /// element vertex.
@@ -121,14 +122,7 @@ fn the_tail_gives_the_same_bits_on_any_thread_count() {
 #[test]
 fn a_cancelled_tail_step_changes_nothing() {
     let s = glowing_box();
-    let mesh = mesh::build(
-        &s,
-        &MeshOptions {
-            lenmax: 0.2,
-            inset: 0.05,
-        },
-    )
-    .unwrap();
+    let mesh = regular_mesh(&s, 0.2);
     let vis = Visibility::new(&s);
     let mut solver = Progressive::new(&s, &mesh, &vis, tail(1.0, 50.0));
     while solver.step().is_some_and(|r| r.particles == 0) {}
@@ -150,14 +144,7 @@ fn a_cancelled_tail_step_changes_nothing() {
 #[test]
 fn a_tail_resumed_from_its_state_ends_as_the_uninterrupted_one() {
     let s = shadowed_box();
-    let mesh = mesh::build(
-        &s,
-        &MeshOptions {
-            lenmax: 0.1,
-            inset: crate::mesh::DEFAULT_INSET,
-        },
-    )
-    .unwrap();
+    let mesh = regular_mesh(&s, 0.1);
     let vis = Visibility::new(&s);
     let options = tail(0.1, 50.0);
     let run = |solver: &mut Progressive| while !solver.is_done() && solver.step().is_some() {};
