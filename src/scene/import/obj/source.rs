@@ -30,9 +30,10 @@
 //!   offsetting the texture coordinates of the material's primitive (the
 //!   texture is sampled at `s × vt + o`, before the flip) and `-clamp on`
 //!   by a clamping sampler; the others are ignored with a warning. A
-//!   texture that cannot be read, is neither PNG nor JPEG, or whose header
-//!   does not parse is left out with a warning naming the file and the
-//!   material, which keeps its `Kd`.
+//!   texture that cannot be read, is neither PNG nor JPEG, whose header
+//!   does not parse, or that would take the embedded images past
+//!   [`MAX_EMBEDDED_BYTES`] is left out with a warning naming the file and
+//!   the material, which keeps its `Kd`.
 //!
 //! Warnings follow the import's rule: one line for a quirk found many
 //! times, with a count and the first position.
@@ -53,6 +54,13 @@ use std::path::{Path, PathBuf};
 
 /// glTF sampler wrap mode `CLAMP_TO_EDGE`, for `-clamp on`.
 const CLAMP_TO_EDGE: u32 = 33071;
+
+/// The most bytes of texture files a model embeds, together: 1 GiB, far
+/// above any real model's textures and a quarter of the most a `.glb`
+/// can hold (its lengths are 32-bit), so the images held in memory and
+/// the file written stay bounded however many textures an MTL names.
+/// A texture that would go past it is left out, with the warning.
+pub const MAX_EMBEDDED_BYTES: u64 = 1 << 30;
 
 /// The model of an OBJ file and what reading it for the model said.
 #[derive(Clone, Debug, Default)]
@@ -391,6 +399,8 @@ impl Builder {
     ) -> ObjSource {
         let mut model = SourceModel::default();
         let mut images: HashMap<PathBuf, usize> = HashMap::new();
+        // Bytes of the images embedded so far.
+        let mut embedded = 0u64;
         let mut textures: HashMap<(usize, bool), usize> = HashMap::new();
         let mut left_out = Tally::<(String, SourcePos)>::default();
         let mut ignored = Tally::<(String, SourcePos)>::default();
@@ -412,11 +422,15 @@ impl Builder {
                     .join(map);
                 let image = match images.get(&path) {
                     Some(&i) => Ok(i),
-                    None => read(&path).and_then(embeddable).map(|image| {
-                        model.images.push(image);
-                        images.insert(path.clone(), model.images.len() - 1);
-                        model.images.len() - 1
-                    }),
+                    None => within_budget(&path, embedded)
+                        .and_then(|()| read(&path))
+                        .and_then(embeddable)
+                        .map(|image| {
+                            embedded += image.bytes.len() as u64;
+                            model.images.push(image);
+                            images.insert(path.clone(), model.images.len() - 1);
+                            model.images.len() - 1
+                        }),
                 };
                 match image {
                     Ok(image) => {
@@ -513,6 +527,21 @@ fn base_material(record: Option<&MtlMaterial>) -> Value {
             "roughnessFactor": 1.0,
         },
     })
+}
+
+/// Whether the texture file at `path` fits beside the `embedded` bytes
+/// already taken ([`MAX_EMBEDDED_BYTES`]), from its size before it is
+/// read; a file whose size cannot be read is let through to the read,
+/// which says why.
+fn within_budget(path: &Path, embedded: u64) -> Result<(), String> {
+    match std::fs::metadata(path) {
+        Ok(meta) if embedded.saturating_add(meta.len()) > MAX_EMBEDDED_BYTES => Err(format!(
+            "its {} bytes would take the model's embedded images past {} MiB",
+            meta.len(),
+            MAX_EMBEDDED_BYTES >> 20
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The image of a texture file's `bytes` as a glTF holds it: PNG or JPEG
@@ -650,6 +679,22 @@ mod tests {
             ]
         );
         assert_eq!(c.texcoords, vec![[0.0, 0.0], [1.0, 0.0]]);
+    }
+
+    #[test]
+    fn textures_past_the_embedding_budget_are_refused_by_their_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.png");
+        // Sparse: the size without the bytes.
+        std::fs::File::create(&path)
+            .unwrap()
+            .set_len(MAX_EMBEDDED_BYTES + 1)
+            .unwrap();
+        assert!(within_budget(&path, 0).is_err());
+        std::fs::File::create(&path).unwrap().set_len(100).unwrap();
+        assert!(within_budget(&path, 0).is_ok());
+        assert!(within_budget(&path, MAX_EMBEDDED_BYTES - 100).is_ok());
+        assert!(within_budget(&path, MAX_EMBEDDED_BYTES - 99).is_err());
     }
 
     #[test]
