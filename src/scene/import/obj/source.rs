@@ -205,12 +205,13 @@ struct Corners {
 }
 
 /// One corner of a face: its position, texture coordinate and normal
-/// indices into the file's lists, 0-based.
+/// indices into the file's lists, 0-based (32-bit, as tobj's: a model's
+/// every corner is held at once).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct CornerRef {
-    v: usize,
-    vt: Option<usize>,
-    vn: Option<usize>,
+    v: u32,
+    vt: Option<u32>,
+    vn: Option<u32>,
 }
 
 impl Corners {
@@ -256,8 +257,8 @@ impl Corners {
         // warned of it and the import read the corner without it).
         for refs in out.faces.values_mut() {
             for r in refs {
-                r.vt = r.vt.filter(|&i| i < out.texcoords.len());
-                r.vn = r.vn.filter(|&i| i < out.normals.len());
+                r.vt = r.vt.filter(|&i| (i as usize) < out.texcoords.len());
+                r.vn = r.vn.filter(|&i| (i as usize) < out.normals.len());
             }
         }
         out
@@ -269,13 +270,14 @@ impl Corners {
 /// `vt` and `vn` lines before it.
 fn corner_ref(word: &str, seen: &[usize; 3]) -> Option<CornerRef> {
     let mut parts = word.split('/');
-    let resolve = |part: Option<&str>, kind: usize| -> Option<usize> {
+    let resolve = |part: Option<&str>, kind: usize| -> Option<u32> {
         let i = part.filter(|p| !p.is_empty())?.parse::<i64>().ok()?;
-        if i > 0 {
-            Some(i as usize - 1)
+        let i = if i > 0 {
+            i as usize - 1
         } else {
-            seen[kind].checked_sub(i.unsigned_abs() as usize)
-        }
+            seen[kind].checked_sub(i.unsigned_abs() as usize)?
+        };
+        u32::try_from(i).ok()
     };
     let v = resolve(parts.next(), 0)?;
     let vt = resolve(parts.next(), 1);
@@ -361,7 +363,7 @@ impl Builder {
             .map(|&(position, r)| {
                 let vn = r
                     .and_then(|r| r.vn)
-                    .map(|i| Vec3::from_array(corners.normals[i]).normalize_or_zero())
+                    .map(|i| Vec3::from_array(corners.normals[i as usize]).normalize_or_zero())
                     .filter(|n| n.is_finite() && *n != Vec3::ZERO);
                 // A corner is shared by its file indices; one whose normal
                 // is its face's is its face's alone.
@@ -377,7 +379,7 @@ impl Builder {
                 p.positions.push(position.to_array());
                 p.normals.push(vn.unwrap_or(piece.normal).to_array());
                 p.texcoords
-                    .push(r.and_then(|r| r.vt).map(|t| corners.texcoords[t]));
+                    .push(r.and_then(|r| r.vt).map(|t| corners.texcoords[t as usize]));
                 if let Some(key) = key {
                     p.vertices.insert(key, i);
                 }
