@@ -5,6 +5,8 @@
 //! options refused with exit code 2.
 
 mod common;
+#[path = "support/gltf.rs"]
+mod support;
 
 use common::{run_in, stderr, write};
 use serde_json::Value;
@@ -509,6 +511,405 @@ fn a_gltf_model_keeps_its_texture_coordinates_and_images() {
             [uv0[2 * k], uv0[2 * k + 1]],
             [x - 10.0, 1.0 + z],
             "vertex {k}"
+        );
+    }
+}
+
+/// A 2 × 1 floor of two quads meeting at x = 1, each with texture
+/// coordinates of its own (so the two corners on x = 1 have two `vt`
+/// each), material `Tex`, and a lamp above facing down. The left quad's
+/// `vt` is `(x / 2, −z)`, the right one's `(1/4 + 3/4 (x − 1), −z)`: `v`
+/// grows towards −z, where OBJ's `v = 1`, the top of the image, lies.
+const TEXTURED_OBJ: &str = "\
+mtllib tex.mtl
+v 0 0 0
+v 1 0 0
+v 2 0 0
+v 2 0 -1
+v 1 0 -1
+v 0 0 -1
+v 0.8 1 -0.3
+v 1.2 1 -0.3
+v 1.2 1 -0.7
+v 0.8 1 -0.7
+vt 0 0
+vt 0.5 0
+vt 0.5 1
+vt 0 1
+vt 0.25 0
+vt 1 0
+vt 1 1
+vt 0.25 1
+o Floor
+usemtl Tex
+f 1/1 2/2 5/3 6/4
+f 2/5 3/6 4/7 5/8
+o Lamp
+usemtl Lamp
+f 10 9 8 7
+";
+
+/// The `vt` [`TEXTURED_OBJ`] gives the floor's point `(x, z)` on the
+/// quad left (`x < 1`) or right of x = 1.
+fn obj_vt(left: bool, x: f32, z: f32) -> [f32; 2] {
+    if left {
+        [x / 2.0, -z]
+    } else {
+        [0.25 + 0.75 * (x - 1.0), -z]
+    }
+}
+
+/// A 4 × 4 PNG, its top two rows red and its bottom two blue.
+fn red_over_blue_png() -> Vec<u8> {
+    let mut png = Vec::new();
+    image::RgbImage::from_fn(4, 4, |_, y| {
+        image::Rgb(if y < 2 { [200, 40, 40] } else { [40, 40, 200] })
+    })
+    .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+    .unwrap();
+    png
+}
+
+impl Glb {
+    /// The primitives of material `name`.
+    fn primitives_of(&self, name: &str) -> Vec<Value> {
+        let materials = self.json["materials"].as_array().unwrap();
+        let m = materials.iter().position(|m| m["name"] == name).unwrap();
+        self.json["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|mesh| mesh["primitives"].as_array().unwrap().clone())
+            .filter(|p| p["material"] == m)
+            .collect()
+    }
+
+    /// The material named `name`.
+    fn material(&self, name: &str) -> &Value {
+        let materials = self.json["materials"].as_array().unwrap();
+        materials.iter().find(|m| m["name"] == name).unwrap()
+    }
+
+    /// Every triangle of `primitive`: its corners' positions and
+    /// `TEXCOORD_0`.
+    fn triangles_uv0(&self, primitive: &Value) -> Vec<Triangle> {
+        let pos = self.floats(primitive["attributes"]["POSITION"].as_u64().unwrap());
+        let uv = self.floats(primitive["attributes"]["TEXCOORD_0"].as_u64().unwrap());
+        let idx = self.floats(primitive["indices"].as_u64().unwrap());
+        idx.chunks_exact(3)
+            .map(|t| {
+                let i = [t[0], t[1], t[2]].map(|i| i as usize);
+                (
+                    [0, 1, 2].map(|k| [pos[3 * i[k]], pos[3 * i[k] + 1], pos[3 * i[k] + 2]]),
+                    [0, 1, 2].map(|k| [uv[2 * i[k]], uv[2 * i[k] + 1]]),
+                )
+            })
+            .collect()
+    }
+
+    /// The image texture `index` shows, decoded, and its encoded bytes
+    /// and media type.
+    fn texture_image(&self, index: &Value) -> (image::RgbImage, Vec<u8>, String) {
+        let texture = &self.json["textures"][index.as_u64().unwrap() as usize];
+        let image = &self.json["images"][texture["source"].as_u64().unwrap() as usize];
+        let bytes = self
+            .view(image["bufferView"].as_u64().unwrap() as usize)
+            .to_vec();
+        let decoded = image::load_from_memory(&bytes).unwrap().to_rgb8();
+        (
+            decoded,
+            bytes,
+            image["mimeType"].as_str().unwrap().to_string(),
+        )
+    }
+}
+
+/// The value at the point `(x, z)` of a floor triangle (facing either
+/// way) of `triangles`, interpolated from its corners' `uv`.
+fn floor_uv_at(triangles: &[Triangle], x: f32, z: f32) -> [f32; 2] {
+    let p = [x, 0.0, z];
+    for (pos, uv) in triangles {
+        let area = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
+            (b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])
+        };
+        let total = area(pos[0], pos[1], pos[2]);
+        let w = [
+            area(p, pos[1], pos[2]) / total,
+            area(pos[0], p, pos[2]) / total,
+            area(pos[0], pos[1], p) / total,
+        ];
+        if w.iter().all(|&x| x >= 0.0) {
+            return [0, 1].map(|k| w[0] * uv[0][k] + w[1] * uv[1][k] + w[2] * uv[2][k]);
+        }
+    }
+    panic!("no floor triangle holds ({x}, {z})");
+}
+
+/// Bakes `obj` (with `mtl` as `tex.mtl` and `files` beside it) in a new
+/// directory; returns it and what the run said.
+fn baked_obj(obj: &str, mtl: &str, files: &[(&str, &[u8])]) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "model.obj", obj);
+    write(dir.path(), "tex.mtl", mtl);
+    for (name, bytes) in files {
+        let path = dir.path().join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, bytes).unwrap();
+    }
+    let out = run_in(
+        dir.path(),
+        &[
+            "model.obj",
+            "--emit",
+            "Lamp=10",
+            "-o",
+            "model.png",
+            "--lightmap",
+            "model.glb",
+            "--lightmap-density",
+            "64",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    (dir, stderr(&out))
+}
+
+#[test]
+fn an_obj_keeps_its_texture_coordinates_and_its_map_kd_image_not_upside_down() {
+    let png = red_over_blue_png();
+    let mut jpeg = Vec::new();
+    image::RgbImage::from_pixel(8, 8, image::Rgb([90, 120, 30]))
+        .write_to(
+            &mut std::io::Cursor::new(&mut jpeg),
+            image::ImageFormat::Jpeg,
+        )
+        .unwrap();
+    // The lamp's texture has no extension: its type comes from its bytes.
+    let mtl = "newmtl Tex\nKd 0.9 0.8 0.7\nmap_Kd textures/red over blue.png\n\
+               newmtl Lamp\nKd 0 0 0\nKe 1 1 1\nmap_Kd lamp-image\n";
+    let (dir, said) = baked_obj(
+        TEXTURED_OBJ,
+        mtl,
+        &[("textures/red over blue.png", &png), ("lamp-image", &jpeg)],
+    );
+    assert!(!said.contains("lightmap's model"), "{said}");
+    let glb = Glb::read(&dir.path().join("model.glb"));
+    // Kd is the base colour, map_Kd its texture: the file's bytes, its
+    // media type read from them.
+    let tex = glb.material("Tex");
+    let factor: Vec<f32> = tex["pbrMetallicRoughness"]["baseColorFactor"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap() as f32)
+        .collect();
+    assert_eq!(factor, [0.9, 0.8, 0.7, 1.0]);
+    let (image, bytes, mime) =
+        glb.texture_image(&tex["pbrMetallicRoughness"]["baseColorTexture"]["index"]);
+    assert_eq!((bytes, mime.as_str()), (png, "image/png"));
+    let lamp = glb.material("Lamp");
+    let (_, bytes, mime) =
+        glb.texture_image(&lamp["pbrMetallicRoughness"]["baseColorTexture"]["index"]);
+    assert_eq!((bytes, mime.as_str()), (jpeg, "image/jpeg"));
+    // Every corner of every floor triangle, front or back, has its face's
+    // vt with v flipped: the corners on x = 1 are two vertices each.
+    let floor = glb.primitives_of("Tex");
+    let triangles: Vec<Triangle> = floor.iter().flat_map(|p| glb.triangles_uv0(p)).collect();
+    // Two quads, two triangles each, and a back copy of each.
+    assert_eq!(triangles.len(), 8);
+    for (pos, uv) in &triangles {
+        let left = pos.iter().map(|p| p[0]).sum::<f32>() < 3.0;
+        for k in 0..3 {
+            let [u, v] = obj_vt(left, pos[k][0], pos[k][2]);
+            assert_eq!(uv[k], [u, 1.0 - v], "corner {:?}", pos[k]);
+        }
+    }
+    // Sampled the glTF way (v = 0 the image's top row), the far end
+    // (OBJ's v = 1, the top of the image) is red and the near end blue,
+    // on both quads and both sides.
+    let colour_at = |x: f32, z: f32, facing_up: bool| {
+        let side: Vec<Triangle> = triangles
+            .iter()
+            .filter(|(p, _)| {
+                let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+                (n[1] > 0.0) == facing_up
+            })
+            .cloned()
+            .collect();
+        let [u, v] = floor_uv_at(&side, x, z);
+        let px = ((u * 4.0) as u32).min(3);
+        let py = ((v * 4.0) as u32).min(3);
+        image.get_pixel(px, py).0
+    };
+    for x in [0.5, 1.5] {
+        for up in [true, false] {
+            assert_eq!(colour_at(x, -0.9, up), [200, 40, 40], "far end at x = {x}");
+            assert_eq!(colour_at(x, -0.1, up), [40, 40, 200], "near end at x = {x}");
+        }
+    }
+    if let Some(validator) = validator() {
+        let issues = validate(&validator, &dir.path().join("model.glb"));
+        assert_eq!(issues["numErrors"], 0, "{issues:#}");
+        assert_eq!(issues["numWarnings"], 0, "{issues:#}");
+    } else {
+        eprintln!("validator skipped: the glTF validator is not installed");
+    }
+}
+
+#[test]
+fn map_kd_options_are_honoured_or_warned_and_a_missing_texture_is_one_warning() {
+    let png = red_over_blue_png();
+    // The left quad's texture is missing; the right one's is scaled,
+    // offset and clamped, and bump-multiplied (which means nothing here).
+    let obj = TEXTURED_OBJ.replace("f 2/5", "usemtl Opt\nf 2/5");
+    let mtl = "newmtl Tex\nKd 0.5 0.5 0.5\nmap_Kd missing.png\n\
+               newmtl Opt\nKd 1 1 1\nmap_Kd -s 2 2 1 -o 0.5 0 0 -clamp on -bm 0.3 tex.png\n\
+               newmtl Lamp\nKe 1 1 1\n";
+    let (dir, said) = baked_obj(&obj, mtl, &[("tex.png", &png)]);
+    let lines: Vec<&str> = said
+        .lines()
+        .filter(|l| l.contains("lightmap's model"))
+        .collect();
+    assert_eq!(lines.len(), 2, "{said}");
+    assert!(
+        lines[0].starts_with("tex.mtl:3:1: warning:")
+            && lines[0].contains("missing.png")
+            && lines[0].contains("`Tex`")
+            && lines[0].contains("keep `Kd` only"),
+        "{said}"
+    );
+    assert!(
+        lines[1].starts_with("tex.mtl:6:1: warning:")
+            && lines[1].contains("`-bm 0.3`")
+            && lines[1].contains("`Opt`"),
+        "{said}"
+    );
+    let glb = Glb::read(&dir.path().join("model.glb"));
+    // The material without its texture keeps Kd; its vt are kept.
+    let tex = glb.material("Tex");
+    assert!(tex["pbrMetallicRoughness"]
+        .get("baseColorTexture")
+        .is_none());
+    assert_eq!(tex["pbrMetallicRoughness"]["baseColorFactor"][0], 0.5);
+    for (pos, uv) in glb.triangles_uv0(&glb.primitives_of("Tex")[0]) {
+        for k in 0..3 {
+            let [u, v] = obj_vt(true, pos[k][0], pos[k][2]);
+            assert_eq!(uv[k], [u, 1.0 - v]);
+        }
+    }
+    // -s and -o: the texture is sampled at s × vt + o, then flipped;
+    // -clamp on: a clamping sampler; Kd 1 stays 1 as a base colour.
+    let opt = glb.material("Opt");
+    assert_eq!(opt["pbrMetallicRoughness"]["baseColorFactor"][0], 1.0);
+    let index = opt["pbrMetallicRoughness"]["baseColorTexture"]["index"]
+        .as_u64()
+        .unwrap() as usize;
+    let sampler = glb.json["textures"][index]["sampler"].as_u64().unwrap() as usize;
+    assert_eq!(glb.json["samplers"][sampler]["wrapS"], 33071);
+    assert_eq!(glb.json["samplers"][sampler]["wrapT"], 33071);
+    for (pos, uv) in glb.triangles_uv0(&glb.primitives_of("Opt")[0]) {
+        for k in 0..3 {
+            let [u, v] = obj_vt(false, pos[k][0], pos[k][2]);
+            assert_eq!(uv[k], [2.0 * u + 0.5, 1.0 - 2.0 * v]);
+        }
+    }
+}
+
+#[test]
+fn a_double_sided_gltf_face_gets_a_back_with_its_own_light() {
+    // A 2 × 2 floor at z = 0 facing +z, its material two-sided, under a
+    // one-sided lamp at z = 1 facing down: the floor's top is lit, its
+    // underside faces nothing.
+    let mut doc = support::Doc::new();
+    let floor = doc.material(serde_json::json!({"name": "Floor", "doubleSided": true,
+        "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0]}}));
+    let lamp = doc.material(serde_json::json!({"name": "Lamp"}));
+    let floor_square = doc.square(Some(floor), true);
+    let lamp_square = doc.square(Some(lamp), true);
+    let floor_mesh = doc.mesh("Floor", vec![floor_square]);
+    let lamp_mesh = doc.mesh("Lamp", vec![lamp_square]);
+    let nodes = [
+        doc.node(serde_json::json!({"name": "Floor", "mesh": floor_mesh,
+            "translation": [-1.0, -1.0, 0.0], "scale": [2.0, 2.0, 1.0]})),
+        // Half a turn about x: the square faces -z, over [-0.2, 0.2]².
+        doc.node(serde_json::json!({"name": "Lamp", "mesh": lamp_mesh,
+            "translation": [-0.2, 0.2, 1.0], "rotation": [1.0, 0.0, 0.0, 0.0],
+            "scale": [0.4, 0.4, 1.0]})),
+    ];
+    doc.scene(&nodes);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("floor.glb"), doc.glb()).unwrap();
+    let out = run_in(
+        dir.path(),
+        &[
+            "floor.glb",
+            "--emit",
+            "Lamp=10",
+            "-o",
+            "floor.png",
+            "--lightmap",
+            "baked.glb",
+            "--lightmap-density",
+            "32",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let glb = Glb::read(&dir.path().join("baked.glb"));
+    // Each side is drawn by its own triangles, so the material is no
+    // longer two-sided; the one-sided lamp gets no back.
+    assert!(glb.material("Floor").get("doubleSided").is_none());
+    let image = glb.lightmap();
+    let mut floor_triangles = Vec::new();
+    for p in glb.primitives_of("Floor") {
+        let pos = glb.floats(p["attributes"]["POSITION"].as_u64().unwrap());
+        let uv = glb.floats(p["attributes"]["TEXCOORD_1"].as_u64().unwrap());
+        let idx = glb.floats(p["indices"].as_u64().unwrap());
+        for t in idx.chunks_exact(3) {
+            let i = [t[0], t[1], t[2]].map(|i| i as usize);
+            floor_triangles.push((
+                [0, 1, 2].map(|k| [pos[3 * i[k]], pos[3 * i[k] + 1], pos[3 * i[k] + 2]]),
+                [0, 1, 2].map(|k| [uv[2 * i[k]], uv[2 * i[k] + 1]]),
+            ));
+        }
+    }
+    assert_eq!(floor_triangles.len(), 4);
+    let lamp_triangles: usize = glb
+        .primitives_of("Lamp")
+        .iter()
+        .map(|p| glb.floats(p["indices"].as_u64().unwrap()).len() / 3)
+        .sum();
+    assert_eq!(lamp_triangles, 2);
+    // The light at (x, y) on the side facing +z (`up`) or -z.
+    let light = |x: f32, y: f32, up: bool| {
+        for (pos, uv) in &floor_triangles {
+            let n = cross(sub(pos[1], pos[0]), sub(pos[2], pos[0]));
+            if (n[2] > 0.0) != up {
+                continue;
+            }
+            let area = |a: [f32; 3], b: [f32; 3], c: [f32; 2]| {
+                (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+            };
+            let p = [x, y];
+            let total = area(pos[0], pos[1], [pos[2][0], pos[2][1]]);
+            let w = [
+                area(pos[1], pos[2], p) / total,
+                area(pos[2], pos[0], p) / total,
+                area(pos[0], pos[1], p) / total,
+            ];
+            if w.iter().all(|&x| x >= 0.0) {
+                let at = [0, 1].map(|k| w[0] * uv[0][k] + w[1] * uv[1][k] + w[2] * uv[2][k]);
+                return brightness_at(&image, at);
+            }
+        }
+        panic!("no floor triangle facing {up} holds ({x}, {y})");
+    };
+    for (x, y) in [(0.1, 0.1), (-0.5, 0.3), (0.6, -0.6)] {
+        let (top, under) = (light(x, y, true), light(x, y, false));
+        assert!(
+            top > 50.0 && under < 2.0,
+            "({x}, {y}): top {top}, underside {under}"
         );
     }
 }

@@ -2,7 +2,7 @@
 // as a web page shows it, and writes the canvas as a PNG.
 //
 //   node render.mjs MODEL.glb OUT.png --eye X,Y,Z --look-at X,Y,Z
-//        [--up X,Y,Z] [--fov DEG] [--size WxH] [--show file|colours]
+//        [--up X,Y,Z] [--fov DEG] [--size WxH] [--show file|colours|base]
 //
 // The camera options mean what the program's own options of those names
 // mean (a vertical field of view in degrees), so a picture the program
@@ -12,7 +12,10 @@
 // added, so what shows is what the file emits (a baked lightmap in
 // `emissiveTexture`): the renderer as the guide's three.js snippet makes
 // it, with its defaults. --show colours: every mesh drawn unlit in its
-// COLOR_0 vertex colours (the program's `--export` baked light).
+// COLOR_0 vertex colours (the program's `--export` baked light). --show
+// base: every mesh drawn unlit in its material's base colour and base
+// colour texture (the albedo a viewer's own lights would shade), to see
+// how a model's textures lie on it.
 //
 // Chromium is /usr/bin/chromium (Debian's `chromium` package) unless
 // CHROMIUM names another; WebGL runs on SwiftShader, so no GPU is needed.
@@ -28,7 +31,7 @@ const here = path.dirname(fileURLToPath(import.meta.url));
 function usage(message) {
   console.error(`render.mjs: error: ${message}`);
   console.error(
-    "usage: node render.mjs MODEL.glb OUT.png --eye X,Y,Z --look-at X,Y,Z [--up X,Y,Z] [--fov DEG] [--size WxH] [--show file|colours]",
+    "usage: node render.mjs MODEL.glb OUT.png --eye X,Y,Z --look-at X,Y,Z [--up X,Y,Z] [--fov DEG] [--size WxH] [--show file|colours|base]",
   );
   process.exit(2);
 }
@@ -67,8 +70,8 @@ if (!(fov > 0 && fov < 180)) usage(`--fov must be in (0, 180), got \`${options.f
 const size = /^(\d+)x(\d+)$/.exec(options.size);
 if (!size) usage(`--size must be WxH, got \`${options.size}\``);
 const [width, height] = [Number(size[1]), Number(size[2])];
-if (!["file", "colours"].includes(options.show)) {
-  usage(`--show must be file or colours, got \`${options.show}\``);
+if (!["file", "colours", "base"].includes(options.show)) {
+  usage(`--show must be file, colours or base, got \`${options.show}\``);
 }
 
 // The page: three.js from node_modules, the model as /model.glb.
@@ -101,6 +104,13 @@ new GLTFLoader().load("/model.glb", (gltf) => {
   if (settings.show === "colours") {
     scene.traverse((o) => {
       if (o.isMesh) o.material = new THREE.MeshBasicMaterial({ vertexColors: true, side: o.material.side });
+    });
+  } else if (settings.show === "base") {
+    scene.traverse((o) => {
+      if (o.isMesh) {
+        const m = o.material;
+        o.material = new THREE.MeshBasicMaterial({ color: m.color, map: m.map, side: m.side });
+      }
     });
   }
   renderer.render(scene, camera);

@@ -692,6 +692,20 @@ fn write_lightmap(
             }
             model
         }
+        SceneSource::File(path) if is_obj(path) => {
+            let source = crate::scene::import::obj::source::load_obj_source(
+                path,
+                &prepared.inputs,
+                &config.scene.stem(),
+            )
+            .map_err(|e| RunError::Prepare(PrepareError::Load(e)))?;
+            // Said whatever `-q` says, as the load's warnings are: the
+            // model lacks what the user gave it.
+            for warning in &source.warnings {
+                eprintln!("{warning}");
+            }
+            source.model
+        }
         _ => lightmap::model::scene_model(&prepared.scene, &config.scene.stem()),
     };
     let mesh: &crate::mesh::Mesh = &solved.mesh;
@@ -750,6 +764,13 @@ fn write_lightmap(
         written.push(path);
     }
     Ok(())
+}
+
+/// True when `path` names an OBJ file (`.obj`, as [`crate::scene::load`]
+/// reads it).
+fn is_obj(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
 }
 
 /// True when `path` names a glTF file (`.gltf` or `.glb`).

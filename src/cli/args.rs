@@ -408,7 +408,8 @@ pub struct Args {
     /// Write the model with its baked light as a lightmap (.glb).
     ///
     /// The scene's own model (a glTF's primitives, normals, TEXCOORD_0 and
-    /// materials; an OBJ's faces), not the element mesh, with a second UV
+    /// materials; an OBJ's faces with their vt, vn, Kd and map_Kd
+    /// textures), not the element mesh, with a second UV
     /// set (TEXCOORD_1: the model's own, else made by chart packing) and
     /// the lightmap embedded as every material's emissiveTexture: the
     /// radiosity tone-mapped as the picture is, so three.js, Blender and

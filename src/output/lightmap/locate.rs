@@ -104,6 +104,27 @@ impl<'a> Locator<'a> {
     /// than the tolerance) is stepped past, [`PROBE_STEPS`] times at most,
     /// by starting again just behind it.
     pub fn sample(&self, point: Vec3, normal: Vec3) -> Option<Sample> {
+        let (polygon, on) = self.polygon_at(point, normal)?;
+        let (shown, radiosity) = self.interpolate(polygon, on)?;
+        Some(Sample {
+            polygon,
+            shown,
+            radiosity,
+        })
+    }
+
+    /// Whether the solver lit the side of the surface at `point` that
+    /// faces along the unit `normal`: a scene polygon lies there (as
+    /// [`Locator::sample`] finds it) with its front that way. False where
+    /// no polygon lies, and on the back of a one-sided face.
+    pub fn lit_side(&self, point: Vec3, normal: Vec3) -> bool {
+        self.polygon_at(point, normal)
+            .is_some_and(|(p, _)| self.scene.polygons[p.index()].normal.dot(normal) > 0.0)
+    }
+
+    /// The polygon [`Locator::sample`] reads at `point` for a surface
+    /// facing along `normal`, and the point where its probe met it.
+    fn polygon_at(&self, point: Vec3, normal: Vec3) -> Option<(PolygonId, Vec3)> {
         let mut origin = point + normal * self.offset;
         let mut ahead = self.offset;
         let mut found = None;
@@ -125,13 +146,7 @@ impl<'a> Locator<'a> {
         let (hit, on) = found?;
         // The two sides of a two-sided face are two coplanar polygons:
         // take the one facing the model's front.
-        let polygon = self.facing(hit, normal);
-        let (shown, radiosity) = self.interpolate(polygon, on)?;
-        Some(Sample {
-            polygon,
-            shown,
-            radiosity,
-        })
+        Some((self.facing(hit, normal), on))
     }
 
     /// `hit`, or its back side when that faces along `normal` and `hit`

@@ -8,8 +8,14 @@
 //! primitives with their positions, normals, `TEXCOORD_0`, indices and
 //! materials (textures and images embedded), in world space (the node
 //! hierarchy is flattened: one node per drawn mesh, transforms applied).
-//! An OBJ or `.sc` scene becomes a glTF of its own faces ([`model`]), not
-//! of the element mesh.
+//! An OBJ file comes back as its faces with their texture coordinates,
+//! normals, colours and `map_Kd` textures
+//! ([`crate::scene::import::obj::source`]); a `.sc` scene becomes a glTF
+//! of its own faces ([`model`]); neither is the element mesh.
+//!
+//! **The sides** ([`backs`]): a triangle whose back the solver lit (a
+//! two-sided face) gets a back copy with texels of its own, unless the
+//! model brings its own lightmap UVs.
 //!
 //! **The UVs** ([`uv`]): the model's `TEXCOORD_1` when every primitive has
 //! one, else made by automatic chart packing, [`uv::PADDING`] texels of
@@ -43,6 +49,7 @@
 //! reflectance`, in the scene's radiosity units, linear, 32-bit float);
 //! `FILE.png` writes the 8-bit emissive texture the `.glb` holds.
 
+pub mod backs;
 pub mod fill;
 pub mod glb;
 pub mod locate;
@@ -111,9 +118,15 @@ pub fn bake(
     density: Option<f32>,
     cancel: &Cancel,
 ) -> Result<Baked, BakeError> {
+    let locator = locate::Locator::new(scene, mesh, visibility, shown, radiosity);
+    // A model with its own lightmap UVs keeps them: back copies would
+    // share their fronts' texels.
+    if !model.primitives.iter().all(|p| p.uv1.is_some()) {
+        backs::add_backs(&mut model, &locator);
+    }
+    cancel.check()?;
     let layout = uv::lay_out(&mut model, density).map_err(BakeError::Layout)?;
     cancel.check()?;
-    let locator = locate::Locator::new(scene, mesh, visibility, shown, radiosity);
     let texture = fill::fill(&model, layout.width, layout.height, &locator, scene, cancel)?;
     Ok(Baked {
         model,

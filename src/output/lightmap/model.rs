@@ -1,13 +1,16 @@
-//! The model a lightmap is baked for, when the scene file is no glTF (an
-//! OBJ or `.sc` scene): the scene's own faces, as loaded, written as a
-//! glTF model.
+//! The model a lightmap is baked for when the scene file is neither glTF
+//! nor OBJ (whose own models are read back from the file, see
+//! [`crate::scene::import::gltf::source`] and
+//! [`crate::scene::import::obj::source`]): a `.sc` scene's faces, as
+//! loaded, written as a glTF model.
 //!
 //! Each face keeps its corners (a convex polygon, fanned into triangles
 //! from its first corner) and its flat normal; faces are grouped into one
 //! primitive per material, in a single node. A two-sided face is two
 //! faces, its front and its back copy, as the solver lit them: each side
 //! gets its own texels, so a viewer that culls back faces shows each side
-//! with its own light. The sky's facets are left out.
+//! with its own light ([`super::backs`] finds every back there and adds
+//! none). The sky's facets are left out.
 
 use super::glb::DEFAULT_MATERIAL_NAME;
 use crate::scene::import::gltf::source::{SourceModel, SourcePrimitive};

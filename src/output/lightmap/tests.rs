@@ -370,3 +370,49 @@ fn a_cancelled_fill_stops_and_says_so() {
     let whole = fill(&model, 256, 256, &locator, &s, &Cancel::new()).unwrap();
     assert!(whole.shown.covered.iter().any(|&c| c));
 }
+
+/// Back copies follow the solution: none on a one-sided floor, one per
+/// triangle on a two-sided one, with their corners reversed and normals
+/// negated, the material made single-sided; none for a model that holds
+/// the backs already (the `.sc` model of the same two-sided floor).
+#[test]
+fn a_triangle_gets_a_back_where_the_solver_lit_one() {
+    use super::backs::add_backs;
+    use crate::scene::Sides;
+    let with_normals = || {
+        let mut m = two_chart_floor();
+        for p in &mut m.primitives {
+            p.normals = Some(vec![[0.0, 1.0, 0.0]; 3]);
+            p.uv1 = None;
+        }
+        m.materials = vec![serde_json::json!({"name": "floor", "doubleSided": true})];
+        m
+    };
+    for (sides, want) in [(Sides::One, 0), (Sides::Two, 2)] {
+        let s = floor_scene().with_sides(sides);
+        let (mesh, radiosity) = linear_solution(&s, 0.25);
+        let visibility = Visibility::new(&s);
+        let locator = Locator::new(&s, &mesh, &visibility, &radiosity, &radiosity);
+        let mut model = with_normals();
+        assert_eq!(add_backs(&mut model, &locator), want, "{sides:?}");
+        assert_eq!(
+            model.materials[0].get("doubleSided").is_none(),
+            want > 0,
+            "{sides:?}"
+        );
+        for p in model.primitives.iter().filter(|_| want > 0) {
+            assert_eq!(p.indices.len(), 6);
+            let (front, back) = (&p.indices[..3], &p.indices[3..]);
+            for k in 0..3 {
+                let (f, b) = (front[k] as usize, back[(3 - k) % 3] as usize);
+                assert_eq!(p.positions[f], p.positions[b]);
+                assert_eq!(p.normals.as_ref().unwrap()[b], [-0.0, -1.0, -0.0]);
+            }
+        }
+        let mut own = scene_model(&s, "floor");
+        let triangles: usize = own.primitives.iter().map(|p| p.indices.len() / 3).sum();
+        assert_eq!(add_backs(&mut own, &locator), 0, "{sides:?}");
+        let after: usize = own.primitives.iter().map(|p| p.indices.len() / 3).sum();
+        assert_eq!(triangles, after);
+    }
+}

@@ -40,7 +40,7 @@ pub enum Sides {
 
 /// The exact vertex bits of a polygon from its lowest vertex on, in its
 /// own order: equal keys mean the same face with the same front.
-fn face_key(vertices: &[glam::Vec3]) -> Vec<[u32; 3]> {
+pub(in crate::scene) fn face_key(vertices: &[glam::Vec3]) -> Vec<[u32; 3]> {
     let bits: Vec<[u32; 3]> = vertices
         .iter()
         .map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()])

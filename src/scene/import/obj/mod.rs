@@ -67,7 +67,9 @@
 //! `mesh::weld`). A face split into triangles gives each its
 //! surface.
 //!
-//! What is ignored: texture coordinates, the directions of normals, lines
+//! What is ignored (by the scene: the model `--lightmap` writes keeps
+//! texture coordinates, normals and `map_Kd` textures, see [`source`]):
+//! texture coordinates, the directions of normals, lines
 //! (`l`) and points (`p`), `Ka`, `Ns`, other maps,
 //! and what makes a material specular, a mirror, glass or metal: non-black
 //! `Ks` above [`DIFFUSE_SHEEN_LIMIT`] (Blender's default 0.5 is not), `illum` 3 to 9, `d`
@@ -98,6 +100,7 @@
 
 mod mtl;
 mod scan;
+pub mod source;
 
 use mtl::{parse_mtl, read_textures, Library, MtlMaterial};
 use scan::{
@@ -450,7 +453,7 @@ fn reading_warnings(
         (
             &scan.dropped[0],
             "texture coordinate",
-            "texture coordinates are not used",
+            "texture coordinates serve only the --lightmap model",
         ),
         (
             &scan.dropped[1],
@@ -726,7 +729,7 @@ fn two_sided_scene(
 // ------------------------------------------------------------ faces --
 
 /// Why a face gives no polygon.
-enum FaceError {
+pub(super) enum FaceError {
     /// No area, a repeated vertex, or smaller than the smallest polygon:
     /// the face is dropped with a warning. The reason, for the message.
     Degenerate(String),
@@ -756,8 +759,20 @@ fn face_polygons(
     vertices: Vec<Vec3>,
     origin: SourcePos,
 ) -> Result<Vec<Polygon>, FaceError> {
+    face_pieces(material, vertices, origin).map(|pieces| pieces.into_iter().map(|p| p.0).collect())
+}
+
+/// [`face_polygons`], each polygon with the face's corners it is made of
+/// (indices into `vertices`, in the polygon's order), so that what the
+/// corners carry besides a position (texture coordinates, normals) can
+/// follow them.
+pub(super) fn face_pieces(
+    material: MaterialId,
+    vertices: Vec<Vec3>,
+    origin: SourcePos,
+) -> Result<Vec<(Polygon, Vec<usize>)>, FaceError> {
     let whole = match Polygon::new(material, vertices.clone(), origin) {
-        Ok(p) => return Ok(vec![p]),
+        Ok(p) => return Ok(vec![(p, (0..vertices.len()).collect())]),
         Err(e) => e,
     };
     let fail = |e: &PolygonError| {
@@ -795,7 +810,7 @@ fn face_polygons(
             vec![vertices[a], vertices[b], vertices[c]],
             origin,
         ) {
-            Ok(p) => out.push(p),
+            Ok(p) => out.push((p, vec![a, b, c])),
             Err(e) if is_degenerate(&e) => {}
             Err(e) => return Err(fail(&e)),
         }

@@ -34,9 +34,14 @@ pub(super) struct MtlMaterial {
     pub(super) pos: SourcePos,
     /// `Kd` as used (clamped below one), `None` when the block has none.
     pub(super) kd: Option<Rgb>,
+    /// `Kd` as written (a model's base colour, which may reach one).
+    pub(super) kd_written: Option<Rgb>,
     pub(super) ke: Rgb,
     /// The `map_Kd` file (with `/` for `\`) and where it is named.
     pub(super) map_kd: Option<(String, SourcePos)>,
+    /// The options written before the `map_Kd` file, word by word
+    /// (`-s 2 2 1 -clamp on`).
+    pub(super) map_kd_options: Vec<String>,
     /// The average linear colour of the `map_Kd` texture, once read.
     pub(super) texture: Option<Rgb>,
     /// Statements asking for more than diffuse reflection, as written
@@ -99,9 +104,13 @@ pub(super) fn number(w: &[(&str, u32)]) -> Option<f64> {
         .filter(|x| x.is_finite())
 }
 
-/// The file named by a `map_Kd` line: the rest of the line after the
-/// options (`-s 1 1 1`, `-bm 0.5`, ...), so names with spaces are kept.
-pub(super) fn map_file<'a>(line: &'a str, w: &[(&'a str, u32)]) -> Option<&'a str> {
+/// A `map_Kd` line split into its options (every word between the
+/// keyword and the file: `-s 1 1 1`, `-bm 0.5`, ...) and its file, the
+/// rest of the line, so that names with spaces are kept.
+pub(super) fn map_parts<'a>(
+    line: &'a str,
+    w: &[(&'a str, u32)],
+) -> Option<(Vec<&'a str>, &'a str)> {
     let mut i = 1;
     while let Some(&(word, _)) = w.get(i) {
         let args = match word {
@@ -122,7 +131,8 @@ pub(super) fn map_file<'a>(line: &'a str, w: &[(&'a str, u32)]) -> Option<&'a st
     }
     let &(_, col) = w.get(i)?;
     let start = line.char_indices().nth(col as usize - 1)?.0;
-    Some(line[start..].trim())
+    let options = w[1..i].iter().map(|(x, _)| *x).collect();
+    Some((options, line[start..].trim()))
 }
 
 /// Reads an MTL library: `newmtl`, `Kd`, `Ke` and `map_Kd`, and notes the
@@ -161,7 +171,8 @@ pub(super) fn parse_mtl(text: &str, file: &str, loaded_at: u32) -> Library {
         match keyword {
             "Kd" | "Ke" => set_color(&mut lib.diags, &mut lib.warnings, m, &w, file, number_),
             "map_Kd" => {
-                if let Some(name) = map_file(line, &w).filter(|n| !n.is_empty()) {
+                if let Some((options, name)) = map_parts(line, &w).filter(|p| !p.1.is_empty()) {
+                    m.map_kd_options = options.into_iter().map(str::to_string).collect();
                     let path = if name.contains('\\') {
                         lib.backslashes.add(at(col), || name.to_string());
                         name.replace('\\', "/")
@@ -230,8 +241,10 @@ fn start_material(lib: &mut Library, file: &str, line: &str, pos: SourcePos) {
         file: file.to_string(),
         pos,
         kd: None,
+        kd_written: None,
         ke: Rgb::BLACK,
         map_kd: None,
+        map_kd_options: Vec::new(),
         texture: None,
         non_diffuse: Vec::new(),
         illum: None,
@@ -272,7 +285,8 @@ fn set_color(
             ));
         }
         Ok(rgb) if keyword == "Ke" => m.ke = rgb,
-        Ok(rgb) if rgb.max_channel() >= 1.0 => {
+        Ok(rgb) if keyword == "Kd" && rgb.max_channel() >= 1.0 => {
+            m.kd_written = Some(rgb);
             // Same hue, brightest channel at the cap.
             let clamped = rgb * (MAX_MTL_REFLECTANCE / rgb.max_channel());
             let show = |c: Rgb| c.to_array().map(fmt_num).join(" ");
@@ -289,7 +303,10 @@ fn set_color(
             ));
             m.kd = Some(clamped);
         }
-        Ok(rgb) => m.kd = Some(rgb),
+        Ok(rgb) => {
+            m.kd_written = Some(rgb);
+            m.kd = Some(rgb);
+        }
     }
 }
 

@@ -276,7 +276,7 @@ fn texture_coordinates_and_normals_that_do_not_exist_are_dropped_with_a_warning(
         warning_lines(&s),
         [
             "m.obj:12:3: warning: 4 face corner(s) name a texture coordinate that does not \
-                 exist (first `1/7/1`); read without it (texture coordinates are not used)",
+                 exist (first `1/7/1`); read without it (texture coordinates serve only the --lightmap model)",
             "m.obj:13:18: warning: 1 face corner(s) name a normal that does not exist \
                  (first `4/4/9`); read without it (normals only join smooth surfaces)",
         ]
