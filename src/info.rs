@@ -240,19 +240,38 @@ fn emitters(scene: &Scene, out: &mut String) {
             ));
         }
     }
-    if lines.is_empty() && sky.is_none() {
+    if lines.is_empty() && sky.is_none() && scene.sun.is_none() {
         out.push_str("emitters: none (light a material, object or group with --emit NAME=VALUE, or give --sky)\n");
         return;
     }
+    let sun = crate::batch::daylight::sun_stats(scene);
     let _ = writeln!(
         out,
         "emitters ({}):",
-        lines.len() + usize::from(sky.is_some())
+        lines.len() + usize::from(sky.is_some()) + usize::from(sun.is_some())
     );
     for line in lines {
         let _ = writeln!(out, "{line}");
     }
     if let Some(s) = sky {
-        let _ = writeln!(out, "  the sky (--sky): {}", rgb(s));
+        if scene.sky_pattern.is_some() {
+            let _ = writeln!(
+                out,
+                "  the sky (--sky): a standard sky, its facets' mean radiosity {}",
+                rgb(s)
+            );
+        } else {
+            let _ = writeln!(out, "  the sky (--sky): {}", rgb(s));
+        }
+    }
+    if let Some(sun) = sun {
+        let _ = writeln!(
+            out,
+            "  the sun (--sun): azimuth {:.1}, altitude {:.1} degrees, {} lx direct normal, {} lx on open ground",
+            sun.azimuth,
+            sun.altitude,
+            crate::batch::daylight::thousands(sun.normal_lux),
+            crate::batch::daylight::thousands(sun.horizontal_lux),
+        );
     }
 }

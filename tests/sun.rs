@@ -238,3 +238,37 @@ fn the_sun_refuses_what_it_cannot_use() {
     let e = eavg(&out);
     assert!((e - 10_000.0).abs() < 100.0, "{e}");
 }
+
+/// `--info` lists the sun among the emitters, where it stands and how
+/// bright, and says the sky is a standard one, without solving.
+#[test]
+fn info_names_the_sun_and_the_standard_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let office = root().join("scenes").join("daylight-office.sc");
+    let out = run_in(
+        dir.path(),
+        &[
+            office.to_str().unwrap(),
+            "--units",
+            "m",
+            "--sky",
+            "cie-clear",
+            "--sun",
+            "200,40,80000lx",
+            "--info",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("emitters (2):"), "{said}");
+    assert!(said.contains("the sky (--sky): a standard sky"), "{said}");
+    // 80,000 lx at 40 degrees: 51,400 lx on the open ground.
+    assert!(
+        said.contains(
+            "the sun (--sun): azimuth 200.0, altitude 40.0 degrees, \
+             80,000 lx direct normal, 51,400 lx on open ground"
+        ),
+        "{said}"
+    );
+    assert!(listing(dir.path()).is_empty(), "--info writes nothing");
+}
