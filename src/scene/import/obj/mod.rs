@@ -656,17 +656,7 @@ fn face_polygons_of(
                 // tobj as a face: a polyline, not a surface.
                 continue;
             }
-            let vertices: Vec<Vec3> = indices
-                .iter()
-                .map(|&i| {
-                    let i = i as usize * 3;
-                    Vec3::new(
-                        mesh.positions[i],
-                        mesh.positions[i + 1],
-                        mesh.positions[i + 2],
-                    )
-                })
-                .collect();
+            let vertices: Vec<Vec3> = indices.iter().map(|&i| position(mesh, i)).collect();
             match face_polygons(material, vertices, face.pos) {
                 Ok(mut ps) => {
                     for p in &mut ps {
@@ -933,6 +923,17 @@ pub(super) fn name_list(names: &[String]) -> String {
         s.push_str(&format!(" and {} more", names.len() - MAX_NAMES_IN_WARNING));
     }
     s
+}
+
+/// The position of vertex `i` of a mesh tobj read (its `positions`, three
+/// floats a vertex; `i` one of its `indices`).
+fn position(mesh: &tobj::Mesh, i: u32) -> Vec3 {
+    let i = i as usize * 3;
+    Vec3::new(
+        mesh.positions[i],
+        mesh.positions[i + 1],
+        mesh.positions[i + 2],
+    )
 }
 
 #[cfg(test)]

@@ -148,17 +148,7 @@ pub fn load_obj_source(path: &Path, inputs: &InputSet, name: &str) -> Result<Obj
             if face.is_line {
                 continue;
             }
-            let positions: Vec<Vec3> = indices
-                .iter()
-                .map(|&i| {
-                    let i = i as usize * 3;
-                    Vec3::new(
-                        mesh.positions[i],
-                        mesh.positions[i + 1],
-                        mesh.positions[i + 2],
-                    )
-                })
-                .collect();
+            let positions: Vec<Vec3> = indices.iter().map(|&i| super::position(mesh, i)).collect();
             // The corners' file indices, when the line has as many as tobj
             // read (it always has: both read the same checked text).
             let refs = corners
