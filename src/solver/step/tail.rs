@@ -14,7 +14,7 @@
 //!   unshot power (area times the mean of its corners' `|Δb|`), at a
 //!   uniform point of it, carrying the unshot radiosity interpolated
 //!   there times the power's share (signed: light sent ahead comes back
-//!   as negative particles, [`crate::solver::unshot::Shot`]);
+//!   as negative particles: overshooting, [`crate::solver::Approximations`]);
 //! - it leaves in a cosine-weighted direction, and where it first lands
 //!   on the front of a reflecting polygon the power reflected there,
 //!   `ρ · Φ`, is added to the corners of the element triangle it landed
