@@ -153,7 +153,7 @@ pub struct Args {
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) tail: TailOption,
 
-    /// Particles the tail traces in all, per element vertex.
+    /// Particles per element vertex the tail traces over four steps.
     ///
     /// The noise of the light the tail carries falls as one over the
     /// square root of this.

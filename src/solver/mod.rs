@@ -241,8 +241,10 @@ pub struct SolverOptions {
     /// When the light left unshot is carried by particles instead of
     /// shooting steps ([`step::tail`]).
     pub tail: TailOption,
-    /// Particles the tail traces over all its steps, per element vertex,
-    /// `> 0` ([`tuning::TAIL_PARTICLES_PER_VERTEX`] by default).
+    /// Particles per element vertex the tail traces over four steps, a
+    /// quarter each (a tail that begins well below its fraction takes
+    /// fewer steps), `> 0` ([`tuning::TAIL_PARTICLES_PER_VERTEX`] by
+    /// default).
     pub tail_particles: f64,
 }
 
