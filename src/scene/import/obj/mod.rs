@@ -197,19 +197,8 @@ pub fn load_obj_with(
     // names are decoded the same way in the OBJ and in its MTL files.
     let text = String::from_utf8_lossy(&bytes);
     let folder = ModelFolder::of(path, inputs);
-    let read_mtl = |name: &str| -> Result<(String, String), String> {
-        let mtl_path = folder.join(name);
-        let display = mtl_path.display().to_string();
-        match folder.read(&mtl_path, InputKind::Material) {
-            Ok(bytes) => Ok((display, String::from_utf8_lossy(&bytes).into_owned())),
-            Err(e) => Err(e.to_string()),
-        }
-    };
-    let read_texture = |path: &Path| {
-        folder
-            .read(path, InputKind::Texture)
-            .map_err(|e| e.to_string())
-    };
+    let read_mtl = |name: &str| read_library(&folder, name);
+    let read_texture = |path: &Path| read_texture_file(&folder, path);
     let scene = parse_obj_reading(&text, &file, &read_mtl, &read_texture, budget);
     // A library or texture refused for what it is or where it lies ends
     // the load, though one that is missing is only warned about.
@@ -925,6 +914,25 @@ pub(super) fn name_list(names: &[String]) -> String {
     s
 }
 
+/// Reads the material library `name` (as an `mtllib` line names it) from
+/// the model's `folder`: its path as messages show it and its text
+/// (decoded lossily, as the OBJ is), or why it cannot be read.
+fn read_library(folder: &ModelFolder, name: &str) -> Result<(String, String), String> {
+    let mtl_path = folder.join(name);
+    let display = mtl_path.display().to_string();
+    match folder.read(&mtl_path, InputKind::Material) {
+        Ok(bytes) => Ok((display, String::from_utf8_lossy(&bytes).into_owned())),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Reads a texture file a material names, from the model's `folder`, or
+/// says why it cannot be read.
+fn read_texture_file(folder: &ModelFolder, path: &Path) -> Result<Vec<u8>, String> {
+    folder
+        .read(path, InputKind::Texture)
+        .map_err(|e| e.to_string())
+}
 /// The position of vertex `i` of a mesh tobj read (its `positions`, three
 /// floats a vertex; `i` one of its `indices`).
 fn position(mesh: &tobj::Mesh, i: u32) -> Vec3 {

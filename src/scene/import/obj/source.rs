@@ -40,7 +40,10 @@
 
 use super::mtl::MtlMaterial;
 use super::scan::{lines, repaired_text, scan_obj, words};
-use super::{face_pieces, read_with_tobj, Tally, DEFAULT_MATERIAL_NAME, DEFAULT_REFLECTANCE};
+use super::{
+    face_pieces, read_library, read_texture_file, read_with_tobj, Tally, DEFAULT_MATERIAL_NAME,
+    DEFAULT_REFLECTANCE,
+};
 use crate::color::Rgb;
 use crate::scene::error::cannot_read;
 use crate::scene::import::gltf::source::{SourceImage, SourceModel, SourcePrimitive};
@@ -85,19 +88,8 @@ pub fn load_obj_source(path: &Path, inputs: &InputSet, name: &str) -> Result<Obj
     let text = String::from_utf8_lossy(&bytes);
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let folder = ModelFolder::of(path, inputs);
-    let read_mtl = |name: &str| -> Result<(String, String), String> {
-        let mtl_path = folder.join(name);
-        let display = mtl_path.display().to_string();
-        match folder.read(&mtl_path, InputKind::Material) {
-            Ok(bytes) => Ok((display, String::from_utf8_lossy(&bytes).into_owned())),
-            Err(e) => Err(e.to_string()),
-        }
-    };
-    let read_texture = |path: &Path| {
-        folder
-            .read(path, InputKind::Texture)
-            .map_err(|e| e.to_string())
-    };
+    let read_mtl = |name: &str| read_library(&folder, name);
+    let read_texture = |path: &Path| read_texture_file(&folder, path);
     let scan = scan_obj(text, &file);
     if !scan.diags.is_empty() {
         return Err(LoadError::from_diagnostics(scan.diags));
