@@ -12,8 +12,9 @@
 # hemicube comparisons from `cargo run --release --example hemicube_compare`
 # (docs/accuracy.md gives the commands) and the scaling plots from
 # `cargo run --release --example scaling_plot` on the CSV files in docs/.
-# window.png and window-mesh.png are screenshots of the window and are not
-# made here. lightmap-threejs.png is the --lightmap model rendered by
+# window.png and window-mesh.png are the window's screenshots, made by
+# scripts/window_shots.sh (the real window under Xvfb, driven with xdotool:
+# apt-get install xvfb xdotool). lightmap-threejs.png is the --lightmap model rendered by
 # three.js in headless Chromium (scripts/browser/render.mjs).
 set -u
 cd "$(dirname "$0")/.."

@@ -2,16 +2,22 @@
 //! is made by a script or a documented command, so a picture can be
 //! regenerated when the program changes instead of going stale:
 //! `scripts/doc_images.sh` for the bundled scenes' pictures,
-//! `docs/images/render_models.sh` for the exported models, and the
-//! `cargo run --example …` lines the docs give for the plots. The window's
-//! two screenshots are the one exception, named here.
+//! `docs/images/render_models.sh` for the exported models,
+//! `scripts/window_shots.sh` for the window's screenshots (the real window
+//! under Xvfb, driven by xdotool), and the `cargo run --example …` lines
+//! the docs give for the plots.
 
 mod common;
 
 use common::*;
 
-/// Pictures that are screenshots of the window, taken by hand.
-const SCREENSHOTS: [&str; 2] = ["window.png", "window-mesh.png"];
+/// The scripts that make pictures: each lists them as `"NAME|…"` entries
+/// (the picture is `NAME.png`), in the folder of `docs/images/` given.
+const SCRIPTS: [(&str, &str); 3] = [
+    ("scripts/doc_images.sh", ""),
+    ("docs/images/render_models.sh", "models/"),
+    ("scripts/window_shots.sh", ""),
+];
 
 /// The documents whose pictures must be reproducible.
 const DOCS: [&str; 6] = [
@@ -37,15 +43,12 @@ fn pictures_in(text: &str) -> Vec<String> {
 }
 
 /// Names a script or a documented command makes: `NAME|` entries of the
-/// two picture scripts (their output is `NAME.png`), and
-/// `docs/images/FILE` arguments of `cargo run` lines in the docs.
+/// [`SCRIPTS`] (their output is `NAME.png`), and `docs/images/FILE`
+/// arguments of `cargo run` lines in the docs.
 fn made_pictures() -> Vec<String> {
     let root = root();
     let mut made = Vec::new();
-    for (script, folder) in [
-        ("scripts/doc_images.sh", ""),
-        ("docs/images/render_models.sh", "models/"),
-    ] {
+    for (script, folder) in SCRIPTS {
         let text = std::fs::read_to_string(root.join(script)).unwrap();
         for line in text.lines() {
             let line = line.trim();
@@ -85,7 +88,7 @@ fn every_picture_the_docs_show_is_made_by_a_script_or_a_documented_command() {
                 "{doc} shows images/{picture}, which does not exist"
             );
             assert!(
-                made.contains(&picture) || SCREENSHOTS.contains(&picture.as_str()),
+                made.contains(&picture),
                 "{doc} shows images/{picture}, which no script makes \
                  (add it to scripts/doc_images.sh)"
             );
@@ -94,11 +97,11 @@ fn every_picture_the_docs_show_is_made_by_a_script_or_a_documented_command() {
     assert!(shown >= 20, "{shown} pictures found");
 }
 
-/// The picture script is valid shell: a syntax error would only show
+/// The picture scripts are valid shell: a syntax error would only show
 /// when someone next needs the pictures.
 #[test]
 fn the_picture_scripts_parse() {
-    for script in ["scripts/doc_images.sh", "docs/images/render_models.sh"] {
+    for (script, _) in SCRIPTS {
         let status = std::process::Command::new("bash")
             .arg("-n")
             .arg(root().join(script))
