@@ -5,9 +5,16 @@
 //! tutorial's `room.sc` taken from the guide itself, real exported models
 //! from `tests/models/` for `room.glb`, `house.glb` and `cornell.obj`),
 //! must exit 0 and write every file it names; where the docs show what a
-//! command prints (a plain code block right after it), each shown line
-//! must be printed exactly, and where a table row gives a command's mesh
-//! (`| 14,206 vertices |`), `--stats` must count as many.
+//! command prints (a plain code block right after it), the block must be
+//! an excerpt of what it printed (standard output, then standard error),
+//! and where a table row gives a command's mesh (`| 14,206 vertices |`),
+//! `--stats` must count as many.
+//!
+//! Finding the commands and their shown output is this file's own work (in
+//! `sh` blocks, inline code and table rows, which `trycmd` cannot read);
+//! running them and matching the output is `snapbox`'s: a shown block may
+//! use its wildcards, `...` on a line of its own for lines left out and
+//! `[..]` for the part of a line that varies with the machine (seconds).
 //!
 //! Real models are solved for a few steps only (`--max-steps` is added);
 //! the bundled `.sc` scenes run to convergence, as the docs say.
@@ -273,6 +280,16 @@ fn files_of(args: &[String]) -> (Vec<String>, Vec<String>) {
     (inputs, outputs)
 }
 
+/// The program with `args` in `dir`, with no display (a documented
+/// command writes its files; it opens no window).
+fn radiosity(dir: &Path, args: &[String]) -> snapbox::cmd::Command {
+    snapbox::cmd::Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+}
+
 fn run_documented(doc: &Documented) {
     let at = format!("{}:{}: `{}`", doc.file, doc.line, doc.command);
     let dir = tempfile::tempdir().unwrap();
@@ -300,16 +317,8 @@ fn run_documented(doc: &Documented) {
         let k = first.iter().position(|a| a == "--resume").unwrap();
         first.drain(k..k + 2);
         first.extend(["--max-steps".to_string(), "5".to_string()]);
-        let o = run_in(
-            dir.path(),
-            &first.iter().map(String::as_str).collect::<Vec<_>>(),
-        );
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "{at} (the run it resumes): {}",
-            stderr(&o)
-        );
+        println!("running {at} (the run it resumes)");
+        radiosity(dir.path(), &first).assert().success();
     }
     let real_model = inputs
         .iter()
@@ -328,12 +337,12 @@ fn run_documented(doc: &Documented) {
         }
         None => String::new(),
     };
-    let o = run_in(
-        dir.path(),
-        &args.iter().map(String::as_str).collect::<Vec<_>>(),
-    );
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(0), "{at}: {err}");
+    // Said first, so that a failure below (whose message is snapbox's:
+    // the exit code, standard output and error) names the documented line.
+    println!("running {at}");
+    let run = radiosity(dir.path(), &args).assert().success();
+    let o = run.get_output();
+    let err = stderr(o);
     assert!(!err.contains("panicked"), "{at}: {err}");
     // A documented command makes a picture worth looking at.
     assert!(!err.contains("nearly black"), "{at}: {err}");
@@ -352,13 +361,18 @@ fn run_documented(doc: &Documented) {
             "{at}: the docs give {vertices} vertices"
         );
     }
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    for line in &doc.prints {
-        assert!(
-            stdout.lines().any(|l| l == line) || err.lines().any(|l| l == line),
-            "{at}: the docs show it printing\n{line}\nbut it printed\n{stdout}{err}"
-        );
+    if !doc.prints.is_empty() {
+        let printed = format!("{}{err}", String::from_utf8_lossy(&o.stdout));
+        snapbox::Assert::new()
+            .try_eq(Some(&at), printed.into(), shown(&doc.prints).into())
+            .unwrap_or_else(|e| panic!("{at}: the docs show other output:\n{e}"));
     }
+}
+
+/// The snapbox pattern the docs' shown lines make: an excerpt, so any
+/// lines before and after it.
+fn shown(prints: &[String]) -> String {
+    format!("...\n{}\n...\n", prints.join("\n"))
 }
 
 #[test]
@@ -368,6 +382,30 @@ fn the_docs_show_commands_to_run() {
     assert!(all.len() >= 15, "{all:#?}");
     assert!(all.iter().any(|d| !d.prints.is_empty()), "{all:#?}");
     assert!(all.iter().any(|d| d.vertices.is_some()), "{all:#?}");
+}
+
+/// What a shown block accepts, without running the program: the lines in
+/// order anywhere in the output, `[..]` for what varies; a changed figure
+/// anywhere else fails.
+#[test]
+fn a_shown_block_is_an_excerpt_with_wildcards() {
+    let printed = "warning: something\nroom.sc: 33 steps, 0.59 s solving, 2.9 M rays\nwrote x\n";
+    let matches = |lines: &[&str]| {
+        let lines: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        snapbox::Assert::new()
+            .try_eq(None, printed.into(), shown(&lines).into())
+            .is_ok()
+    };
+    assert!(matches(&["room.sc: 33 steps, [..] s solving, 2.9 M rays"]));
+    assert!(matches(&[
+        "room.sc: 33 steps, 0.59 s solving, 2.9 M rays",
+        "wrote x"
+    ]));
+    assert!(matches(&["warning: something", "...", "wrote x"]));
+    assert!(!matches(&["room.sc: 34 steps, [..] s solving, 2.9 M rays"]));
+    assert!(!matches(&["room.sc: 33 steps, [..] s solving, 3.0 M rays"]));
+    assert!(!matches(&["wrote x", "warning: something"]));
+    assert!(!matches(&["room.sc: 33 steps, 0.60 s solving, 2.9 M rays"]));
 }
 
 #[test]
