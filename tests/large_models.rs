@@ -13,7 +13,9 @@
 //!   straight above is the one `tests/models/README.md` gives;
 //! - through the program, a short solve under `--sky 1` on a coarse mesh
 //!   (one element a triangle) gives a picture that is not black, with
-//!   finite radiosity everywhere.
+//!   finite radiosity everywhere;
+//! - every figure and quote `tests/models/README.md` gives of the models
+//!   is one checked here or counted from the file.
 //!
 //! A full solve of one of these takes minutes (`docs/performance.md`);
 //! two steps (each the light of one of the sky's 80 facets) are what
@@ -296,6 +298,15 @@ const VIANNEY_HOUSE: Model = Model {
     min_lit: 0.045,
 };
 
+/// `room.glb`: the triangles of material `Room` (walls, floor, roof).
+const ROOM_WALLS: usize = 232;
+/// `room.glb`: its spheres, and the triangles of each.
+const SPHERES: usize = 16;
+/// See [`SPHERES`].
+const SPHERE_TRIANGLES: usize = 3968;
+/// The house's polygons the intersection pass cuts, and their pieces.
+const VIANNEY_CUT: (usize, usize) = (696, 2034);
+
 /// The path of a collected model, `tests/models/<rel>`.
 fn model(rel: &str) -> PathBuf {
     root().join("tests").join("models").join(rel)
@@ -451,7 +462,8 @@ fn load(m: &Model) -> Scene {
 /// at the default sides, checks the warnings of loading and repair
 /// against [`Model::warnings`] and that every polygon stays finite, and
 /// meshes the result at the coarse lenmax: every element vertex finite.
-fn repair_and_mesh(m: &Model, loaded: Scene) {
+/// Returns what the intersection pass cut: polygons and their pieces.
+fn repair_and_mesh(m: &Model, loaded: Scene) -> (usize, usize) {
     let name = model(m.rel).display().to_string();
     let options = RepairOptions {
         sides: Sides::AsLoaded,
@@ -459,7 +471,7 @@ fn repair_and_mesh(m: &Model, loaded: Scene) {
         file: &name,
         budget: radiosity::budget::MemoryBudget::UNLIMITED,
     };
-    let (repaired, _) = repair::run(loaded, &options, Visibility::new).unwrap();
+    let (repaired, report) = repair::run(loaded, &options, Visibility::new).unwrap();
     let warnings: Vec<String> = repaired.warnings.iter().map(|w| w.to_string()).collect();
     assert_eq!(warnings.len(), m.warnings.len(), "{}: {warnings:#?}", m.rel);
     for (got, want) in warnings.iter().zip(m.warnings) {
@@ -490,12 +502,13 @@ fn repair_and_mesh(m: &Model, loaded: Scene) {
         "{}: element vertices finite",
         m.rel
     );
+    (report.split.polygons_cut, report.split.pieces)
 }
 
 /// [`load`] then [`repair_and_mesh`].
-fn loads_whole(m: &Model) {
+fn loads_whole(m: &Model) -> (usize, usize) {
     let loaded = load(m);
-    repair_and_mesh(m, loaded);
+    repair_and_mesh(m, loaded)
 }
 
 // ---------------------------------------------------------------------------
@@ -603,15 +616,15 @@ fn godot_room_loads_whole() {
             .filter(|p| s.materials[p.material.index()].name == material)
             .count()
     };
-    assert_eq!(triangles_of("Room"), 232);
-    assert_eq!(triangles_of("Glass"), 16 * 3968);
+    assert_eq!(triangles_of("Room"), ROOM_WALLS);
+    assert_eq!(triangles_of("Glass"), SPHERES * SPHERE_TRIANGLES);
     let spheres: Vec<usize> = s
         .groups
         .iter()
         .filter(|g| g.kind == GroupKind::Object && g.name.starts_with("Sphere"))
         .map(|g| g.polygons.len())
         .collect();
-    assert_eq!(spheres, [3968; 16]);
+    assert_eq!(spheres, [SPHERE_TRIANGLES; SPHERES]);
     repair_and_mesh(&ROOM_GLB, s);
 }
 
@@ -645,10 +658,261 @@ fn redeclipse_fortitude_is_lit_under_a_sky() {
 
 #[test]
 fn xeogl_vianney_house_loads_whole() {
-    loads_whole(&VIANNEY_HOUSE);
+    // Walls, floors and frames pass through each other: cut where they
+    // cross, as `tests/models/README.md` says.
+    assert_eq!(loads_whole(&VIANNEY_HOUSE), VIANNEY_CUT);
 }
 
 #[test]
 fn xeogl_vianney_house_is_lit_under_a_sky() {
     lit_under_a_sky(&VIANNEY_HOUSE);
+}
+
+// ---------------------------------------------------------------------------
+// What tests/models/README.md says of the models.
+
+/// `n` with a comma between thousands, as the README writes counts.
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// `N closed object(s) (M faces)` of a model's warnings, as `N of M faces`.
+fn turned_out(m: &Model) -> Option<String> {
+    m.warnings.iter().find_map(|w| {
+        let (n, rest) = w.starts.split_once(" closed object(s) (")?;
+        let n = n.rsplit(' ').next()?;
+        let faces = rest.split_once(" faces)")?.0;
+        Some(format!("{n} of {faces} faces"))
+    })
+}
+
+/// The size the README gives: each side to the nearest whole unit.
+fn size_text(m: &Model) -> String {
+    m.size.map(|x| format!("{}", x.round())).join(" × ")
+}
+
+/// Every figure `tests/models/README.md` gives of the collected models is
+/// the one the tests above check (the constants, each checked against the
+/// model itself) or one counted here from the file: the README cannot
+/// drift from the models.
+#[test]
+fn the_models_readme_gives_what_the_models_hold() {
+    let text = std::fs::read_to_string(root().join("tests/models/README.md")).unwrap();
+    // Figures run across line breaks: compare with single spaces.
+    let readme = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let says = |what: &str| {
+        assert!(
+            readme.contains(what),
+            "tests/models/README.md does not say `{what}`"
+        )
+    };
+    // The table's triangle column.
+    for m in [
+        &PANDORA,
+        &ZDM2_OBJ,
+        &ROOM_GLB,
+        &ZDM2_GLB,
+        &VIANNEY_HOUSE,
+        &FORTITUDE,
+    ] {
+        let dropped = match m.dropped {
+            0 => "none".to_string(),
+            n => thousands(n),
+        };
+        says(&format!("| {} ({dropped} dropped)", thousands(m.triangles)));
+    }
+    // The Cube 2 levels, in the README's order.
+    let levels = [&PANDORA, &ZDM2_OBJ, &FORTITUDE];
+    let [a, b, c] = levels.map(|m| m.materials);
+    says(&format!("texture ({a}, {b} and {c} of them)"));
+    let [a, b, c] = levels.map(|m| m.dropped);
+    says(&format!("a vertex written twice ({a}, {b} and {c},"));
+    let [a, b, c] = levels.map(|m| turned_out(m).unwrap_or("none".into()));
+    says(&format!("under the default two sides ({a}, {b}, {c})"));
+    let [a, b, c] = levels.map(size_text);
+    says(&format!(
+        "Cube units, {a} (pandora), {b} (zdm2), {c} (fortitude)"
+    ));
+    let [a, b, c] = levels.map(|m| m.open_up_percent);
+    says(&format!("pandora {a} % (mostly roofed), zdm2 {b} %"));
+    says(&format!("fortitude {c} %."));
+    // The room.
+    let nodes = gltf_json(&model(ROOM_GLB.rel))["nodes"]
+        .as_array()
+        .unwrap()
+        .len();
+    says(&format!("a closed room of {} m", size_text(&ROOM_GLB)));
+    says(&format!(
+        "{SPHERES} spheres of {} triangles each",
+        thousands(SPHERE_TRIANGLES)
+    ));
+    says(&format!("the room's {ROOM_WALLS} triangles"));
+    says(&format!(
+        "all {} triangles of the spheres",
+        thousands(SPHERES * SPHERE_TRIANGLES)
+    ));
+    says(&format!("{nodes} nodes, each a mesh of its own"));
+    says(&format!(
+        "Of its upward-facing area {} % is open",
+        ROOM_GLB.open_up_percent
+    ));
+    // zdm2 through Blender.
+    let first = ZDM2_GLB.warnings[0].starts;
+    let at = first.split("triangle ").nth(1).unwrap().split(':').next();
+    says(&format!(
+        "{} degenerate triangles, zero-area ones and slivers (the first is triangle {})",
+        thousands(ZDM2_GLB.dropped),
+        at.unwrap()
+    ));
+    says(&format!("metres, {}", size_text(&ZDM2_GLB)));
+    says(&format!(
+        "{} % of the upward-facing area open",
+        ZDM2_GLB.open_up_percent
+    ));
+    // The house: its triangles by material, from the file.
+    let house = gltf_json(&model(VIANNEY_HOUSE.rel));
+    let mesh = &house["meshes"][0]["primitives"];
+    let of = |names: &[&str]| -> usize {
+        mesh.as_array()
+            .unwrap()
+            .iter()
+            .filter(|p| {
+                let material = &house["materials"][p["material"].as_u64().unwrap() as usize];
+                names.contains(&material["name"].as_str().unwrap())
+            })
+            .map(|p| {
+                house["accessors"][p["indices"].as_u64().unwrap() as usize]["count"]
+                    .as_u64()
+                    .unwrap() as usize
+                    / 3
+            })
+            .sum()
+    };
+    says(&format!(
+        "One mesh of {} primitives",
+        mesh.as_array().unwrap().len()
+    ));
+    says(&format!(
+        "{} of its triangles are `door_handle` and {} window and door frames \
+         (`metal_frame`, `mid-frame`), against {} of `wall`",
+        thousands(of(&["door_handle"])),
+        thousands(of(&["metal_frame", "mid-frame"])),
+        of(&["wall"])
+    ));
+    assert_eq!(VIANNEY_HOUSE.dropped, 1);
+    says("one zero-area triangle (dropped)");
+    says(&format!(
+        "{} polygons cut into {} pieces",
+        thousands(VIANNEY_CUT.0),
+        thousands(VIANNEY_CUT.1)
+    ));
+    says(&format!(
+        "a house with glazed walls, {} in",
+        size_text(&VIANNEY_HOUSE)
+    ));
+    says(&format!(
+        "{} % of the upward-facing area open",
+        VIANNEY_HOUSE.open_up_percent
+    ));
+}
+
+/// What `tests/models/README.md` quotes from the small models' files is in
+/// them, and the counts it gives are theirs.
+#[test]
+fn the_models_readme_quotes_the_small_models() {
+    let text = std::fs::read_to_string(root().join("tests/models/README.md")).unwrap();
+    let readme = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let file = |rel: &str| std::fs::read_to_string(model(rel)).unwrap();
+    let lines = |rel: &str, start: &str| file(rel).lines().filter(|l| l.starts_with(start)).count();
+    let sphere = "mcguire/CornellBox-Sphere.obj";
+    for (rel, quotes) in [
+        ("mcguire/CornellBox-Original.mtl", &["Ke 17 12 4"][..]),
+        (
+            "mcguire/CornellBox-Original.obj",
+            &["f -12 -11 -10 -9", "f -8 -7 -6 -5"],
+        ),
+        (sphere, &["# 546 vertices", "s 1"]),
+        (
+            "mcguire/CornellBox-Sphere.mtl",
+            &[
+                "Ks 0.95",
+                "illum 5",
+                "illum 7",
+                "Ni 2.5",
+                "Kd 0.01",
+                "v 0.2 0 0",
+            ],
+        ),
+        ("tinyobjloader/cornell_box.mtl", &["Kd 1", "Ka 20 20 20"]),
+        ("raylib/plane.obj", &["# Blender v2.90.0 OBJ File"]),
+    ] {
+        let text = file(rel);
+        for quote in quotes {
+            assert!(text.contains(quote), "{rel} has no `{quote}`");
+            assert!(readme.contains(&format!("`{quote}")), "README: {quote}");
+        }
+    }
+    assert!(readme.contains(&format!("{} faces", lines(sphere, "f "))));
+    let vt = lines("threejs/verify.obj", "vt ");
+    assert_eq!(vt, 4, "the README says four `vt` lines");
+    assert!(readme.contains("beyond the four `vt` lines"));
+    // The glTF files' generators, as the README quotes them.
+    for (rel, generator) in [
+        ("raylib/greenman.glb", "Khronos glTF Blender I/O v3.6.27"),
+        ("khronos/Box.gltf", "COLLADA2GLTF"),
+        (ROOM_GLB.rel, "Khronos glTF Blender I/O v3.3.27"),
+        (ZDM2_GLB.rel, "Khronos glTF Blender I/O v1.6.16"),
+        (VIANNEY_HOUSE.rel, "Sketchfab (OSG glTF plugin)"),
+    ] {
+        assert_eq!(gltf_json(&model(rel))["asset"]["generator"], generator);
+        assert!(
+            readme.contains(&format!("`{generator}`")),
+            "README: {generator}"
+        );
+    }
+    // room.glb's two colours, to two decimals.
+    let room = gltf_json(&model(ROOM_GLB.rel));
+    let colour = |name: &str| -> String {
+        let m = room["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == name)
+            .unwrap();
+        let c = m["pbrMetallicRoughness"]["baseColorFactor"]
+            .as_array()
+            .unwrap();
+        c[..3]
+            .iter()
+            .map(|x| format!("{}", (x.as_f64().unwrap() * 100.0).round() / 100.0))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    assert_eq!(colour("Room"), "0.8, 0.8, 0.8");
+    assert!(readme.contains("`Room` (0.8 grey"));
+    assert!(readme.contains(&format!("`Glass` ({}, all", colour("Glass"))));
+    // zdm2.glb's one node turns it a quarter about x.
+    let zdm2 = gltf_json(&model(ZDM2_GLB.rel));
+    let q: Vec<f64> = zdm2["nodes"][0]["rotation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    assert!((q[0] - half).abs() < 1e-6 && q[1] == 0.0 && q[2] == 0.0 && (q[3] - half).abs() < 1e-6);
+    assert!(readme.contains("one mesh in one node, rotated 90° about x"));
+    // The one level under 50,000 triangles.
+    assert!(FORTITUDE.triangles < 50_000 && readme.contains("just under 50,000"));
+    // The pictures' size is the script's.
+    let script = std::fs::read_to_string(root().join("docs/images/render_models.sh")).unwrap();
+    assert!(script.contains("--size 480x360") && readme.contains("(480x360;"));
 }
