@@ -384,6 +384,34 @@ fn the_docs_show_commands_to_run() {
     assert!(all.iter().any(|d| d.vertices.is_some()), "{all:#?}");
 }
 
+/// The README a newcomer reads first stays short (about ten minutes), and
+/// gets to their own model early: the formats in its opening paragraph,
+/// then the two commands, then a model of theirs lit (`--emit`) and taken
+/// elsewhere (`--export`) within its first 60 lines, all of it run by the
+/// tests above.
+#[test]
+fn the_readme_is_short_and_lights_your_own_model_early() {
+    let text = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines.len() <= 200, "README.md has {} lines", lines.len());
+    let first = |what: &str| lines.iter().position(|l| l.contains(what));
+    assert!(first("OBJ").is_some_and(|k| k < 10), "OBJ late");
+    assert!(first("glTF").is_some_and(|k| k < 10), "glTF late");
+    let commands = first("## The two commands").expect("the two commands");
+    let own = first("## Your own model").expect("your own model");
+    assert!(commands < own && own < 60, "{commands} {own}");
+    let own_commands: Vec<Documented> = commands_of("README.md")
+        .into_iter()
+        .filter(|d| d.line > own && d.line < 60)
+        .collect();
+    for option in ["--emit", "--export"] {
+        assert!(
+            own_commands.iter().any(|d| d.command.contains(option)),
+            "no `radiosity … {option}` under \"Your own model\": {own_commands:#?}"
+        );
+    }
+}
+
 /// What a shown block accepts, without running the program: the lines in
 /// order anywhere in the output, `[..]` for what varies; a changed figure
 /// anywhere else fails.
