@@ -348,6 +348,39 @@ fn quit(display: &str, program: &mut Reaper) {
     assert!(status.success(), "exit status {status}");
 }
 
+/// The title the guide gives as its example is the one rtable's window
+/// shows once converged, rays per second aside (they vary with the
+/// machine).
+#[test]
+fn the_guides_title_example_is_rtables_converged_title() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let guide = std::fs::read_to_string(common::root().join("docs/guide.md")).unwrap();
+    let example = guide
+        .split('`')
+        .find(|span| span.starts_with("radiosity — rtable — "))
+        .expect("the guide gives a title example");
+    // The number before ` Mrays/s` varies: a snapbox wildcard.
+    let (before, after) = example.split_once(" Mrays/s").expect("Mrays/s");
+    let pattern = format!(
+        "{}[..] Mrays/s{after}",
+        &before[..before.rfind(' ').unwrap() + 1]
+    );
+    let Some((_xvfb, display)) = x_server() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (mut program, window) = open_scene("rtable", dir.path(), &display, &[]);
+    let title = wait_for(Duration::from_secs(120), || {
+        let title = xdotool(&display, &["getwindowname", &window])?;
+        title.contains("converged").then_some(title)
+    })
+    .expect("rtable converges in the window");
+    snapbox::Assert::new()
+        .try_eq(Some(&"the window's title"), title.into(), pattern.into())
+        .unwrap_or_else(|e| panic!("docs/guide.md's title example:\n{e}"));
+    quit(&display, &mut program);
+}
+
 /// From the camera of every bundled scene, dragging with the left button
 /// (150 px right and 80 px up, then back to the start) looks around
 /// from the eye: the view stays in the room and the picture `w` writes is
