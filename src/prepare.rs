@@ -485,14 +485,17 @@ mod tests {
     use super::*;
     use crate::mesh::budget::VERTEX_BUDGET;
 
-    /// 125 unit squares stacked 0.001 apart, facing up: at the default
-    /// lenmax (1/80 of the diagonal √2.015376, 0.017745) 58 × 58 vertices
-    /// each, 420,500 in all, over [`VERTEX_BUDGET`]; the finest
-    /// three-digit lenmax within it is 0.0182, 56 × 56 each, 392,000 in
-    /// all (0.0181 gives 57 × 57, 406,125).
+    /// Unit squares in [`stack_of_squares`].
+    const STACKED: usize = 150;
+
+    /// [`STACKED`] unit squares stacked 0.001 apart, facing up: at the
+    /// default lenmax (1/80 of the diagonal √2.022201, 0.017776) 58 × 58
+    /// vertices each, 504,600 in all, over [`VERTEX_BUDGET`]; the finest
+    /// three-digit lenmax within it is 0.0186, 55 × 55 each, 453,750 in
+    /// all (0.0185 gives 56 × 56, 470,400).
     fn stack_of_squares(dir: &Path) -> std::path::PathBuf {
         let mut text = String::from("material wall color 1 1 1 k_diffrefl 0.5 end\n");
-        for k in 0..125 {
+        for k in 0..STACKED {
             let z = k as f64 * 0.001;
             text += &format!(
                 "polygon wall vertex 0 0 {z} vertex 1 0 {z} vertex 1 1 {z} vertex 0 1 {z} end\n"
@@ -529,15 +532,15 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let config = RunConfig::new(SceneSource::File(stack_of_squares(dir.path())));
         let prepared = prepare_deferred(&config).expect("the stack prepares");
-        assert_eq!(prepared.lenmax, 0.0182);
+        assert_eq!(prepared.lenmax, 0.0186);
         assert!((prepared.mesh.vertex_count() as u64) <= VERTEX_BUDGET);
         // The squares share no edge: the estimate is the mesh.
         let n = (1.0 / prepared.lenmax).floor() as usize + 2;
-        assert_eq!(prepared.mesh.vertex_count(), 125 * n * n);
+        assert_eq!(prepared.mesh.vertex_count(), STACKED * n * n);
         // The next finer three-digit lenmax is over the budget.
         let finer = prepared.lenmax - 0.0001;
         let m = (1.0 / finer).floor() as u64 + 2;
-        assert!(125 * m * m > VERTEX_BUDGET, "{finer}: {m}");
+        assert!(STACKED as u64 * m * m > VERTEX_BUDGET, "{finer}: {m}");
         let said: Vec<String> = prepared
             .scene
             .warnings
@@ -550,7 +553,7 @@ mod tests {
             said[0].contains(&format!(
                 "stack.sc: warning: mesh coarsened to lenmax {} (an estimated",
                 prepared.lenmax
-            )) && said[0].contains("the default 0.01775 would give 421,000"),
+            )) && said[0].contains("the default 0.01778 would give 505,000"),
             "{}",
             said[0]
         );
@@ -566,7 +569,7 @@ mod tests {
             let prepared = prepare_deferred(&config).expect("the stack prepares");
             assert_eq!(prepared.lenmax, lenmax);
             let n = (1.0 / lenmax).floor() as usize + 2;
-            assert_eq!(prepared.mesh.vertex_count(), 125 * n * n);
+            assert_eq!(prepared.mesh.vertex_count(), STACKED * n * n);
             assert!(prepared
                 .scene
                 .warnings

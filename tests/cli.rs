@@ -627,13 +627,13 @@ fn hemicube_runs_end_to_end_and_refuses_a_bad_resolution() {
 /// Without `--lenmax`, a scene whose default mesh is over the vertex
 /// budget is cut coarser, and one line before the solve says so (under
 /// `-q` too, as the load warnings); with `--lenmax` the line is not there.
-/// The scene: 125 unit squares stacked 0.001 apart, 420,500 vertices at
-/// the default lenmax 0.017745, 392,000 at the budget's 0.0182.
+/// The scene: 150 unit squares stacked 0.001 apart, 504,600 vertices at
+/// the default lenmax 0.017776, 453,750 at the budget's 0.0186.
 #[test]
 fn a_default_mesh_over_the_vertex_budget_is_coarsened_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let mut text = String::from("material wall color 1 1 1 k_diffrefl 0.5 end\n");
-    for k in 0..125 {
+    for k in 0..150 {
         let z = k as f64 * 0.001;
         text += &format!(
             "polygon wall vertex 0 0 {z} vertex 1 0 {z} vertex 1 1 {z} vertex 0 1 {z} end\n"
@@ -649,14 +649,14 @@ fn a_default_mesh_over_the_vertex_budget_is_coarsened_with_one_line() {
     assert!(out.status.success(), "{}", stderr(&out));
     let said = stderr(&out);
     let line = format!(
-        "{scene}: warning: mesh coarsened to lenmax 0.0182 (an estimated 392,000 vertices, \
-         within the budget of 400,000; the default 0.01775 would give 421,000): \
+        "{scene}: warning: mesh coarsened to lenmax 0.0186 (an estimated 454,000 vertices, \
+         within the budget of 470,000; the default 0.01778 would give 505,000): \
          give --lenmax for a finer one\n"
     );
     assert!(said.contains(&line), "{said}");
     let stats = read_json(dir.path(), "a.json");
-    assert_eq!(stats["lenmax"].as_f64().unwrap() as f32, 0.0182);
-    assert_eq!(stats["vertices"], 392_000);
+    assert_eq!(stats["lenmax"].as_f64().unwrap() as f32, 0.0186);
+    assert_eq!(stats["vertices"], 453_750);
 
     let given = [scene, "--lenmax", "0.02", "--stats", "b.json"];
     let out = run_in(dir.path(), &[&given[..], &quick[..]].concat());
@@ -664,7 +664,7 @@ fn a_default_mesh_over_the_vertex_budget_is_coarsened_with_one_line() {
     assert!(!stderr(&out).contains("coarsened"), "{}", stderr(&out));
     let stats = read_json(dir.path(), "b.json");
     assert_eq!(stats["lenmax"].as_f64().unwrap() as f32, 0.02);
-    assert_eq!(stats["vertices"], 125 * 52 * 52);
+    assert_eq!(stats["vertices"], 150 * 52 * 52);
 }
 
 /// `--tail` hands the light left to the particle tail, which carries all

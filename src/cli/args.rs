@@ -77,7 +77,7 @@ pub struct Args {
     /// Longest element edge, in scene units.
     ///
     /// Default: 1/80 of the scene's bounding-box diagonal, or coarser when
-    /// that mesh would have more than about 400,000 vertices (a line then
+    /// that mesh would have more than about 470,000 vertices (a line then
     /// says which lenmax was chosen).
     #[arg(long, value_name = "L", value_parser = parse_number::<f32>)]
     #[arg(help_heading = heading::SOLVER)]

@@ -24,31 +24,39 @@ use std::fmt;
 /// Most element vertices a default mesh may have, by [`Sizes::at`]'s
 /// estimate: the budget above.
 ///
-/// Measured 2026-12-05 on this project's machine (2 cores of an AMD EPYC)
-/// as the difference in user seconds between two runs of one thread,
-/// `radiosity MODEL --sky 1 --threads 1 --max-steps N` for two values of
-/// `N` (the load, mesh and picture cancel), split between the kinds of
-/// step by their share of the `--log` seconds. A step of a sky facet
-/// costs about 4 µs of one core per vertex: 4.0 µs on Godot's `room.glb`
-/// (262,340 vertices, steps 2 to 11), 4.0 µs on the Sauerbraten `zdm2.obj`
-/// at `--lenmax 40` (501,324 vertices, steps 12 to 61), 6.6 µs at its
-/// default lenmax (765,478 vertices, where the arrays outgrow the caches).
-/// A step of reflected light costs about 0.6 µs (`room.glb`, steps 81 to
-/// 151). A sky of 80 facets is then 160 µs of two cores per vertex, and
-/// 300 steps of reflected light 90 µs more: at 400,000 vertices, 64 s for
-/// the sky and 100 s in all, a solve of a couple of minutes. A model of
-/// 70,000 triangles has 210,000 corners, so it fits; with the back copies
-/// of two-sided faces, which double that, it is cut one element per
-/// polygon. The largest default mesh that `docs/performance.md` times, two
-/// spheres of 224 segments in the Cornell box (312,235 vertices), keeps
-/// its default.
+/// Chosen 2026-12-06 from whole solves of the Sauerbraten level
+/// `zdm2.obj` under `--sky 1` on two cores (`docs/performance.md`), timed
+/// and compared with a path tracer's 4,096-sample picture of one view by
+/// `scripts/pathtrace/timing.py` (relative L1 on 4 × 4 blocks):
+///
+/// | lenmax | vertices built | error | CPU |
+/// |---|---|---|---|
+/// | 182 (one element per polygon) | 429,068 | 5.85 % | 125 s |
+/// | 27 | 506,660 | 2.84 % | 181 s |
+/// | **25.3 (this budget)** | 512,769 | 2.73 % | 190 s, 105 s wall |
+/// | 20 | 574,595 | 2.66 % | 240 s |
+/// | 13.85 (the diagonal's 1/80) | 765,478 | 2.55 % | 317 s, 189 s wall |
+///
+/// The level's 70,000 triangles have 210,000 corners, twice that with the
+/// back copies of two-sided faces, so one element per polygon is already
+/// about 410,000 vertices; the first 100,000 vertices past that split its
+/// large walls and floors, where the sky's shadows fall, and take the
+/// error from 5.9 % to 2.7 %; the next 250,000 buy a tenth of a percent
+/// more for half as much time again. Most of a solve's time is the sky's
+/// 80 steps (about 4 µs of one core per vertex each, 6.6 µs once the
+/// arrays outgrow the caches) and the particle tail's three or four
+/// steps; the reflected light's shooting steps before the tail are few.
+/// The largest default mesh that `docs/performance.md` times, two spheres
+/// of 224 segments in the Cornell box (312,235 vertices), keeps its
+/// default.
 ///
 /// The estimate counts each polygon's own grid: the vertices that
 /// stitching adds where polygons meet ([`super::stitch`]) are under half a
 /// percent more on the bundled scenes, but 3 to 18 % more on the game
 /// levels measured (`zdm2.glb` with the facets of `--sky 1`: 339,941
-/// estimated, 401,255 built).
-pub const VERTEX_BUDGET: u64 = 400_000;
+/// estimated, 401,255 built; `zdm2.obj` at lenmax 25.3: 468,191
+/// estimated, 512,769 built).
+pub const VERTEX_BUDGET: u64 = 470_000;
 
 /// The lenmax a scene is meshed at when none is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
