@@ -12,7 +12,14 @@
 //! Arguments: the scene and, optionally, `lenmax` in scene units (`-` or
 //! absent for the program's default) and the part budget in milliseconds
 //! (default the window's; `0` ends a part after every chunk, `none` runs
-//! every step in one piece, as a batch run does). Prints the steps, the
+//! every step in one piece, as a batch run does). `WP_SKY=V` puts the
+//! scene under a uniform sky of radiosity `V`, as `--sky V` does (a real
+//! export has no lamps of its own):
+//!
+//! ```sh
+//! WP_SKY=1 cargo run --release --example window_parts -- tests/models/godot/room.glb
+//! ```
+//! Prints the steps, the
 //! parts, the median and longest part and step, how many of each took more
 //! than 100 ms, and the whole solve's seconds.
 //! `WP_LIST=1` also lists each part over 100 ms: its step, which part of
@@ -42,6 +49,17 @@ fn main() {
     };
     let mut config = RunConfig::new(SceneSource::File(PathBuf::from(scene)));
     config.lenmax = args.get(1).and_then(|l| l.parse().ok());
+    if let Some(v) = std::env::var_os("WP_SKY") {
+        match v.to_str().and_then(|v| v.parse::<f64>().ok()) {
+            Some(v) if v.is_finite() && v >= 0.0 => {
+                config.sky = Some(radiosity::color::Rgb::new(v, v, v));
+            }
+            _ => {
+                eprintln!("WP_SKY: a radiosity of 0 or more, not {v:?}");
+                std::process::exit(2);
+            }
+        }
+    }
     let budget = match args.get(2).map(String::as_str) {
         None => Some(WINDOW_PART_BUDGET),
         Some("none") => None,
@@ -65,6 +83,8 @@ fn main() {
     let mut session = Session::from_prepared(&prepared, options);
     let cancel = AtomicBool::new(false);
     let (mut parts, mut steps) = (Vec::new(), Vec::new());
+    // The particle tail's parts and steps, apart.
+    let (mut tail_parts, mut tail_steps) = (Vec::new(), Vec::new());
     let mut step_so_far = 0.0;
     let list_long = std::env::var_os("WP_LIST").is_some();
     let start = Instant::now();
@@ -87,9 +107,15 @@ fn main() {
                     );
                 }
                 parts.push(took);
+                if report.particles > 0 {
+                    tail_parts.push(took);
+                }
                 step_so_far += took;
                 if report.complete {
                     steps.push(step_so_far);
+                    if report.particles > 0 {
+                        tail_steps.push(step_so_far);
+                    }
                     step_so_far = 0.0;
                 }
             }
@@ -111,6 +137,13 @@ fn main() {
     println!("|---|---|---|---|---|");
     println!("| parts (pictures) | {n_parts} | {pm:.3} | {px:.3} | {po} |");
     println!("| steps | {n_steps} | {sm:.3} | {sx:.3} | {so} |");
+    if !tail_steps.is_empty() {
+        let (n_tp, n_ts) = (tail_parts.len(), tail_steps.len());
+        let (tpm, tpx, tpo) = summary(&mut tail_parts);
+        let (tsm, tsx, tso) = summary(&mut tail_steps);
+        println!("| of them the tail's parts | {n_tp} | {tpm:.3} | {tpx:.3} | {tpo} |");
+        println!("| of them the tail's steps | {n_ts} | {tsm:.3} | {tsx:.3} | {tso} |");
+    }
     println!(
         "solve {total:.2} s, {} rays, unshot {:.3} %",
         session.totals().rays,

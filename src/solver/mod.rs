@@ -937,7 +937,7 @@ impl<'a> Progressive<'a> {
     /// Why the solve should stop now, or `None` to go on (always while a
     /// step is under way: [`Progressive::in_step`]).
     pub fn stop_reason(&self) -> Option<StopReason> {
-        if self.underway.is_some() {
+        if self.in_step() {
             None
         } else if (self.unshot_fraction() <= self.options.threshold && !self.unsettled())
             || self.unshot_power() <= 0.0
@@ -1114,7 +1114,7 @@ impl<'a> Progressive<'a> {
     /// ask for parts).
     pub fn state(&self) -> checkpoint::SolverState {
         debug_assert!(
-            self.underway.as_ref().is_none_or(|u| !u.spent),
+            self.underway.as_ref().is_none_or(|u| !u.spent) && self.tail.underway.is_none(),
             "a solver state taken in the middle of a step"
         );
         checkpoint::SolverState {
@@ -1171,6 +1171,7 @@ impl<'a> Progressive<'a> {
         self.unshot.set_values(state.unshot);
         self.changed();
         self.underway = None;
+        self.tail.underway = None;
         self.fault = None;
         self.last_fraction = self.unshot_fraction();
         self.steps = state.steps;

@@ -19,7 +19,7 @@
 //! | gathering from a cluster | `step::gather_cluster`, `accel::cluster` | [`WEAK_STRATUM_SHARE`], [`STRATUM_NEAR_RATIO`], [`PLANE_DEPTH_RATIO`], [`TOP_DEPTH_RATIO`], [`RESTING_NEAR_FACTOR`], [`RESTING_TOLERANCE`] |
 //! | delivering a step in parts | `step::parts` | [`CHUNK_WORK`], [`PIECE_WORK`], [`CHUNK_GROWTH`], [`PIECE_GROWTH`], [`CHUNK_TARGET`], [`NEAR_WEIGHT`], [`WINDOW_PART_BUDGET`] |
 //! | the hemicube | `hemicube` | [`DEFAULT_HEMICUBE_RES`], [`HEMICUBE_EDGE_SLACK`], [`HEMICUBE_NEAR_FRACTION`] |
-//! | the particle tail | `step::tail` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
+//! | the particle tail | `step::tail` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_PART_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
 //!
 //! Structural constants (how many ray slots a cluster step keeps, the
 //! sub-cell grid's side, file-format fields) stay with the code whose
@@ -490,6 +490,13 @@ pub const TAIL_CHUNK: u64 = 1024;
 /// are held until summed (about 100 kB a task).
 pub const TAIL_BATCH: u64 = 64;
 
+/// Tasks run together in a tail step delivered in parts (the window's
+/// part budget): a part ends after a batch, and a batch of
+/// [`TAIL_BATCH`] took about 0.1 s on `room.glb`, over the window's
+/// 50 ms. The deposits are summed in task order whatever the batch, so
+/// the step's bits are the same.
+pub const TAIL_PART_BATCH: u64 = 16;
+
 /// Bounces a particle takes at most: Russian roulette ends nearly every
 /// path long before (a path survives 200 bounces of the most reflective
 /// surface allowed with odds of 1 in 30,000), this only bounds a path
@@ -841,6 +848,11 @@ pub const INDEX: &[Tuned] = &[
         name: "TAIL_BATCH",
         phase: Phase::Tail,
         value: TAIL_BATCH as f64,
+    },
+    Tuned {
+        name: "TAIL_PART_BATCH",
+        phase: Phase::Tail,
+        value: TAIL_PART_BATCH as f64,
     },
     Tuned {
         name: "TAIL_MAX_BOUNCES",

@@ -137,8 +137,8 @@ impl<'a> Progressive<'a> {
         // A step's first part counts choosing the shooter and reading it
         // (building its strata) against its budget.
         let start = std::time::Instant::now();
-        if self.underway.is_none() && self.tail_due() {
-            return self.tail_step(cancel);
+        if self.tail.underway.is_some() || (self.underway.is_none() && self.tail_due()) {
+            return self.tail_step(start, cancel);
         }
         if self.underway.is_none() {
             let chosen = self.choose_step()?;
@@ -197,7 +197,7 @@ impl<'a> Progressive<'a> {
     /// has begun and not finished: the next [`Progressive::step`]
     /// continues it. The solution then holds the receivers done so far.
     pub fn in_step(&self) -> bool {
-        self.underway.is_some()
+        self.underway.is_some() || self.tail.underway.is_some()
     }
 
     /// Phase 1 of a step: chooses the shooter and what it sends; `None`

@@ -47,8 +47,8 @@ use crate::mesh::Mesh;
 use crate::scene::{PolygonId, Scene};
 use crate::solver::accel::shared::ALONE;
 use crate::solver::tuning::{
-    TAIL_BATCH, TAIL_CHUNK, TAIL_MAX_BOUNCES, TAIL_PARTICLES_PER_VERTEX, TAIL_STEPS,
-    TAIL_SURVIVAL_MAX,
+    TAIL_BATCH, TAIL_CHUNK, TAIL_MAX_BOUNCES, TAIL_PARTICLES_PER_VERTEX, TAIL_PART_BATCH,
+    TAIL_STEPS, TAIL_SURVIVAL_MAX,
 };
 use crate::solver::unshot::TriangleLocator;
 use crate::solver::{Progressive, StepReport, TailOption};
@@ -73,6 +73,9 @@ pub(in crate::solver) struct Tail {
     /// back copy, or the face a back copy belongs to).
     twin: Vec<Option<u32>>,
     tables: OnceLock<Tables>,
+    /// The tail step begun and not finished, when it is delivered in
+    /// parts ([`crate::solver::SolverOptions::part_budget`]).
+    pub(in crate::solver) underway: Option<Box<TailUnderway>>,
 }
 
 impl Tail {
@@ -108,6 +111,7 @@ impl Tail {
                 .map(|p| p.surface.back.or(p.surface.back_of).map(|b| b.0))
                 .collect(),
             tables: OnceLock::new(),
+            underway: None,
         }
     }
 
@@ -336,12 +340,43 @@ impl Tracer<'_> {
 
 /// The emitting triangles of one tail step, for choosing where each
 /// particle starts: their cumulative weights and what each carries.
+#[derive(Debug)]
 struct Sources {
     /// Indices into [`Tables::triangles`] of triangles with unshot light.
     triangles: Vec<u32>,
     /// Cumulative weights (area × mean corner `|Δb|`), ascending.
     cumulative: Vec<f64>,
     total: f64,
+}
+
+/// A tail step under way: what it shoots, and what its particles have
+/// brought so far.
+#[derive(Debug)]
+pub(in crate::solver) struct TailUnderway {
+    share: f64,
+    sources: Sources,
+    /// Per vertex, the unshot radiosity the particles carry.
+    unshot: Vec<Rgb>,
+    /// Per polygon, whether particles land on it and go on.
+    reflects: Vec<bool>,
+    /// Per polygon, its share of the sources' weight.
+    per_polygon: Vec<f64>,
+    /// Particles the step traces, and the power scale each carries.
+    count: u64,
+    scale: f64,
+    /// The step's number, which seeds its particles' streams.
+    step_number: u64,
+    /// Chunks of [`TAIL_CHUNK`] particles, and the next to trace.
+    chunks: u64,
+    next: u64,
+    /// Received power per vertex, summed in particle order.
+    received: Vec<Rgb>,
+    rays: u64,
+    /// Parts delivered so far.
+    part: u32,
+    /// The radiosity before the step, once a part has shown the light so
+    /// far in its place.
+    base: Option<Vec<Rgb>>,
 }
 
 impl<'a> Progressive<'a> {
@@ -380,9 +415,206 @@ impl<'a> Progressive<'a> {
     }
 
     /// One tail step: shoots `share` of every polygon's unshot light by
-    /// particles ([module docs](self)). `None` when cancelled (nothing
-    /// changed) or when nothing is left to shoot.
-    pub(in crate::solver) fn tail_step(&mut self, cancel: &AtomicBool) -> Option<StepReport> {
+    /// particles ([module docs](self)), or with a part budget
+    /// ([`crate::solver::SolverOptions::part_budget`]) the particles that
+    /// fit in it since `start`: the report says whether the step is
+    /// complete, and between parts the solution shows the light landed
+    /// so far (the finished step is bit-identical to the step in one
+    /// piece). `None` when cancelled (without a part budget nothing
+    /// changed; with one, the next call continues after the last part)
+    /// or when nothing is left to shoot.
+    pub(in crate::solver) fn tail_step(
+        &mut self,
+        start: std::time::Instant,
+        cancel: &AtomicBool,
+    ) -> Option<StepReport> {
+        let mut u = match self.tail.underway.take() {
+            Some(u) => u,
+            None => Box::new(self.begin_tail()?),
+        };
+        let budget = self.options.part_budget;
+        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
+        let tracer = Tracer {
+            mesh: &self.mesh,
+            visibility: self.visibility,
+            reflectance: &self.reflectance,
+            reflects: &u.reflects,
+            twin: &self.tail.twin,
+            tables,
+        };
+        let mut received = std::mem::take(&mut u.received);
+        let mut cancelled = false;
+        while u.next < u.chunks {
+            if cancel.load(Ordering::Relaxed) {
+                cancelled = true;
+                break;
+            }
+            let batch = if budget.is_some() {
+                TAIL_PART_BATCH
+            } else {
+                TAIL_BATCH
+            };
+            let batch_end = (u.next + batch).min(u.chunks);
+            let (sources, unshot) = (&u.sources, &u.unshot);
+            let (count, scale, step_number) = (u.count, u.scale, u.step_number);
+            let results: Vec<(Vec<Deposit>, u64)> = (u.next..batch_end)
+                .into_par_iter()
+                .map(|c| {
+                    let mut out = Vec::new();
+                    let mut rays = 0;
+                    let first = c * TAIL_CHUNK;
+                    for i in first..(first + TAIL_CHUNK).min(count) {
+                        if cancel.load(Ordering::Relaxed) {
+                            break;
+                        }
+                        let mut s = Stream::new(step_number, i);
+                        let pick = s.uniform() * sources.total;
+                        let n = sources
+                            .cumulative
+                            .partition_point(|&c| c <= pick)
+                            .min(sources.triangles.len() - 1);
+                        let before = if n == 0 {
+                            0.0
+                        } else {
+                            sources.cumulative[n - 1]
+                        };
+                        let weight = sources.cumulative[n] - before;
+                        let (corners, area) = tables.triangles[sources.triangles[n] as usize];
+                        // A uniform point of the triangle.
+                        let (r1, r2) = (s.uniform().sqrt(), s.uniform());
+                        let b = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
+                        let p = corners
+                            .iter()
+                            .zip(b)
+                            .fold(DVec3::ZERO, |acc, (&c, b)| {
+                                acc + tracer.mesh.positions[c as usize].as_dvec3() * b
+                            })
+                            .as_vec3();
+                        let carried = corners
+                            .iter()
+                            .zip(b)
+                            .fold(Rgb::BLACK, |acc, (&c, b)| acc + unshot[c as usize] * b);
+                        // Δb(x) / p(x) with p(x) = weight / (total · area),
+                        // over the step's particles and times its share.
+                        let power = carried * (area * scale / weight);
+                        let j = tracer.mesh.vertex_polygon[corners[0] as usize].index();
+                        rays += tracer.trace(j, p, power, &mut s, &mut out);
+                    }
+                    (out, rays)
+                })
+                .collect();
+            // A batch cut short by a cancel is dropped whole.
+            if cancel.load(Ordering::Relaxed) {
+                cancelled = true;
+                break;
+            }
+            for (out, r) in results {
+                u.rays += r;
+                for (v, p) in out {
+                    received[v as usize] += p;
+                }
+            }
+            u.next = batch_end;
+            if budget.is_some_and(|b| start.elapsed() >= b) && u.next < u.chunks {
+                break;
+            }
+        }
+        u.received = received;
+        if cancelled {
+            // Without parts a cancelled step never happened; with them the
+            // next call continues after the last part delivered.
+            if budget.is_some() {
+                self.tail.underway = Some(u);
+            } else if let Some(base) = u.base.take() {
+                self.radiosity = base;
+                self.changed();
+            }
+            return None;
+        }
+        let delta = self.tail_delta(&u.received);
+        if u.next < u.chunks {
+            // A part: the light landed so far, over the radiosity before
+            // the step.
+            u.part += 1;
+            let base = u.base.get_or_insert_with(|| self.radiosity.clone());
+            for ((b, before), d) in self.radiosity.iter_mut().zip(base.iter()).zip(&delta) {
+                *b = (*before + *d).max(Rgb::BLACK);
+            }
+            self.changed();
+            let report = StepReport {
+                step: self.steps + 1,
+                shooter: PolygonId(heaviest(&u.per_polygon) as u32),
+                polygons: u.per_polygon.iter().filter(|&&w| w > 0.0).count() as u32,
+                shot_power: u.share * self.net_unshot_power(),
+                unshot_fraction: self.unshot_fraction(),
+                rays: u.rays,
+                pairs: u.rays,
+                receivers: 0,
+                clear_receivers: 0,
+                part: u.part,
+                complete: false,
+                particles: u.next.saturating_mul(TAIL_CHUNK).min(u.count),
+            };
+            self.tail.underway = Some(u);
+            return Some(report);
+        }
+        if !delta.iter().all(|d| d.is_finite()) {
+            if let Some(base) = u.base.take() {
+                self.radiosity = base;
+                self.changed();
+            }
+            return None;
+        }
+        let shot_power = u.share * self.net_unshot_power();
+        let shooter = heaviest(&u.per_polygon);
+        let polygons = u.per_polygon.iter().filter(|&&w| w > 0.0).count() as u32;
+        // Negative particles (light sent ahead coming back) may take a
+        // dark vertex a hair below zero by their noise.
+        match u.base.take() {
+            Some(base) => {
+                for ((b, before), d) in self.radiosity.iter_mut().zip(&base).zip(&delta) {
+                    *b = (*before + *d).max(Rgb::BLACK);
+                }
+            }
+            None => {
+                for (b, d) in self.radiosity.iter_mut().zip(&delta) {
+                    *b = (*b + *d).max(Rgb::BLACK);
+                }
+            }
+        }
+        self.unshot.scale(1.0 - u.share);
+        self.changed();
+        self.tail.particles += u.count;
+        self.steps += 1;
+        self.rays += u.rays;
+        self.pairs += u.rays;
+        let fraction = self.unshot_fraction();
+        self.last_fraction = fraction;
+        let receivers = self
+            .mesh
+            .polygons
+            .iter()
+            .filter(|pm| pm.vertices.clone().any(|l| !delta[l as usize].is_black()))
+            .count() as u64;
+        Some(StepReport {
+            step: self.steps,
+            shooter: PolygonId(shooter as u32),
+            polygons,
+            shot_power,
+            unshot_fraction: fraction,
+            rays: u.rays,
+            pairs: u.rays,
+            receivers,
+            clear_receivers: 0,
+            part: u.part + 1,
+            complete: true,
+            particles: u.count,
+        })
+    }
+
+    /// Begins a tail step: its share, where its particles start and what
+    /// they carry; `None` when nothing is left to shoot.
+    fn begin_tail(&self) -> Option<TailUnderway> {
         let share = self.tail.share(self.unshot_fraction());
         let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
         let unshot = self.unshot_at_vertices();
@@ -433,88 +665,34 @@ impl<'a> Progressive<'a> {
         let vertices = self.mesh.vertex_count() as f64;
         let count =
             ((self.tail.per_vertex * vertices / f64::from(TAIL_STEPS)).ceil() as u64).max(1);
-        let tracer = Tracer {
-            mesh: &self.mesh,
-            visibility: self.visibility,
-            reflectance: &self.reflectance,
-            reflects: &reflects,
-            twin: &self.tail.twin,
-            tables,
-        };
-        let step_number = self.steps + 1;
-        let scale = share * sources.total / count as f64;
         // A particle from a triangle of weight `w` and area `A` carries
         // `Δb(x) · scale · A / w`.
-        // Received power per vertex, summed in particle order.
-        let mut received = vec![Rgb::BLACK; self.mesh.vertex_count()];
-        let mut rays = 0u64;
-        let chunks = count.div_ceil(TAIL_CHUNK);
-        let mut chunk = 0;
-        while chunk < chunks {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            let batch_end = (chunk + TAIL_BATCH).min(chunks);
-            let results: Vec<(Vec<Deposit>, u64)> = (chunk..batch_end)
-                .into_par_iter()
-                .map(|c| {
-                    let mut out = Vec::new();
-                    let mut rays = 0;
-                    let first = c * TAIL_CHUNK;
-                    for i in first..(first + TAIL_CHUNK).min(count) {
-                        if cancel.load(Ordering::Relaxed) {
-                            break;
-                        }
-                        let mut s = Stream::new(step_number, i);
-                        let pick = s.uniform() * sources.total;
-                        let n = sources
-                            .cumulative
-                            .partition_point(|&c| c <= pick)
-                            .min(sources.triangles.len() - 1);
-                        let before = if n == 0 {
-                            0.0
-                        } else {
-                            sources.cumulative[n - 1]
-                        };
-                        let weight = sources.cumulative[n] - before;
-                        let (corners, area) = tables.triangles[sources.triangles[n] as usize];
-                        // A uniform point of the triangle.
-                        let (r1, r2) = (s.uniform().sqrt(), s.uniform());
-                        let b = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
-                        let p = corners
-                            .iter()
-                            .zip(b)
-                            .fold(DVec3::ZERO, |acc, (&c, b)| {
-                                acc + tracer.mesh.positions[c as usize].as_dvec3() * b
-                            })
-                            .as_vec3();
-                        let carried = corners
-                            .iter()
-                            .zip(b)
-                            .fold(Rgb::BLACK, |acc, (&c, b)| acc + unshot[c as usize] * b);
-                        // Δb(x) / p(x) with p(x) = weight / (total · area),
-                        // over the step's particles and times its share.
-                        let power = carried * (area * scale / weight);
-                        let j = tracer.mesh.vertex_polygon[corners[0] as usize].index();
-                        rays += tracer.trace(j, p, power, &mut s, &mut out);
-                    }
-                    (out, rays)
-                })
-                .collect();
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            for (out, r) in results {
-                rays += r;
-                for (v, p) in out {
-                    received[v as usize] += p;
-                }
-            }
-            chunk = batch_end;
-        }
-        // A vertex's rise: what landed on its hat over the hat's area;
-        // vertices that receive as one ([`crate::solver::accel::shared`])
-        // pool what landed on them all.
+        let scale = share * sources.total / count as f64;
+        Some(TailUnderway {
+            share,
+            sources,
+            unshot,
+            reflects,
+            per_polygon,
+            count,
+            scale,
+            step_number: self.steps + 1,
+            chunks: count.div_ceil(TAIL_CHUNK),
+            next: 0,
+            received: vec![Rgb::BLACK; self.mesh.vertex_count()],
+            rays: 0,
+            part: 0,
+            base: None,
+        })
+    }
+
+    /// Per vertex, the rise that `received` (power landed per vertex)
+    /// makes: what landed on its hat over the hat's area; vertices that
+    /// receive as one ([`crate::solver::accel::shared`]) pool what landed
+    /// on them all.
+    fn tail_delta(&self, received: &[Rgb]) -> Vec<Rgb> {
+        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
+        let mut received = received.to_vec();
         let mut hat = tables.hat.clone();
         if !self.leaders.is_empty() {
             for l in 0..received.len() {
@@ -526,7 +704,7 @@ impl<'a> Progressive<'a> {
                 }
             }
         }
-        let delta: Vec<Rgb> = (0..received.len())
+        (0..received.len())
             .map(|l| {
                 let lead = match self.leaders.get(l) {
                     Some(&leader) if leader != ALONE => leader as usize,
@@ -538,55 +716,22 @@ impl<'a> Progressive<'a> {
                     Rgb::BLACK
                 }
             })
-            .collect();
-        if !delta.iter().all(|d| d.is_finite()) {
-            return None;
-        }
-        let shot_power = share * self.net_unshot_power();
-        let shooter = per_polygon
-            .iter()
-            .enumerate()
-            .fold((0, f64::NEG_INFINITY), |best, (j, &w)| {
-                if w > best.1 {
-                    (j, w)
-                } else {
-                    best
-                }
-            })
-            .0;
-        let polygons = per_polygon.iter().filter(|&&w| w > 0.0).count() as u32;
-        // Negative particles (light sent ahead coming back) may take a
-        // dark vertex a hair below zero by their noise.
-        for (b, d) in self.radiosity.iter_mut().zip(&delta) {
-            *b = (*b + *d).max(Rgb::BLACK);
-        }
-        self.unshot.scale(1.0 - share);
-        self.changed();
-        self.tail.particles += count;
-        self.steps += 1;
-        self.rays += rays;
-        self.pairs += rays;
-        let fraction = self.unshot_fraction();
-        self.last_fraction = fraction;
-        let receivers = self
-            .mesh
-            .polygons
-            .iter()
-            .filter(|pm| pm.vertices.clone().any(|l| !delta[l as usize].is_black()))
-            .count() as u64;
-        Some(StepReport {
-            step: self.steps,
-            shooter: PolygonId(shooter as u32),
-            polygons,
-            shot_power,
-            unshot_fraction: fraction,
-            rays,
-            pairs: rays,
-            receivers,
-            clear_receivers: 0,
-            part: 1,
-            complete: true,
-            particles: count,
-        })
+            .collect()
     }
+}
+
+/// The index of the largest of `weights` (the first on ties; 0 when
+/// empty).
+fn heaviest(weights: &[f64]) -> usize {
+    weights
+        .iter()
+        .enumerate()
+        .fold((0, f64::NEG_INFINITY), |best, (j, &w)| {
+            if w > best.1 {
+                (j, w)
+            } else {
+                best
+            }
+        })
+        .0
 }

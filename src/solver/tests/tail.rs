@@ -158,3 +158,62 @@ fn a_tail_resumed_from_its_state_ends_as_the_uninterrupted_one() {
     assert_eq!(resumed.steps(), whole.steps());
     assert_eq!(resumed.radiosity(), whole.radiosity());
 }
+
+/// A tail step delivered in parts (the window's part budget) ends bit for
+/// bit as the step in one piece; between its parts the solution shows the
+/// light landed so far, rising part by part, and a cancel between parts
+/// loses nothing: the next call goes on from the last part.
+#[test]
+fn a_tail_step_in_parts_ends_as_the_step_in_one_piece() {
+    let s = glowing_box();
+    let mesh = regular_mesh(&s, 0.1);
+    let vis = Visibility::new(&s);
+    // About 360,000 particles a tail step: six batches.
+    let options = tail(1.0, 2000.0);
+    let parted_options = SolverOptions {
+        part_budget: Some(std::time::Duration::ZERO),
+        ..options
+    };
+    let mut whole = Progressive::new(&s, &mesh, &vis, options);
+    while whole.step().is_some_and(|r| r.particles == 0) {}
+    let mut parted = Progressive::new(&s, &mesh, &vis, parted_options);
+    let mean = |p: &Progressive| p.radiosity().iter().map(|b| b.g).sum::<f64>();
+    // The shooting steps before the tail, each in parts too.
+    loop {
+        let r = parted.step().expect("a step");
+        if r.particles > 0 {
+            assert!(!r.complete, "the tail step comes in parts");
+            break;
+        }
+    }
+    let mut parts = 1;
+    let mut last = mean(&parted);
+    let cancel = std::sync::atomic::AtomicBool::new(true);
+    loop {
+        if parts == 3 {
+            let held = parted.radiosity().to_vec();
+            assert!(parted.step_cancellable(&cancel).is_none());
+            assert!(parted.in_step(), "a cancel keeps the step under way");
+            assert_eq!(parted.radiosity(), &held[..]);
+        }
+        let r = parted.step().expect("the tail step goes on");
+        assert!(r.particles > 0);
+        parts += 1;
+        let now = mean(&parted);
+        assert!(
+            now >= last - 1e-9 * last.abs(),
+            "part {parts}: {now} < {last}"
+        );
+        last = now;
+        if r.complete {
+            assert_eq!(r.part, parts);
+            break;
+        }
+        assert!(!parted.is_done() && parted.in_step());
+    }
+    assert!(parts > 3, "{parts} parts");
+    assert_eq!(parted.steps(), whole.steps());
+    assert_eq!(parted.radiosity(), whole.radiosity());
+    assert_eq!(parted.unshot(), whole.unshot());
+    assert!(!parted.in_step());
+}
