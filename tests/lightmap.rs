@@ -124,18 +124,8 @@ impl Glb {
             if n[1] <= 0.0 || pos.iter().any(|v| v[1].abs() > 1e-6) {
                 continue;
             }
-            // Barycentrics in the xz plane.
-            let area = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
-                (b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])
-            };
-            let total = area(pos[0], pos[1], pos[2]);
-            let w = [
-                area(p, pos[1], pos[2]) / total,
-                area(pos[0], p, pos[2]) / total,
-                area(pos[0], pos[1], p) / total,
-            ];
-            if w.iter().all(|&x| x >= 0.0) {
-                return [0, 1].map(|k| w[0] * uv[0][k] + w[1] * uv[1][k] + w[2] * uv[2][k]);
+            if let Some(at) = uv_in_xz(&(pos, uv), p) {
+                return at;
             }
         }
         panic!("no upward face holds {p:?}");
@@ -627,22 +617,27 @@ impl Glb {
 /// The value at the point `(x, z)` of a floor triangle (facing either
 /// way) of `triangles`, interpolated from its corners' `uv`.
 fn floor_uv_at(triangles: &[Triangle], x: f32, z: f32) -> [f32; 2] {
-    let p = [x, 0.0, z];
-    for (pos, uv) in triangles {
-        let area = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
-            (b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])
-        };
-        let total = area(pos[0], pos[1], pos[2]);
-        let w = [
-            area(p, pos[1], pos[2]) / total,
-            area(pos[0], p, pos[2]) / total,
-            area(pos[0], pos[1], p) / total,
-        ];
-        if w.iter().all(|&x| x >= 0.0) {
-            return [0, 1].map(|k| w[0] * uv[0][k] + w[1] * uv[1][k] + w[2] * uv[2][k]);
-        }
-    }
-    panic!("no floor triangle holds ({x}, {z})");
+    triangles
+        .iter()
+        .find_map(|t| uv_in_xz(t, [x, 0.0, z]))
+        .unwrap_or_else(|| panic!("no floor triangle holds ({x}, {z})"))
+}
+
+/// The `uv` of triangle `(pos, uv)` at point `p`, interpolated by the
+/// barycentrics of `p` in the xz plane; `None` when `p` is outside it.
+fn uv_in_xz((pos, uv): &Triangle, p: [f32; 3]) -> Option<[f32; 2]> {
+    let area = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
+        (b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])
+    };
+    let total = area(pos[0], pos[1], pos[2]);
+    let w = [
+        area(p, pos[1], pos[2]) / total,
+        area(pos[0], p, pos[2]) / total,
+        area(pos[0], pos[1], p) / total,
+    ];
+    w.iter()
+        .all(|&x| x >= 0.0)
+        .then(|| [0, 1].map(|k| w[0] * uv[0][k] + w[1] * uv[1][k] + w[2] * uv[2][k]))
 }
 
 /// Bakes `obj` (with `mtl` as `tex.mtl` and `files` beside it) in a new
