@@ -969,6 +969,19 @@ impl Locator {
     /// element order) is the best of all; otherwise every triangle is
     /// searched.
     fn source(&self, mesh: &Mesh, pm: &PolygonMesh, p: glam::Vec3) -> SampleSource {
+        match self.best(mesh, p) {
+            Some((least, k, w)) if least >= 0.0 => {
+                SampleSource::Triangle(self.triangles[k as usize].map(|v| v.0), w)
+            }
+            _ => point_source(mesh, pm, p),
+        }
+    }
+
+    /// The candidate triangle nearest to holding `p`: its smallest
+    /// barycentric weight (negative when `p` lies outside it), its index
+    /// and the weights; `None` when the bucket and the degenerate list
+    /// are empty.
+    fn best(&self, mesh: &Mesh, p: glam::Vec3) -> Option<(f32, u32, [f32; 3])> {
         let (x, y) = self.bucket(glam::Vec2::new(p.dot(self.u), p.dot(self.v)));
         let mut best: Option<(f32, u32, [f32; 3])> = None;
         for &k in self.buckets[y * self.n + x].iter().chain(&self.degenerate) {
@@ -983,12 +996,7 @@ impl Locator {
                 best = Some((least, k, w));
             }
         }
-        match best {
-            Some((least, k, w)) if least >= 0.0 => {
-                SampleSource::Triangle(self.triangles[k as usize].map(|v| v.0), w)
-            }
-            _ => point_source(mesh, pm, p),
-        }
+        best
     }
 }
 
@@ -1006,14 +1014,21 @@ impl TriangleLocator {
 
     /// The element triangle of `pm` holding `p` (or nearest to holding it,
     /// when rounding puts `p` a hair outside them all): its corners and
-    /// `p`'s barycentric weights there; `None` for a polygon without
-    /// triangles.
+    /// `p`'s barycentric weights there (a weight may be a hair below
+    /// zero); `None` for a polygon without triangles.
+    ///
+    /// A point of the polygon always lands: a particle that found no
+    /// triangle holding it within rounding (a sliver's, whose weights
+    /// `f32` once could not resolve) was dropped, and its light lost.
     pub(crate) fn find(
         &self,
         mesh: &Mesh,
         pm: &PolygonMesh,
         p: glam::Vec3,
     ) -> Option<([u32; 3], [f32; 3])> {
+        if let Some((_, k, w)) = self.0.best(mesh, p) {
+            return Some((self.0.triangles[k as usize].map(|v| v.0), w));
+        }
         match self.0.source(mesh, pm, p) {
             SampleSource::Triangle(t, w) => Some((t, w)),
             _ => None,
@@ -1022,8 +1037,11 @@ impl TriangleLocator {
 }
 
 /// Barycentric weights of `p` (projected into the triangle's plane) in
-/// the triangle `a b c`; zeros for a degenerate triangle.
+/// the triangle `a b c`; zeros for a degenerate triangle. Computed in
+/// `f64`: in `f32` the determinant of a sliver a thousandth as wide as
+/// long cancels to noise, and points far outside it came out inside.
 fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f32; 3] {
+    let (p, a, b, c) = (p.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
     let (e1, e2, d) = (b - a, c - a, p - a);
     let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let (dp1, dp2) = (d.dot(e1), d.dot(e2));
@@ -1033,7 +1051,7 @@ fn barycentric(p: glam::Vec3, a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> [f
     }
     let v = (d22 * dp1 - d12 * dp2) / det;
     let w = (d11 * dp2 - d12 * dp1) / det;
-    [1.0 - v - w, v, w]
+    [(1.0 - v - w) as f32, v as f32, w as f32]
 }
 
 #[cfg(test)]
@@ -1144,6 +1162,32 @@ mod tests {
         let mut dark = vec![Rgb::BLACK; 2];
         super::send_what_is_spent(&mut dark, &samples, Rgb::BLACK);
         assert_eq!(dark, vec![Rgb::BLACK; 2]);
+    }
+
+    #[test]
+    fn a_slivers_weights_tell_inside_from_outside() {
+        // A triangle ten units long and a thousandth wide, ten units from
+        // the origin, as a real export's slivers are.
+        let (a, b, c) = (
+            glam::Vec3::new(10.0, 0.0, 10.0),
+            glam::Vec3::new(20.0, 0.0, 10.0),
+            glam::Vec3::new(20.0, 0.0, 10.001),
+        );
+        let inside = a * 0.3 + b * 0.3 + c * 0.4;
+        let w = super::barycentric(inside, a, b, c);
+        assert!(
+            (w[0] - 0.3).abs() < 1e-3 && (w[1] - 0.3).abs() < 1e-3 && (w[2] - 0.4).abs() < 1e-3,
+            "{w:?}"
+        );
+        // Points a few widths off its long edges, along its whole length.
+        for k in 1..10 {
+            let along = a.lerp(b, k as f32 / 10.0);
+            for off in [-0.003f32, 0.003 + 0.001 * k as f32 / 10.0] {
+                let p = along + glam::Vec3::new(0.0, 0.0, off);
+                let w = super::barycentric(p, a, b, c);
+                assert!(w[0].min(w[1]).min(w[2]) < 0.0, "{p} came out inside: {w:?}");
+            }
+        }
     }
 
     #[test]
