@@ -73,7 +73,8 @@ pub struct RunConfig {
     /// Longest element edge in scene units; `None` for the default
     /// ([`mesh::MeshOptions::within_budget`]), which `prepare` picks.
     pub lenmax: Option<f32>,
-    /// Boundary inset as a fraction of an element edge.
+    /// Boundary inset as a fraction of lenmax (or of the polygon's
+    /// diameter when smaller).
     pub inset: f32,
     /// Solver settings.
     pub solver: SolverOptions,

@@ -79,10 +79,11 @@ fn switches() -> Vec<Switch> {
         off(NearField, RelativeL1(0.1)),
         // Shaft culling changes which rays are cast, never what they find.
         off(ShaftCulling, SameBits),
-        // 2.7e-4, 5.9e-4, 3.0e-4, 8.8e-7, 5e-7 (the Cornell box has no
+        // 2.7e-4, 2.3e-3, 5.8e-4, 2.0e-6, 5e-7 (the Cornell box has no
         // clusters: what changes there is the receiver heuristics, which
-        // act only in a solve that clusters).
-        off(Clusters, RelativeL1(2e-3)),
+        // act only in a solve that clusters; the tiled box's is mostly
+        // shared receivers).
+        off(Clusters, RelativeL1(5e-3)),
         // 0, 4.9e-4, 3.0e-4, 4.9e-7, 4e-7.
         off(Strata, RelativeL1(2e-3)),
         // 2.7e-4, 1.4e-4, 0, 3.4e-7, 7e-8.
@@ -97,16 +98,16 @@ fn switches() -> Vec<Switch> {
         off(SkyProbes, RelativeL1(1e-5)),
         // 0 everywhere: the far lamp's probes agree; it casts fewer rays.
         off(FarShooters, RelativeL1(1e-5)),
-        // 0, 1.4e-3, 2.6e-4, 9.8e-7, 0: a tile's or a facet's vertex
-        // takes its neighbour's value at the same point, a twentieth of an
-        // element from its own inset point.
-        off(SharedReceivers, RelativeL1(3e-3)),
-        // 2.7e-4, 1.6e-3, 5.1e-4, 1.2e-6, 2.5e-7.
-        Switch { name: "--exact-receivers", twin: Approximations::DEFAULT.without(&Heuristic::RECEIVERS), tolerance: RelativeL1(3.5e-3), skip: &[] },
-        // 5.7e-4, 1.6e-3, (3.5e-4), 2.3e-6, 5e-7. The brute-force twin, but
+        // 0, 2.2e-3, 3.2e-4, 1.2e-6, 0: a tile's or a facet's vertex
+        // takes its neighbour's value at the same point, a tenth of
+        // lenmax from its own inset point.
+        off(SharedReceivers, RelativeL1(5e-3)),
+        // 2.7e-4, 2.3e-3, 5.7e-4, 1.6e-6, 2.5e-7.
+        Switch { name: "--exact-receivers", twin: Approximations::DEFAULT.without(&Heuristic::RECEIVERS), tolerance: RelativeL1(5e-3), skip: &[] },
+        // 5.7e-4, 2.3e-3, (skipped), 2.8e-6, 5e-7. The brute-force twin, but
         // for shaft culling, which changes no bit (its own row) and
         // would only multiply the rays.
-        Switch { name: "Approximations::EXACT", twin: Approximations::EXACT.with(ShaftCulling, true), tolerance: RelativeL1(3.5e-3), skip: &["spheres"] },
+        Switch { name: "Approximations::EXACT", twin: Approximations::EXACT.with(ShaftCulling, true), tolerance: RelativeL1(5e-3), skip: &["spheres"] },
     ]
 }
 

@@ -83,7 +83,7 @@ pub struct Args {
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) lenmax: Option<f32>,
 
-    /// Inset of boundary vertices, as a fraction of an element edge.
+    /// Inset of boundary vertices, as a fraction of lenmax.
     ///
     /// Boundary vertices are evaluated this far inside their polygon, so
     /// room corners do not come out dark; 0 disables it.

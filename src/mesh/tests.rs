@@ -185,7 +185,9 @@ fn vertices_are_shared_not_duplicated() {
 fn inset_moves_boundary_vertices_inward_only() {
     let s = scene(vec![all_shapes().remove(0)]);
     let m = build(&s, &opts(0.5, 0.1)).unwrap();
-    let d = 0.1 * m.polygons[0].min_edge;
+    // A tenth of lenmax (the 2 × 1 polygon is larger).
+    let d = 0.1 * 0.5;
+    assert_eq!(m.polygons[0].inset, d);
     for (p, q) in m.positions.iter().zip(&m.sample_positions) {
         let on_x_edge = p.x == 0.0 || p.x == 2.0;
         let on_y_edge = p.y == 0.0 || p.y == 1.0;
@@ -234,6 +236,40 @@ fn inset_samples_stay_inside_the_polygon() {
                 inward.dot(*q - v[k]) > 0.0,
                 "sample {q} is not strictly inside"
             );
+        }
+    }
+}
+
+/// A sliver's apex (2.9° here) moves the full inset distance along its
+/// bisector, not the few percent of it its two edges' nearly opposite
+/// normals add up to; a vertex on a long edge moves at most half the way
+/// across. Every sample stays strictly inside.
+#[test]
+fn a_slivers_samples_leave_its_apex_and_stay_inside() {
+    let sliver = polygon(
+        &[[0., 0., 0.], [4., 0., 0.], [4., 0.2, 0.]],
+        Shape::Triangle,
+    );
+    let d = 0.05;
+    let got: Vec<Vec3> = inset_positions(&sliver, &sliver.vertices, d).collect();
+    let apex = got[0] - sliver.vertices[0];
+    assert!((apex.length() - d).abs() < 1e-6, "apex moved {apex}");
+    let bisector = (Vec3::X + Vec3::new(4.0, 0.2, 0.0).normalize()).normalize();
+    assert!(apex.normalize().dot(bisector) > 0.9999, "{apex}");
+    // Midway along the long edge y = 0 the sliver is 0.1 across: a move
+    // of 0.2 is cut to half of that.
+    let mid = Vec3::new(2.0, 0.0, 0.0);
+    let moved: Vec<Vec3> = inset_positions(&sliver, &[mid], 0.2).collect();
+    assert!(
+        (moved[0] - mid - Vec3::new(0.0, 0.05, 0.0)).length() < 1e-6,
+        "{}",
+        moved[0]
+    );
+    for q in got.iter().chain(&moved) {
+        let v = &sliver.vertices;
+        for k in 0..3 {
+            let inward = sliver.normal.cross(v[(k + 1) % 3] - v[k]);
+            assert!(inward.dot(*q - v[k]) > 0.0, "{q} is not strictly inside");
         }
     }
 }
@@ -305,22 +341,23 @@ fn the_edge_grid_finds_every_edge_a_point_lies_on() {
     let extent = crate::scene::polygon_extent_f32(v);
     let tolerance = ON_EDGE_TOLERANCE * extent;
     let every_edge = |q: Vec3| {
-        let mut moved = q;
+        let mut sum = Vec3::ZERO;
         for k in 0..n {
             let (a, b) = (v[k], v[(k + 1) % n]);
             let dir = (b - a).normalize_or_zero();
             let inward = p.normal.cross(dir).normalize_or_zero();
             let rel = q - a;
             if (rel - rel.dot(dir) * dir).length() <= tolerance {
-                moved += inward * d;
+                sum += inward;
             }
         }
-        moved
+        // At least `d` along the sum of the edges' normals.
+        q + sum.normalize_or_zero() * d * sum.length().max(1.0)
     };
     let got: Vec<Vec3> = inset_positions(&p, &points, d).collect();
     let mut moved = 0;
     for (q, g) in points.iter().zip(&got) {
-        assert_eq!(*g, every_edge(*q), "at {q}");
+        assert!((*g - every_edge(*q)).length() < 1e-6, "at {q}: {g}");
         moved += (*g != *q) as usize;
     }
     // Every vertex and point on an edge moved; the others did not.
