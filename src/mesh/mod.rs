@@ -1128,12 +1128,12 @@ impl Inset {
 const EDGE_GRID_MIN: usize = 32;
 
 /// The share of the way across the polygon a vertex's sample moves at
-/// most ([`Inset`]), for polygons of at most [`EDGE_GRID_MIN`] edges: a
+/// most (see the module docs), for polygons of at most 32 edges: a
 /// sliver's width, not the element size, bounds it there. Measured on
 /// Godot's `zdm2.glb` (its camera, a 1,024-sample path-traced
 /// reference): 3.69 % at a quarter of the way, 3.15 % at half, 3.34 %
 /// unclamped, where samples left their polygon.
-const INSET_CLAMP: f32 = 0.5;
+pub const INSET_CLAMP: f32 = 0.5;
 
 /// A polygon's boundary edges binned in cubic cells by their bounds grown
 /// by the on-edge tolerance: the edges a point may lie on are those of
