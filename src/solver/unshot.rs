@@ -1026,12 +1026,13 @@ impl TriangleLocator {
         pm: &PolygonMesh,
         p: glam::Vec3,
     ) -> Option<([u32; 3], [f32; 3])> {
-        if let Some((_, k, w)) = self.0.best(mesh, p) {
-            return Some((self.0.triangles[k as usize].map(|v| v.0), w));
-        }
-        match self.0.source(mesh, pm, p) {
-            SampleSource::Triangle(t, w) => Some((t, w)),
-            _ => None,
+        match self.0.best(mesh, p) {
+            Some((_, k, w)) => Some((self.0.triangles[k as usize].map(|v| v.0), w)),
+            // No candidate in the bucket: every triangle is searched.
+            None => match point_source(mesh, pm, p) {
+                SampleSource::Triangle(t, w) => Some((t, w)),
+                _ => None,
+            },
         }
     }
 }
