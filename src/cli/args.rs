@@ -213,9 +213,8 @@ pub struct Args {
     /// Each is one switch, measured against its twin: emitters-first,
     /// overshoot, settling, near-field, shaft-culling, clusters, strata,
     /// receiver-interpolation, weak-strata, crowded-cells, facet-rays,
-    /// sky-probes, far-shooters, shared-receivers. `docs/accuracy.md`
-    /// gives what each costs
-    /// and buys.
+    /// sky-probes, far-shooters, shared-receivers, sky-at-once.
+    /// `docs/accuracy.md` gives what each costs and buys.
     #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
     #[arg(help_heading = heading::SOLVER, hide_short_help = true)]
     pub(crate) without: Vec<Heuristic>,

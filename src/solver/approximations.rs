@@ -87,6 +87,12 @@ pub struct Approximations {
     /// evaluated and the others taking its `Δrad`
     /// ([`super::accel::shared`]). Off: each is evaluated alone.
     pub shared_receivers: bool,
+    /// A sky that reflects nothing is shot in one step, every receiving
+    /// vertex gathering it over its own hemisphere of directions
+    /// ([`super::accel::sky_dome`]). Acts only in a solve that clusters,
+    /// and not on a daylight sky (its luminance varies within a facet).
+    /// Off: one step per sky facet, from its own directions.
+    pub sky_at_once: bool,
 }
 
 /// The name of one switch of [`Approximations`], as the command line
@@ -147,11 +153,16 @@ pub enum Heuristic {
     /// [`Approximations::shared_receivers`].
     #[value(help = "vertices of one surface at one point receive as one")]
     SharedReceivers,
+    /// [`Approximations::sky_at_once`].
+    #[value(
+        help = "the sky is shot in one step, each vertex asking its own hemisphere of directions"
+    )]
+    SkyAtOnce,
 }
 
 impl Heuristic {
     /// Every switch, in the order of [`Approximations`]' fields.
-    pub const ALL: [Heuristic; 14] = [
+    pub const ALL: [Heuristic; 15] = [
         Heuristic::EmittersFirst,
         Heuristic::Overshoot,
         Heuristic::Settling,
@@ -166,6 +177,7 @@ impl Heuristic {
         Heuristic::SkyProbes,
         Heuristic::FarShooters,
         Heuristic::SharedReceivers,
+        Heuristic::SkyAtOnce,
     ];
 
     /// The switches `--exact-receivers` turns off: every receiving vertex
@@ -198,6 +210,7 @@ impl Approximations {
         sky_probes: true,
         far_shooters: true,
         shared_receivers: true,
+        sky_at_once: true,
     };
 
     /// The brute-force twin: no heuristic that trades accuracy or a
@@ -221,6 +234,7 @@ impl Approximations {
         sky_probes: false,
         far_shooters: false,
         shared_receivers: false,
+        sky_at_once: false,
     };
 
     /// Whether switch `h` is on.
@@ -266,6 +280,7 @@ impl Approximations {
             Heuristic::SkyProbes => &mut self.sky_probes,
             Heuristic::FarShooters => &mut self.far_shooters,
             Heuristic::SharedReceivers => &mut self.shared_receivers,
+            Heuristic::SkyAtOnce => &mut self.sky_at_once,
         }
     }
 }

@@ -566,6 +566,8 @@ pub struct Progressive<'a> {
     sun: Option<sun::SunShot>,
     /// The particle tail's settings and tables ([`step::tail`]).
     tail: step::tail::Tail,
+    /// The sky gathered at once, and its step under way.
+    sky: step::sky::SkyGather,
 }
 
 /// The scans over every vertex that choosing a step, checking for
@@ -725,6 +727,14 @@ impl<'a> Progressive<'a> {
             scans: std::sync::Mutex::new(Scans::default()),
             sun: sun::SunShot::for_scene(scene),
             tail: step::tail::Tail::new(options.tail, options.tail_particles, scene, mesh),
+            // A daylight sky's luminance varies within a facet (its
+            // samples are weighted by it), which the dome's per-facet
+            // light does not hold: such a sky shoots facet by facet.
+            sky: step::sky::SkyGather::new(
+                mesh,
+                clustered && approx.sky_at_once && scene.sky_pattern.is_none(),
+                clustered && approx.sky_probes,
+            ),
         };
         solver.receive_sun();
         solver.initial_unshot_power = solver.unshot_power();
@@ -1114,7 +1124,9 @@ impl<'a> Progressive<'a> {
     /// ask for parts).
     pub fn state(&self) -> checkpoint::SolverState {
         debug_assert!(
-            self.underway.as_ref().is_none_or(|u| !u.spent) && self.tail.underway.is_none(),
+            self.underway.as_ref().is_none_or(|u| !u.spent)
+                && self.tail.underway.is_none()
+                && self.sky.underway.is_none(),
             "a solver state taken in the middle of a step"
         );
         checkpoint::SolverState {
@@ -1172,6 +1184,7 @@ impl<'a> Progressive<'a> {
         self.changed();
         self.underway = None;
         self.tail.underway = None;
+        self.sky.underway = None;
         self.fault = None;
         self.last_fraction = self.unshot_fraction();
         self.steps = state.steps;

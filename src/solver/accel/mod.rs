@@ -12,7 +12,9 @@
 //! - [`far_shooters`]: a far shooter's samples probed first;
 //! - [`subcells`]: shooter cells much larger than their elements, shot as
 //!   their sub-cells;
-//! - [`shared`]: vertices of one surface at one point receiving as one.
+//! - [`shared`]: vertices of one surface at one point receiving as one;
+//! - [`sky_dome`]: the whole sky gathered at once over each vertex's
+//!   hemisphere of directions.
 
 pub mod cluster;
 pub mod facets;
@@ -20,4 +22,5 @@ pub mod far_shooters;
 pub mod probes;
 pub mod receivers;
 pub mod shared;
+pub mod sky_dome;
 pub mod subcells;

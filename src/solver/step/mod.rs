@@ -27,6 +27,7 @@ pub mod gather;
 pub mod gather_cluster;
 pub mod parts;
 pub mod read;
+pub mod sky;
 pub mod tail;
 
 /// A step begun: what it shoots, how, and how far it has got.
@@ -137,6 +138,9 @@ impl<'a> Progressive<'a> {
         // A step's first part counts choosing the shooter and reading it
         // (building its strata) against its budget.
         let start = std::time::Instant::now();
+        if self.sky.underway.is_some() || self.sky_due() {
+            return self.sky_step(start, cancel);
+        }
         if self.tail.underway.is_some() || (self.underway.is_none() && self.tail_due()) {
             return self.tail_step(start, cancel);
         }
@@ -197,7 +201,7 @@ impl<'a> Progressive<'a> {
     /// has begun and not finished: the next [`Progressive::step`]
     /// continues it. The solution then holds the receivers done so far.
     pub fn in_step(&self) -> bool {
-        self.underway.is_some() || self.tail.underway.is_some()
+        self.underway.is_some() || self.tail.underway.is_some() || self.sky.underway.is_some()
     }
 
     /// Phase 1 of a step: chooses the shooter and what it sends; `None`
