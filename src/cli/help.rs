@@ -8,7 +8,7 @@ use super::args::{Args, EXIT_CODES};
 use crate::solver::tuning::{
     CHECK_TOLERANCE, CLUSTER_EXTENT, EXACT_RATIO, FACET_SCALE_RATIO, FAR_PROBES, FAR_SHOOTER_RATIO,
     NEAR_FIELD_RATIO, OVERSHOOT_SHARE, RECEIVER_STRIDE, RECEIVER_WEAK_SHARE, SHARE_CREASE_DEG,
-    SKY_FACET_SAMPLES, SKY_PROBES, WEAK_STRATUM_SHARE,
+    SKY_CELL_STRATA, SKY_FACET_SAMPLES, SKY_PROBES, WEAK_STRATUM_SHARE,
 };
 use clap::CommandFactory;
 
@@ -141,7 +141,9 @@ fn exact_receivers() -> String {
          under {facet} of an element across asks one shadow ray per shooter \
          sample for all its vertices, in every step, and a vertex asks \
          {SKY_PROBES} of a sky facet's {SKY_FACET_SAMPLES} directions first, \
-         the others only when those disagree; a vertex {FAR_SHOOTER_RATIO} or \
+         the others only when those disagree (a sky gathered at once: one of \
+         each {SKY_CELL_STRATA} × {SKY_CELL_STRATA} of its hemisphere's \
+         directions, then the rest of those along an edge); a vertex {FAR_SHOOTER_RATIO} or \
          more diameters from a lamp asks {FAR_PROBES} of its samples first, the \
          others only when those disagree. Vertices of polygons of one surface \
          at one point (coplanar, or smooth within {SHARE_CREASE_DEG}°) take \
@@ -188,6 +190,7 @@ mod tests {
         for quoted in [
             format!("every {RECEIVER_STRIDE}th row"),
             format!("{SKY_PROBES} of a sky facet's {SKY_FACET_SAMPLES} directions"),
+            format!("one of each {SKY_CELL_STRATA} × {SKY_CELL_STRATA}"),
             format!("{FAR_SHOOTER_RATIO} or more diameters"),
             format!("asks {FAR_PROBES} of its samples"),
             format!("smooth within {SHARE_CREASE_DEG}°"),

@@ -394,7 +394,7 @@ impl Dome {
         &self.facets
     }
 
-    /// Where the ray from `x` (inside the sphere of [`Dome::reach`]) along
+    /// Where the ray from `x` (inside the sphere the rays end on) along
     /// the unit `d` ends: on that sphere, short of every facet.
     pub fn end(&self, x: Vec3, d: Vec3) -> Vec3 {
         let o = x - self.centre;

@@ -4,13 +4,13 @@
 //!
 //! The step is due while a sky facet holds light and no other step is
 //! under way, so under `--sky` it is the first: it replaces the 80 steps
-//! of shooting the sky facet by facet. It visits the receiving polygons
-//! in index order, in chunks of about [`SKY_CHUNK_VERTICES`] element
-//! vertices gathered in parallel; with a part budget
-//! ([`crate::solver::SolverOptions::part_budget`]) it applies each chunk
-//! as it is done and returns between chunks, so a window shows the sky
-//! arriving; without one it applies them all at the end, so a cancelled
-//! step leaves nothing changed. Vertices that receive as one
+//! of shooting the sky facet by facet. It gathers the element vertices
+//! in index order, in chunks of [`SKY_CHUNK_VERTICES`] gathered in
+//! parallel; with a part budget
+//! ([`crate::solver::SolverOptions::part_budget`]) it applies each
+//! polygon once all its vertices are gathered and returns between
+//! chunks, so a window shows the sky arriving; without one it applies
+//! them all at the end, so a cancelled step leaves nothing changed. Vertices that receive as one
 //! ([`crate::solver::accel::shared`]) take their leader's value. The bits
 //! do not depend on the thread count or on the parts.
 
@@ -59,7 +59,7 @@ pub(in crate::solver) struct SkyUnderway {
     light: SkyLight,
     /// The power they sent, weighted as [`Progressive::unshot_power`].
     shot_power: f64,
-    /// The polygons before this one are gathered.
+    /// The vertices before this one are gathered.
     next: usize,
     /// The polygons before this one are applied.
     applied: usize,
@@ -115,9 +115,9 @@ impl<'a> Progressive<'a> {
             None => Box::new(self.begin_sky()?),
         };
         let budget = self.options.part_budget;
-        let polygons = self.mesh.polygons.len();
+        let vertices = self.mesh.vertex_count();
         let mut longest = std::time::Duration::ZERO;
-        while u.next < polygons {
+        while u.next < vertices {
             if cancel.load(Ordering::Relaxed) {
                 if budget.is_some() {
                     self.sky.underway = Some(u);
@@ -125,17 +125,14 @@ impl<'a> Progressive<'a> {
                 return None;
             }
             let chunk_start = std::time::Instant::now();
-            let (from, end) = (u.next, self.sky_chunk_end(u.next));
-            if !self.gather_sky(&mut u, from..end, cancel) {
+            let chunk = u.next..(u.next + SKY_CHUNK_VERTICES).min(vertices);
+            if !self.gather_sky(&mut u, chunk.clone(), cancel) {
                 if budget.is_some() {
                     self.sky.underway = Some(u);
                 }
                 return None;
             }
-            if !u.gathered[self.vertex_range(u.next..end)]
-                .iter()
-                .all(|g| g.is_finite())
-            {
+            if !u.gathered[chunk.clone()].iter().all(|g| g.is_finite()) {
                 self.fault = Some(SolverError::NotFinite {
                     step: self.steps + 1,
                     shooter: self.sky_shooter(),
@@ -143,13 +140,13 @@ impl<'a> Progressive<'a> {
                 });
                 return None;
             }
-            u.next = end;
+            u.next = chunk.end;
             if budget.is_some() {
                 self.apply_sky(&mut u);
             }
             longest = longest.max(chunk_start.elapsed());
             if let Some(b) = budget {
-                if u.next < polygons && start.elapsed() + longest >= b {
+                if u.next < vertices && start.elapsed() + longest >= b {
                     u.part += 1;
                     let report = self.sky_report(&u, false);
                     self.sky.underway = Some(u);
@@ -185,34 +182,6 @@ impl<'a> Progressive<'a> {
         PolygonId(first.copied().unwrap_or(0) as u32)
     }
 
-    /// The range of vertex indices of `polygons` (consecutive polygons
-    /// own consecutive vertices).
-    fn vertex_range(&self, polygons: std::ops::Range<usize>) -> std::ops::Range<usize> {
-        let mesh = &self.mesh;
-        let start = mesh
-            .polygons
-            .get(polygons.start)
-            .map_or(mesh.vertex_count(), |pm| pm.vertices.start as usize);
-        let end = if polygons.end < mesh.polygons.len() {
-            mesh.polygons[polygons.end].vertices.start as usize
-        } else {
-            mesh.vertex_count()
-        };
-        start..end.max(start)
-    }
-
-    /// Where the chunk that starts at polygon `from` ends: after about
-    /// [`SKY_CHUNK_VERTICES`] vertices, at least one polygon.
-    fn sky_chunk_end(&self, from: usize) -> usize {
-        let mut count = 0usize;
-        let mut j = from;
-        while j < self.mesh.polygons.len() && (j == from || count < SKY_CHUNK_VERTICES) {
-            count += self.mesh.polygons[j].vertex_count() as usize;
-            j += 1;
-        }
-        j
-    }
-
     /// Begins a sky step: what the facets hold; `None` when nothing.
     fn begin_sky(&self) -> Option<SkyUnderway> {
         let light = self.sky_light()?;
@@ -239,23 +208,24 @@ impl<'a> Progressive<'a> {
         })
     }
 
-    /// Gathers the vertices of `polygons` that are evaluated themselves
-    /// (not a shared receiver's follower) into `u.gathered`, in parallel;
-    /// false when cancelled (then `u` is as before).
+    /// Gathers the vertices among `vertices` that are evaluated themselves
+    /// (of a polygon that receives, and not a shared receiver's follower)
+    /// into `u.gathered`, in parallel; false when cancelled (then `u` is
+    /// as before).
     fn gather_sky(
         &self,
         u: &mut SkyUnderway,
-        polygons: std::ops::Range<usize>,
+        vertices: std::ops::Range<usize>,
         cancel: &AtomicBool,
     ) -> bool {
         let Some((hemisphere, dome)) = self.sky.tables.as_ref() else {
             return true;
         };
         let mesh = &self.mesh;
-        let heads: Vec<u32> = polygons
-            .filter(|&j| self.receives_sky(j))
-            .flat_map(|j| mesh.polygons[j].vertices.clone())
-            .filter(|&l| self.leaders.get(l as usize).is_none_or(|&x| x == ALONE))
+        let heads: Vec<u32> = vertices
+            .filter(|&l| self.receives_sky(mesh.vertex_polygon[l].index()))
+            .filter(|&l| self.leaders.get(l).is_none_or(|&x| x == ALONE))
+            .map(|l| l as u32)
             .collect();
         let (light, probing, visibility) = (&u.light, self.sky.probing, self.visibility);
         let results: Vec<(Rgb, u64)> = heads
@@ -283,7 +253,8 @@ impl<'a> Progressive<'a> {
         true
     }
 
-    /// Applies the gathered polygons not yet applied: each vertex's
+    /// Applies the polygons not yet applied whose vertices are all
+    /// gathered: each vertex's
     /// `Δrad = ρ · gathered` (its leader's, for a follower) to its
     /// radiosity and unshot radiosity; before the first, spends the
     /// facets' light.
@@ -302,7 +273,11 @@ impl<'a> Progressive<'a> {
             }
             u.spent = true;
         }
-        for j in u.applied..u.next {
+        let done = self.mesh.polygons[u.applied..]
+            .iter()
+            .take_while(|pm| pm.vertices.end as usize <= u.next)
+            .count();
+        for j in u.applied..u.applied + done {
             if !self.receives_sky(j) {
                 continue;
             }
@@ -320,7 +295,7 @@ impl<'a> Progressive<'a> {
             }
             self.unshot.accumulate(&self.mesh, j, &self.delta);
         }
-        u.applied = u.next;
+        u.applied += done;
     }
 
     /// The report of the sky step `u` so far.

@@ -124,3 +124,78 @@ fn a_step_cancelled_before_its_first_part_changes_nothing() {
     assert!(!solver.in_step());
     assert_eq!((solver.steps(), solver.rays()), (0, 0));
 }
+
+/// A floor of 3,721 vertices under a skylight in a black room, under a
+/// sky: its sky step (gathered at once) spans several chunks of
+/// [`crate::solver::tuning::SKY_CHUNK_VERTICES`].
+fn room_under_a_sky() -> (Scene, Mesh) {
+    use crate::testutil::{grey, polygon, scene};
+    let w = 6.0f32;
+    let floor = polygon(0, &[[0., 0., 0.], [0., 0., w], [w, 0., w], [w, 0., 0.]]);
+    // A ceiling with a 2 × 2 hole in the middle, facing down.
+    let ceiling = |x0: f32, x1: f32, z0: f32, z1: f32| {
+        polygon(1, &[[x0, 2., z0], [x1, 2., z0], [x1, 2., z1], [x0, 2., z1]])
+    };
+    let mut s = scene(
+        vec![
+            floor,
+            ceiling(0., w, 0., 2.),
+            ceiling(0., w, 4., w),
+            ceiling(0., 2., 2., 4.),
+            ceiling(4., w, 2., 4.),
+        ],
+        vec![grey("floor", 0.0, 0.5), grey("ceiling", 0.0, 0.3)],
+    );
+    s.add_sky(Rgb::splat(1.0)).unwrap();
+    let m = crate::testutil::regular_mesh(&s, 0.1);
+    let floor_vertices = m.polygons[0].vertex_count() as usize;
+    assert!(floor_vertices > 3 * crate::solver::tuning::SKY_CHUNK_VERTICES);
+    (s, m)
+}
+
+#[test]
+fn a_sky_step_in_parts_is_bit_identical_to_one_in_a_piece() {
+    let (s, m) = room_under_a_sky();
+    let whole = run(&s, &m, SolverOptions::default(), 2);
+    let parted = run(&s, &m, chunk_by_chunk(), 2);
+    assert_eq!(whole.3, 2);
+    assert!(parted.3 > 4, "{} parts", parted.3);
+    assert!(same_bits(&whole.0, &parted.0), "radiosity");
+    assert!(same_bits(&whole.1, &parted.1), "unshot radiosity");
+    assert_eq!(whole.2, parted.2, "rays");
+}
+
+#[test]
+fn a_cancelled_sky_step_keeps_its_parts_or_nothing() {
+    let (s, m) = room_under_a_sky();
+    let vis = Visibility::new(&s);
+    // In parts: a cancel keeps the parts delivered, and going on ends as
+    // the step in one piece does.
+    let mut solver = Progressive::new(&s, &m, &vis, chunk_by_chunk());
+    let first = solver.step().unwrap();
+    assert!(!first.complete && first.part == 1);
+    // On until the floor, gathered over several parts, is applied.
+    let mut last = first;
+    while last.receivers == 0 {
+        last = solver.step().unwrap();
+    }
+    assert!(!last.complete && last.part > 1 && last.step == 1);
+    let before = (solver.radiosity().to_vec(), solver.unshot().to_vec());
+    assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
+    assert!(solver.in_step());
+    assert!(same_bits(&before.0, solver.radiosity()));
+    assert!(same_bits(&before.1, solver.unshot()));
+    while solver.steps() < 1 {
+        solver.step().unwrap();
+    }
+    let whole = run(&s, &m, SolverOptions::default(), 1);
+    assert!(same_bits(&whole.0, solver.radiosity()));
+    assert!(same_bits(&whole.1, solver.unshot()));
+    // In one piece: a cancel changes nothing.
+    let mut solver = Progressive::new(&s, &m, &vis, SolverOptions::default());
+    let fresh = solver.radiosity().to_vec();
+    assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
+    assert!(!solver.in_step());
+    assert_eq!((solver.steps(), solver.rays()), (0, 0));
+    assert!(same_bits(&fresh, solver.radiosity()));
+}
