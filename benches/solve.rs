@@ -3,8 +3,10 @@
 //! 0.1 % threshold, settling), from mesh to converged solution, with
 //! clusters (the default), with clusters stopping at the threshold alone
 //! (`--settle 0`), without clusters (`--no-clustering`), and with the
-//! particle tail carrying the last 10 % (`--tail 0.1`). Rays per second
-//! are printed once per run; criterion reports the time per solve.
+//! particle tail carrying the last 10 % (`--tail 0.1`); and `rtable`
+//! under a uniform sky (`--sky 1`), the sky gathered at once (the
+//! default) and shot facet by facet (`--without sky-at-once`). Rays per
+//! second are printed once per run; criterion reports the time per solve.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use radiosity::mesh::{self, MeshOptions};
@@ -24,10 +26,21 @@ fn load(name: &str) -> Scene {
 
 /// One full solve; returns (steps, rays).
 fn solve(scene: &Scene, clustering: bool, settle: f64, tail: TailOption) -> (u64, u64) {
+    let approximations = Approximations::DEFAULT.with(Heuristic::Clusters, clustering);
+    solve_with(scene, approximations, settle, tail)
+}
+
+/// [`solve`] with these approximations.
+fn solve_with(
+    scene: &Scene,
+    approximations: Approximations,
+    settle: f64,
+    tail: TailOption,
+) -> (u64, u64) {
     let mesh = mesh::build(scene, &MeshOptions::for_scene(scene)).expect("mesh");
     let visibility = Visibility::new(scene);
     let options = SolverOptions {
-        approximations: Approximations::DEFAULT.with(Heuristic::Clusters, clustering),
+        approximations,
         settle,
         tail,
         ..SolverOptions::default()
@@ -77,5 +90,34 @@ fn bench_solve(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_solve);
+fn bench_sky(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sky");
+    group.sample_size(10);
+    let mut scene = load("rtable.sc");
+    scene
+        .add_sky(radiosity::color::Rgb::splat(1.0))
+        .expect("a sky fits");
+    for (at_once, label) in [
+        (true, "rtable.sc --sky 1"),
+        (false, "rtable.sc --sky 1 --without sky-at-once"),
+    ] {
+        let approximations = Approximations::DEFAULT.with(Heuristic::SkyAtOnce, at_once);
+        let auto = TailOption::Auto;
+        let t = Instant::now();
+        let (steps, rays) = solve_with(&scene, approximations, DEFAULT_SETTLE, auto);
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!(
+            "{label}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
+            rays as f64 / 1e6,
+            secs,
+            rays as f64 / secs / 1e6
+        );
+        group.bench_function(label, |b| {
+            b.iter(|| solve_with(&scene, approximations, DEFAULT_SETTLE, auto))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_solve, bench_sky);
 criterion_main!(benches);

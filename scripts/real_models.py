@@ -47,18 +47,22 @@ def run(radiosity, model, work, max_steps):
     wall, user, system, kb = open(timing).read().split()[-4:]
     s = json.load(open(stats))
     steps = list(csv.DictReader(open(log)))
-    # `seconds` is the solve's time so far; a sky facet's step is the
-    # difference from the row before.
-    sky_seconds, before = 0.0, 0.0
+    # `seconds` is the solve's time so far; a sky step (the sky's one,
+    # gathered at once, or a facet's) is the difference from the row
+    # before: its shooter is a sky facet, numbered after the model's
+    # polygons.
+    sky_seconds, sky_steps, before = 0.0, 0, 0.0
     for r in steps:
         if int(r["shooter"]) >= s["polygons"]:
             sky_seconds += float(r["seconds"]) - before
+            sky_steps += 1
         before = float(r["seconds"])
+    sky = "step" if sky_steps == 1 else "{} steps".format(sky_steps)
     state = "converged" if s["converged"] else "not converged ({:.2%} unshot)".format(
         s["unshot_fraction"])
-    return "| `{}` | {:,} / {:,} | {}: {:,} steps (the sky's 80 in {:.0f} s), {:.0f} s wall, {:.0f} s CPU | {:.0f} MB |".format(
+    return "| `{}` | {:,} / {:,} | {}: {:,} steps (the sky's {} in {:.0f} s), {:.0f} s wall, {:.0f} s CPU | {:.0f} MB |".format(
         model.replace("tests/models/", ""), s["polygons"], s["vertices"], state, s["steps"],
-        sky_seconds, float(wall), float(user) + float(system), int(kb) / 1024)
+        sky, sky_seconds, float(wall), float(user) + float(system), int(kb) / 1024)
 
 
 def main():

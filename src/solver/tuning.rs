@@ -274,10 +274,10 @@ pub const SKY_CELLS: usize = 24;
 pub const SKY_CELL_STRATA: usize = 3;
 
 /// Element vertices a sky step gathers in one parallel chunk (a part of
-/// the step ends only between chunks): about 50 ms on two cores at the
+/// the step ends only between chunks): 15 to 100 ms on two cores at the
 /// 600 to 1,000 rays a vertex of a real export, so a window's parts keep
 /// near their budget.
-pub const SKY_CHUNK_VERTICES: usize = 1_024;
+pub const SKY_CHUNK_VERTICES: usize = 512;
 
 /// A verdict needs at least this many probes in front of the receiver: a
 /// facet near its horizon is seen through too few to judge.
