@@ -24,13 +24,7 @@ fn load(name: &str) -> Scene {
     scene::load(&path).expect("bundled scene loads")
 }
 
-/// One full solve; returns (steps, rays).
-fn solve(scene: &Scene, clustering: bool, settle: f64, tail: TailOption) -> (u64, u64) {
-    let approximations = Approximations::DEFAULT.with(Heuristic::Clusters, clustering);
-    solve_with(scene, approximations, settle, tail)
-}
-
-/// [`solve`] with these approximations.
+/// One full solve with these approximations; returns (steps, rays).
 fn solve_with(
     scene: &Scene,
     approximations: Approximations,
@@ -48,6 +42,29 @@ fn solve_with(
     let mut solver = Progressive::new(scene, &mesh, &visibility, options);
     while !solver.is_done() && solver.step().is_some() {}
     (solver.steps(), solver.rays())
+}
+
+/// Prints one solve's steps, rays and rate, then benches it as `label`.
+fn bench_one(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    label: &str,
+    scene: &Scene,
+    approximations: Approximations,
+    settle: f64,
+    tail: TailOption,
+) {
+    let t = Instant::now();
+    let (steps, rays) = solve_with(scene, approximations, settle, tail);
+    let secs = t.elapsed().as_secs_f64();
+    eprintln!(
+        "{label}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
+        rays as f64 / 1e6,
+        secs,
+        rays as f64 / secs / 1e6
+    );
+    group.bench_function(label, |b| {
+        b.iter(|| solve_with(scene, approximations, settle, tail))
+    });
 }
 
 fn bench_solve(c: &mut Criterion) {
@@ -73,18 +90,8 @@ fn bench_solve(c: &mut Criterion) {
             ),
         ];
         for (clustering, settle, tail, label) in variants {
-            let t = Instant::now();
-            let (steps, rays) = solve(&scene, clustering, settle, tail);
-            let secs = t.elapsed().as_secs_f64();
-            eprintln!(
-                "{label}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
-                rays as f64 / 1e6,
-                secs,
-                rays as f64 / secs / 1e6
-            );
-            group.bench_function(&label, |b| {
-                b.iter(|| solve(&scene, clustering, settle, tail))
-            });
+            let approximations = Approximations::DEFAULT.with(Heuristic::Clusters, clustering);
+            bench_one(&mut group, &label, &scene, approximations, settle, tail);
         }
     }
     group.finish();
@@ -103,18 +110,14 @@ fn bench_sky(c: &mut Criterion) {
     ] {
         let approximations = Approximations::DEFAULT.with(Heuristic::SkyAtOnce, at_once);
         let auto = TailOption::Auto;
-        let t = Instant::now();
-        let (steps, rays) = solve_with(&scene, approximations, DEFAULT_SETTLE, auto);
-        let secs = t.elapsed().as_secs_f64();
-        eprintln!(
-            "{label}: {steps} steps, {:.1} M rays, {:.2} s, {:.2} M rays/s",
-            rays as f64 / 1e6,
-            secs,
-            rays as f64 / secs / 1e6
+        bench_one(
+            &mut group,
+            label,
+            &scene,
+            approximations,
+            DEFAULT_SETTLE,
+            auto,
         );
-        group.bench_function(label, |b| {
-            b.iter(|| solve_with(&scene, approximations, DEFAULT_SETTLE, auto))
-        });
     }
     group.finish();
 }

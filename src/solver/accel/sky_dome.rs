@@ -484,6 +484,15 @@ impl SkyLight {
 mod tests {
     use super::*;
 
+    /// The floor under a plate with a uniform sky: its mesh and dome.
+    fn plate_under_a_sky() -> (Mesh, Dome) {
+        let mut scene = crate::testutil::floor_under_a_plate();
+        scene.add_sky(Rgb::splat(1.0)).unwrap();
+        let mesh = crate::testutil::regular_mesh(&scene, 10.0);
+        let dome = Dome::new(&mesh).unwrap();
+        (mesh, dome)
+    }
+
     #[test]
     fn the_directions_are_cosine_weighted() {
         // Over the hemisphere, E[cos θ] = 2/3 and E[cos² θ] = 1/2 for the
@@ -539,10 +548,7 @@ mod tests {
 
     #[test]
     fn every_texel_finds_the_facet_its_direction_crosses() {
-        let mut scene = crate::testutil::floor_under_a_plate();
-        scene.add_sky(Rgb::splat(1.0)).unwrap();
-        let mesh = crate::testutil::regular_mesh(&scene, 10.0);
-        let dome = Dome::new(&mesh).unwrap();
+        let (mesh, dome) = plate_under_a_sky();
         assert_eq!(dome.facets().len(), 80);
         // A ray from the centre along a facet's middle direction meets
         // that facet.
@@ -573,10 +579,7 @@ mod tests {
 
     #[test]
     fn an_open_plane_under_a_uniform_sky_receives_it_all() {
-        let mut scene = crate::testutil::floor_under_a_plate();
-        scene.add_sky(Rgb::splat(1.0)).unwrap();
-        let mesh = crate::testutil::regular_mesh(&scene, 10.0);
-        let dome = Dome::new(&mesh).unwrap();
+        let (_, dome) = plate_under_a_sky();
         let h = Hemisphere::new(12, 3);
         let light = SkyLight::of(&dome, |_| Rgb::splat(2.0));
         assert!(matches!(light, SkyLight::Uniform(_)));
@@ -593,10 +596,7 @@ mod tests {
 
     #[test]
     fn a_half_blocked_hemisphere_receives_half_and_probes_agree_with_every_direction() {
-        let mut scene = crate::testutil::floor_under_a_plate();
-        scene.add_sky(Rgb::splat(1.0)).unwrap();
-        let mesh = crate::testutil::regular_mesh(&scene, 10.0);
-        let dome = Dome::new(&mesh).unwrap();
+        let (_, dome) = plate_under_a_sky();
         let h = Hemisphere::new(12, 3);
         let light = SkyLight::Uniform(Rgb::splat(1.0));
         // Everything with x > 0 blocked: half the cosine-weighted

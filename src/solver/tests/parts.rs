@@ -84,17 +84,16 @@ fn a_step_in_parts_is_bit_identical_to_one_in_a_piece() {
     }
 }
 
-/// A cancelled part leaves the parts before it; going on finishes the
-/// step as if nothing had happened.
-#[test]
-fn a_cancelled_part_leaves_the_parts_before_it() {
-    let (s, m) = hall();
-    let vis = Visibility::new(&s);
-    let mut solver = Progressive::new(&s, &m, &vis, chunk_by_chunk());
+/// On `s` and `m` in parts: a part cancelled after some receivers were
+/// applied leaves the parts before it, and going on to `steps` finishes
+/// as the steps in one piece do.
+fn cancelled_part_keeps_the_parts_before_it(s: &Scene, m: &Mesh, steps: u64) {
+    let vis = Visibility::new(s);
+    let mut solver = Progressive::new(s, m, &vis, chunk_by_chunk());
     let first = solver.step().unwrap();
     assert!(!first.complete && first.part == 1);
     // On until some receivers are applied (the first parts may be pieces
-    // of the floor, which is applied once whole).
+    // of a large polygon, which is applied once whole).
     let mut last = first;
     while last.receivers == 0 {
         last = solver.step().unwrap();
@@ -105,12 +104,20 @@ fn a_cancelled_part_leaves_the_parts_before_it() {
     assert!(solver.in_step());
     assert!(same_bits(&before.0, solver.radiosity()));
     assert!(same_bits(&before.1, solver.unshot()));
-    while solver.steps() < 3 {
+    while solver.steps() < steps {
         solver.step().unwrap();
     }
-    let whole = run(&s, &m, SolverOptions::default(), 3);
+    let whole = run(s, m, SolverOptions::default(), steps);
     assert!(same_bits(&whole.0, solver.radiosity()));
     assert!(same_bits(&whole.1, solver.unshot()));
+}
+
+/// A cancelled part leaves the parts before it; going on finishes the
+/// step as if nothing had happened.
+#[test]
+fn a_cancelled_part_leaves_the_parts_before_it() {
+    let (s, m) = hall();
+    cancelled_part_keeps_the_parts_before_it(&s, &m, 3);
 }
 
 /// A step cancelled before any of its receivers were applied is forgotten,
@@ -168,30 +175,10 @@ fn a_sky_step_in_parts_is_bit_identical_to_one_in_a_piece() {
 #[test]
 fn a_cancelled_sky_step_keeps_its_parts_or_nothing() {
     let (s, m) = room_under_a_sky();
-    let vis = Visibility::new(&s);
-    // In parts: a cancel keeps the parts delivered, and going on ends as
-    // the step in one piece does.
-    let mut solver = Progressive::new(&s, &m, &vis, chunk_by_chunk());
-    let first = solver.step().unwrap();
-    assert!(!first.complete && first.part == 1);
-    // On until the floor, gathered over several parts, is applied.
-    let mut last = first;
-    while last.receivers == 0 {
-        last = solver.step().unwrap();
-    }
-    assert!(!last.complete && last.part > 1 && last.step == 1);
-    let before = (solver.radiosity().to_vec(), solver.unshot().to_vec());
-    assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
-    assert!(solver.in_step());
-    assert!(same_bits(&before.0, solver.radiosity()));
-    assert!(same_bits(&before.1, solver.unshot()));
-    while solver.steps() < 1 {
-        solver.step().unwrap();
-    }
-    let whole = run(&s, &m, SolverOptions::default(), 1);
-    assert!(same_bits(&whole.0, solver.radiosity()));
-    assert!(same_bits(&whole.1, solver.unshot()));
+    // In parts: a cancel keeps the parts delivered.
+    cancelled_part_keeps_the_parts_before_it(&s, &m, 1);
     // In one piece: a cancel changes nothing.
+    let vis = Visibility::new(&s);
     let mut solver = Progressive::new(&s, &m, &vis, SolverOptions::default());
     let fresh = solver.radiosity().to_vec();
     assert!(solver.step_cancellable(&AtomicBool::new(true)).is_none());
