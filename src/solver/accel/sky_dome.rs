@@ -29,7 +29,8 @@
 //! cells touching it see the sky takes that answer for all its
 //! directions; one whose probes two rings deep are all blocked takes
 //! that (an opening poking into a cell past its nearest probes); the
-//! others, along a shadow's edge, ask every direction. Off with
+//! others, along a shadow's edge, ask every direction, and so do the
+//! cells near the horizon ([`SKY_GRAZING_Z`](crate::solver::tuning::SKY_GRAZING_Z)). Off with
 //! [`crate::solver::Approximations::sky_probes`].
 //!
 //! **The sky's light by direction** ([`Dome`]): a uniform sky's facets
@@ -59,6 +60,9 @@ pub struct Hemisphere {
     ring1: Vec<Vec<u16>>,
     /// Per cell, the cells within two rings of it (itself left out).
     ring2: Vec<Vec<u16>>,
+    /// Per cell, whether its probe may answer for it: not a cell near the
+    /// horizon ([`SKY_GRAZING_Z`](crate::solver::tuning::SKY_GRAZING_Z)).
+    probed: Vec<bool>,
     /// Per stratum (cell by cell, `per_cell²` each), the direction of its
     /// centre, unit, `z >= 0`: where a settled cell's directions reach
     /// the sky.
@@ -135,17 +139,22 @@ impl Hemisphere {
             per_cell,
             ring1: (0..n).map(|c| ring(c, 1)).collect(),
             ring2: (0..n).map(|c| ring(c, 2)).collect(),
+            probed: Vec::with_capacity(n),
             centres: Vec::with_capacity(n * per_cell * per_cell),
             asked: Vec::with_capacity(n * per_cell * per_cell),
         };
         for c in 0..n {
+            let mut lowest = 1.0f32;
             for s in 0..per_cell * per_cell {
                 let (a, b) = h.square(c, s, (0.5, 0.5));
                 h.centres.push(concentric(a, b));
+                lowest = lowest.min(concentric(a, b).z);
                 let stratum = (c * per_cell * per_cell + s) as u32;
                 let (a, b) = h.square(c, s, jitter(stratum));
                 h.asked.push(concentric(a, b));
             }
+            h.probed
+                .push(lowest >= crate::solver::tuning::SKY_GRAZING_Z);
         }
         h
     }
@@ -222,11 +231,12 @@ impl Hemisphere {
         let is_open = |c: usize| seen[c / 64] >> (c % 64) & 1 == 1;
         for (c, &probe_end) in probe_end.iter().enumerate().take(cells) {
             let here = is_open(c);
-            let settled = if here {
-                self.ring1[c].iter().all(|&o| is_open(usize::from(o)))
-            } else {
-                self.ring2[c].iter().all(|&o| !is_open(usize::from(o)))
-            };
+            let settled = self.probed[c]
+                && if here {
+                    self.ring1[c].iter().all(|&o| is_open(usize::from(o)))
+                } else {
+                    self.ring2[c].iter().all(|&o| !is_open(usize::from(o)))
+                };
             if settled {
                 if here {
                     sum += light.cell(self, dome, x, world, c);
@@ -583,10 +593,14 @@ mod tests {
         let h = Hemisphere::new(12, 3);
         let light = SkyLight::of(&dome, |_| Rgb::splat(2.0));
         assert!(matches!(light, SkyLight::Uniform(_)));
+        // A probe a cell, and every direction of the cells near the
+        // horizon.
+        let grazing = h.probed.iter().filter(|&&p| !p).count() as u64;
+        assert!(grazing > 0 && grazing < 144 / 2, "{grazing}");
         for probing in [true, false] {
             let (e, rays) = h.gather(&dome, &light, Vec3::ZERO, Vec3::Y, probing, |_| false);
             assert!((e.r - 2.0).abs() < 1e-9, "{e:?}");
-            assert_eq!(rays, if probing { 144 } else { 1296 });
+            assert_eq!(rays, if probing { 144 + 8 * grazing } else { 1296 });
         }
         // Per facet, the same light gives the same answer.
         let per = SkyLight::PerFacet(vec![Rgb::splat(2.0); 80]);
@@ -597,7 +611,7 @@ mod tests {
     #[test]
     fn a_half_blocked_hemisphere_receives_half_and_probes_agree_with_every_direction() {
         let (_, dome) = plate_under_a_sky();
-        let h = Hemisphere::new(12, 3);
+        let h = Hemisphere::new(24, 3);
         let light = SkyLight::Uniform(Rgb::splat(1.0));
         // Everything with x > 0 blocked: half the cosine-weighted
         // hemisphere about +y.

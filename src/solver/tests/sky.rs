@@ -389,16 +389,17 @@ fn the_checkpoint_fingerprint_covers_the_sky() {
 /// away from the edge), and the same bits on 1 and 2 threads.
 #[test]
 fn sky_probes_match_asking_every_direction() {
-    // Shot facet by facet, a facet's 16 probes; gathered at once, a
-    // cell's one of 576 (a little coarser near the horizon, where the
-    // concentric map's cells stretch).
-    sky_probes_match(false, 0.005);
-    sky_probes_match(true, 0.01);
+    // Shot facet by facet, a facet's 16 probes: relL1 0.19 %, 0.35 × the
+    // rays; gathered at once, a cell's one of 576, the cells near the
+    // horizon asking all their directions: 0.01 %, 0.47 × the rays.
+    sky_probes_match(false, 0.005, 0.4);
+    sky_probes_match(true, 0.005, 0.5);
 }
 
 /// The probes against asking every direction, the sky gathered at once
-/// or not: the floor's relative L1 difference below `l1`.
-fn sky_probes_match(at_once: bool, l1: f64) {
+/// or not: the floor's relative L1 difference below `l1`, the rays below
+/// `share` of asking every direction.
+fn sky_probes_match(at_once: bool, l1: f64, share: f64) {
     let roof = [[-1., 1., -1.], [2., 1., -1.], [2., 1., 5.], [-1., 1., 5.]];
     let mut polygons = vec![floor(4.0), polygon(1, &roof)];
     polygons.extend(crate::testutil::cuboid(
@@ -446,7 +447,7 @@ fn sky_probes_match(at_once: bool, l1: f64) {
     assert!(diff / total < l1, "floor relL1 {}", diff / total);
     assert!(worst < 0.02, "worst vertex {worst} of the peak");
     assert!(
-        (probed_rays as f64) < 0.4 * every_rays as f64,
+        (probed_rays as f64) < share * every_rays as f64,
         "probes saved too few rays: {probed_rays} vs {every_rays}"
     );
     let threads = |n| {
