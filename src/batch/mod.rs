@@ -919,6 +919,7 @@ fn solve<'p>(
             save(session, &records)?;
             return Err(Written::default().interrupted(config, session.totals().steps, true));
         }
+        progress.follow(session.solver().gauge());
         let event = match session.advance(cancel.flag()) {
             Ok(event) => event,
             Err(error) => {

@@ -1,12 +1,22 @@
 //! The batch run's progress bar on stderr: how far the unshot power has
 //! fallen towards the threshold, in log scale, with the rate of rays and
-//! an estimate of the time left.
+//! an estimate of the time left; and, while a long step runs, how much of
+//! it is done and how long the rest should take.
 
-use crate::solver::StepReport;
+use crate::solver::{StepGauge, StepReport};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::VecDeque;
 use std::io::IsTerminal;
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
+
+/// How often the bar is redrawn while a step runs.
+const REDRAW: Duration = Duration::from_millis(250);
+
+/// How long a step runs before the bar speaks of it: shorter steps come
+/// and go faster than anyone reads.
+const LONG_STEP: Duration = Duration::from_secs(1);
 
 /// Ticks of the bar: fine enough for a smooth bar on any terminal width.
 const TICKS: u64 = 1000;
@@ -32,6 +42,28 @@ pub struct Progress {
     last: Duration,
     start: Instant,
     rate: RateEstimate,
+    /// What the redrawing thread reads.
+    shown: Arc<Mutex<Shown>>,
+    /// The thread that redraws the bar while a step runs.
+    redraw: Option<JoinHandle<()>>,
+}
+
+/// The bar's message after the last step, and the step under way.
+struct Shown {
+    /// The message [`Progress::step`] set.
+    base: String,
+    /// The number of the step under way.
+    step: u64,
+    /// When it began.
+    began: Instant,
+    /// Its solver's gauge, if the solver has one.
+    gauge: Option<Arc<StepGauge>>,
+    /// When the gauge was first seen filling in this step, and how full:
+    /// the pace is measured from there, not from the step's start (its
+    /// set-up and the first chunk's are not the rest's).
+    since: Option<(Instant, f64)>,
+    /// Set when the bar is dropped: the thread ends.
+    done: bool,
 }
 
 impl Progress {
@@ -50,6 +82,27 @@ impl Progress {
             ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
+        let shown = Arc::new(Mutex::new(Shown {
+            base: String::new(),
+            step: 1,
+            began: Instant::now(),
+            gauge: None,
+            since: None,
+            done: false,
+        }));
+        // Only a bar someone sees is redrawn.
+        let redraw = (!bar.is_hidden()).then(|| {
+            let (bar, shown) = (bar.clone(), Arc::clone(&shown));
+            std::thread::spawn(move || loop {
+                std::thread::park_timeout(REDRAW);
+                let mut shown = shown.lock().unwrap_or_else(PoisonError::into_inner);
+                if shown.done {
+                    break;
+                }
+                bar.set_message(shown.message(Instant::now()));
+                bar.tick();
+            })
+        });
         Progress {
             bar,
             threshold,
@@ -59,7 +112,19 @@ impl Progress {
             last: Duration::ZERO,
             start: Instant::now(),
             rate: RateEstimate::default(),
+            shown,
+            redraw,
         }
+    }
+
+    /// The solver whose steps come next reports their progress on
+    /// `gauge` (`None`: it does not).
+    pub fn follow(&self, gauge: Option<Arc<StepGauge>>) {
+        self.shown().gauge = gauge;
+    }
+
+    fn shown(&self) -> std::sync::MutexGuard<'_, Shown> {
+        self.shown.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
     /// Shows a finished step; `rays` is every ray cast so far.
@@ -78,12 +143,18 @@ impl Progress {
         self.bar
             .set_position(((done_log / self.total_log).clamp(0.0, 1.0) * TICKS as f64) as u64);
         let left = self.left(report.unshot_fraction, done_log);
-        self.bar.set_message(format!(
+        let message = format!(
             "step {} · unshot {:.3}% · {:.2} Mrays/s · {left}",
             report.step,
             report.unshot_fraction * 100.0,
             rays_per_s / 1e6,
-        ));
+        );
+        self.bar.set_message(message.clone());
+        let mut shown = self.shown();
+        shown.base = message;
+        shown.step = report.step + 1;
+        shown.began = Instant::now();
+        shown.since = None;
     }
 
     /// What the bar says of the time left at unshot fraction `fraction`
@@ -129,7 +200,47 @@ impl Progress {
 
 impl Drop for Progress {
     fn drop(&mut self) {
+        self.shown().done = true;
+        if let Some(thread) = self.redraw.take() {
+            thread.thread().unpark();
+            // A redraw thread that panicked has nothing left to clean up.
+            let _ = thread.join();
+        }
         self.clear();
+    }
+}
+
+impl Shown {
+    /// The bar's message at `now`: the last step's, and once the step
+    /// under way has run past [`LONG_STEP`] how far it has got by its
+    /// gauge and the time its pace since the gauge was first seen leaves
+    /// (or only how long it has run, when it does not report).
+    fn message(&mut self, now: Instant) -> String {
+        let running = now.saturating_duration_since(self.began);
+        let fraction = self.gauge.as_ref().and_then(|g| g.fraction());
+        if let Some(f) = fraction {
+            self.since.get_or_insert((now, f));
+        }
+        if running < LONG_STEP {
+            return self.base.clone();
+        }
+        let now_says = match (fraction, self.since) {
+            (Some(f), Some((t0, f0))) => {
+                let pace = (f - f0) / now.saturating_duration_since(t0).as_secs_f64();
+                let left = if pace > 0.0 {
+                    format!(", {:.0}s left in it", (1.0 - f) / pace)
+                } else {
+                    String::new()
+                };
+                format!("step {} {:.0}% done{left}", self.step, f * 100.0)
+            }
+            _ => format!("step {} running {:.0}s", self.step, running.as_secs_f64()),
+        };
+        if self.base.is_empty() {
+            now_says
+        } else {
+            format!("{} · {now_says}", self.base)
+        }
     }
 }
 
@@ -209,6 +320,66 @@ mod tests {
         let mut t = Progress::new(false, 0.001, Some(0.04));
         t.step(&report(1, 0.03, 1000), 10);
         assert!(t.tail_step.is_some());
+    }
+
+    /// Past a second, a step's gauge says how much of it is done and
+    /// what its pace since the gauge was first seen leaves; a step
+    /// without one says how long it runs.
+    #[test]
+    fn a_long_step_says_how_far_it_has_got() {
+        let gauge = Arc::new(StepGauge::default());
+        let t0 = Instant::now();
+        let mut shown = Shown {
+            base: String::new(),
+            step: 1,
+            began: t0,
+            gauge: Some(Arc::clone(&gauge)),
+            since: None,
+            done: false,
+        };
+        let at = |ms: u64| t0 + Duration::from_millis(ms);
+        // The step's set-up: nothing done for the first two seconds.
+        assert_eq!(shown.message(at(500)), "");
+        gauge.set(0, 100);
+        assert_eq!(shown.message(at(2_000)), "step 1 0% done");
+        // 25 % in the next 5 s: 15 s for the 75 % left.
+        gauge.set(25, 100);
+        assert_eq!(shown.message(at(7_000)), "step 1 25% done, 15s left in it");
+        gauge.idle();
+        assert_eq!(shown.message(at(10_000)), "step 1 running 10s");
+        // The next step's message keeps the last step's.
+        shown.base = "step 1 · unshot 33.000%".to_string();
+        shown.step = 2;
+        shown.began = at(10_000);
+        shown.since = None;
+        gauge.set(3, 4);
+        assert_eq!(shown.message(at(10_500)), "step 1 · unshot 33.000%");
+        gauge.set(9, 10);
+        assert_eq!(
+            shown.message(at(11_500)),
+            "step 1 · unshot 33.000% · step 2 90% done, 1s left in it"
+        );
+        shown.gauge = None;
+        assert_eq!(
+            shown.message(at(13_000)),
+            "step 1 · unshot 33.000% · step 2 running 3s"
+        );
+    }
+
+    /// A step's report is the base of the next one's message.
+    #[test]
+    fn a_finished_step_starts_the_next_ones_clock() {
+        let mut p = Progress::new(false, 0.001, None);
+        p.follow(Some(Arc::new(StepGauge::default())));
+        p.step(&report(4, 0.5, 0), 10);
+        let shown = p.shown();
+        assert_eq!(shown.step, 5);
+        assert!(
+            shown.base.starts_with("step 4 · unshot 50.000%"),
+            "{}",
+            shown.base
+        );
+        assert!(shown.gauge.is_some());
     }
 
     #[test]

@@ -131,6 +131,13 @@ pub trait Method<'a> {
         None
     }
 
+    /// How far the step under way has got, for a progress display on
+    /// another thread ([`super::gauge`]); `None` for a method whose steps
+    /// do not report it.
+    fn gauge(&self) -> Option<std::sync::Arc<super::StepGauge>> {
+        None
+    }
+
     /// The mesh it solves on.
     fn mesh(&self) -> &Mesh;
 

@@ -86,6 +86,7 @@ mod ambient;
 mod approximations;
 pub mod checkpoint;
 pub mod final_gather;
+pub mod gauge;
 pub mod kernel;
 pub mod method;
 pub mod methods;
@@ -105,6 +106,7 @@ use accel::{cluster, facets, far_shooters, receivers, shared, subcells};
 pub use ambient::first_look;
 use ambient::{ambient_term, sky_power_weights};
 pub use approximations::{Approximations, Heuristic};
+pub use gauge::StepGauge;
 use kernel::{cell_integrals, distribution, formfactor};
 pub use step::StepPhase;
 use step::Underway;
@@ -568,6 +570,9 @@ pub struct Progressive<'a> {
     tail: step::tail::Tail,
     /// The sky gathered at once, and its step under way.
     sky: step::sky::SkyGather,
+    /// How far the step under way has got ([`gauge`]): the sky's and the
+    /// particle tail's steps fill it.
+    gauge: std::sync::Arc<StepGauge>,
 }
 
 /// The scans over every vertex that choosing a step, checking for
@@ -735,6 +740,7 @@ impl<'a> Progressive<'a> {
                 clustered && approx.sky_at_once && scene.sky_pattern.is_none(),
                 clustered && approx.sky_probes,
             ),
+            gauge: std::sync::Arc::default(),
         };
         solver.receive_sun();
         solver.initial_unshot_power = solver.unshot_power();

@@ -29,8 +29,12 @@
 //! cells touching it see the sky takes that answer for all its
 //! directions; one whose probes two rings deep are all blocked takes
 //! that (an opening poking into a cell past its nearest probes); the
-//! others, along a shadow's edge, ask every direction, and so do the
-//! cells near the horizon ([`SKY_GRAZING_Z`](crate::solver::tuning::SKY_GRAZING_Z)). Off with
+//! others, along a shadow's edge, ask every direction. A cell near the
+//! horizon ([`SKY_GRAZING_Z`](crate::solver::tuning::SKY_GRAZING_Z)) spans
+//! some 24° of elevation, across which a window's head or sill or a
+//! parapet runs: its probe is the column of strata from the horizon up
+//! and the row along the horizon (five of nine), and it settles only
+//! when they agree. Off with
 //! [`crate::solver::Approximations::sky_probes`].
 //!
 //! **The sky's light by direction** ([`Dome`]): a uniform sky's facets
@@ -60,9 +64,12 @@ pub struct Hemisphere {
     ring1: Vec<Vec<u16>>,
     /// Per cell, the cells within two rings of it (itself left out).
     ring2: Vec<Vec<u16>>,
-    /// Per cell, whether its probe may answer for it: not a cell near the
-    /// horizon ([`SKY_GRAZING_Z`](crate::solver::tuning::SKY_GRAZING_Z)).
-    probed: Vec<bool>,
+    /// Per cell, the strata its probe asks (indices within the cell, the
+    /// middle one first): the middle alone, or for a cell near the
+    /// horizon ([`SKY_GRAZING_Z`](crate::solver::tuning::SKY_GRAZING_Z))
+    /// the column through the middle from the horizon up and the row
+    /// along the horizon ([`horizon_probe`]).
+    probes: Vec<Vec<u16>>,
     /// Per stratum (cell by cell, `per_cell²` each), the direction of its
     /// centre, unit, `z >= 0`: where a settled cell's directions reach
     /// the sky.
@@ -81,6 +88,38 @@ const MAX_CELLS: usize = 32;
 fn probe_of(per_cell: usize) -> usize {
     let m = per_cell / 2;
     m * per_cell + m
+}
+
+/// The strata of a cell near the horizon that its probe asks: the middle
+/// one, then the rest of the column through it along the radius of the
+/// concentric map (`u` when the cell's middle `(a, b)` has `|a| >= |b|`,
+/// else `v`), which runs from the horizon up, and the rest of the row
+/// nearest the horizon, which spans the most elevation (13.6° of the
+/// cell's 23.6° at 24 cells of 3 × 3).
+fn horizon_probe(per_cell: usize, (a, b): (f32, f32)) -> Vec<u16> {
+    let m = per_cell / 2;
+    let along_u = a.abs() >= b.abs();
+    let outer = if (if along_u { a } else { b }) > 0.0 {
+        per_cell - 1
+    } else {
+        0
+    };
+    // Stratum `along` radially, `across` round the horizon.
+    let at = |along: usize, across: usize| {
+        (if along_u {
+            across * per_cell + along
+        } else {
+            along * per_cell + across
+        }) as u16
+    };
+    let mut strata = vec![probe_of(per_cell) as u16];
+    for i in (0..per_cell).filter(|&i| i != m) {
+        strata.push(at(i, m));
+    }
+    for i in (0..per_cell).filter(|&i| i != m) {
+        strata.push(at(outer, i));
+    }
+    strata
 }
 
 /// Shirley and Chiu's concentric map of `(a, b)` in `[-1, 1]²` onto the
@@ -139,7 +178,7 @@ impl Hemisphere {
             per_cell,
             ring1: (0..n).map(|c| ring(c, 1)).collect(),
             ring2: (0..n).map(|c| ring(c, 2)).collect(),
-            probed: Vec::with_capacity(n),
+            probes: Vec::with_capacity(n),
             centres: Vec::with_capacity(n * per_cell * per_cell),
             asked: Vec::with_capacity(n * per_cell * per_cell),
         };
@@ -153,8 +192,12 @@ impl Hemisphere {
                 let (a, b) = h.square(c, s, jitter(stratum));
                 h.asked.push(concentric(a, b));
             }
-            h.probed
-                .push(lowest >= crate::solver::tuning::SKY_GRAZING_Z);
+            let grazing = lowest < crate::solver::tuning::SKY_GRAZING_Z;
+            h.probes.push(if grazing {
+                horizon_probe(per_cell, h.cell_middle(c))
+            } else {
+                vec![probe_of(per_cell) as u16]
+            });
         }
         h
     }
@@ -174,6 +217,13 @@ impl Hemisphere {
             2.0 * (u as f32 + ju) / n - 1.0,
             2.0 * (v as f32 + jv) / n - 1.0,
         )
+    }
+
+    /// The middle of cell `c` on the square `[-1, 1]²`.
+    fn cell_middle(&self, c: usize) -> (f32, f32) {
+        let n = self.cells as f32;
+        let (u, v) = ((c % self.cells) as f32 + 0.5, (c / self.cells) as f32 + 0.5);
+        (2.0 * u / n - 1.0, 2.0 * v / n - 1.0)
     }
 
     /// The direction asked for stratum `s` of cell `c`, in the receiver's
@@ -214,24 +264,43 @@ impl Hemisphere {
                 for s in 0..k {
                     let (seen, end) = open(self.jittered(c, s));
                     if seen {
-                        sum += light.at(dome, x, end);
+                        sum += light.at(dome, end);
                     }
                 }
             }
             return (sum * (1.0 / self.directions() as f64), rays);
         }
-        // One probe per cell, a bit each.
+        // Each stratum asked so far, and whether it was open: two bits.
+        let words = (cells * k).div_ceil(64);
+        let mut asked = vec![0u64; words];
+        let mut opened = vec![0u64; words];
+        let bit = |bits: &[u64], i: usize| bits[i / 64] >> (i % 64) & 1 == 1;
+        let mut ask = |c: usize, s: usize| -> bool {
+            let i = c * k + s;
+            if !bit(&asked, i) {
+                asked[i / 64] |= 1 << (i % 64);
+                if open(self.jittered(c, s)).0 {
+                    opened[i / 64] |= 1 << (i % 64);
+                }
+            }
+            bit(&opened, i)
+        };
+        // The probes: a cell is open when its middle stratum is, and
+        // agrees with itself when its whole probe does.
         let mut seen = [0u64; MAX_CELLS * MAX_CELLS / 64];
-        let mut probe_end = [Vec3::ZERO; MAX_CELLS * MAX_CELLS];
+        let mut uniform = [0u64; MAX_CELLS * MAX_CELLS / 64];
         for c in 0..cells {
-            let (s, end) = open(self.jittered(c, probe));
-            seen[c / 64] |= u64::from(s) << (c % 64);
-            probe_end[c] = end;
+            let here = ask(c, probe);
+            let agree = self.probes[c][1..]
+                .iter()
+                .all(|&s| ask(c, usize::from(s)) == here);
+            seen[c / 64] |= u64::from(here) << (c % 64);
+            uniform[c / 64] |= u64::from(agree) << (c % 64);
         }
         let is_open = |c: usize| seen[c / 64] >> (c % 64) & 1 == 1;
-        for (c, &probe_end) in probe_end.iter().enumerate().take(cells) {
+        for c in 0..cells {
             let here = is_open(c);
-            let settled = self.probed[c]
+            let settled = uniform[c / 64] >> (c % 64) & 1 == 1
                 && if here {
                     self.ring1[c].iter().all(|&o| is_open(usize::from(o)))
                 } else {
@@ -244,13 +313,8 @@ impl Hemisphere {
                 continue;
             }
             for s in 0..k {
-                let (visible, end) = if s == probe {
-                    (here, probe_end)
-                } else {
-                    open(self.jittered(c, s))
-                };
-                if visible {
-                    sum += light.at(dome, x, end);
+                if ask(c, s) {
+                    sum += light.at(dome, dome.end(x, world(self.jittered(c, s))));
                 }
             }
         }
@@ -459,9 +523,9 @@ impl SkyLight {
         }
     }
 
-    /// What the open direction from `x` ending at `end` brings.
+    /// What the open direction ending at `end` brings.
     #[inline]
-    fn at(&self, dome: &Dome, _x: Vec3, end: Vec3) -> Rgb {
+    fn at(&self, dome: &Dome, end: Vec3) -> Rgb {
         match self {
             SkyLight::Uniform(v) => *v,
             SkyLight::PerFacet(v) => v[dome.facet_at(end)],
@@ -593,19 +657,45 @@ mod tests {
         let h = Hemisphere::new(12, 3);
         let light = SkyLight::of(&dome, |_| Rgb::splat(2.0));
         assert!(matches!(light, SkyLight::Uniform(_)));
-        // A probe a cell, and every direction of the cells near the
-        // horizon.
-        let grazing = h.probed.iter().filter(|&&p| !p).count() as u64;
-        assert!(grazing > 0 && grazing < 144 / 2, "{grazing}");
+        // A probe a cell, five strata for the cells near the horizon:
+        // the outer ring.
+        let grazing = h.probes.iter().filter(|p| p.len() == 5).count() as u64;
+        assert_eq!(grazing, 4 * 12 - 4);
         for probing in [true, false] {
             let (e, rays) = h.gather(&dome, &light, Vec3::ZERO, Vec3::Y, probing, |_| false);
             assert!((e.r - 2.0).abs() < 1e-9, "{e:?}");
-            assert_eq!(rays, if probing { 144 + 8 * grazing } else { 1296 });
+            assert_eq!(rays, if probing { 144 + 4 * grazing } else { 1296 });
         }
         // Per facet, the same light gives the same answer.
         let per = SkyLight::PerFacet(vec![Rgb::splat(2.0); 80]);
         let (e, _) = h.gather(&dome, &per, Vec3::ZERO, Vec3::Y, true, |_| false);
         assert!((e.r - 2.0).abs() < 1e-9);
+    }
+
+    /// A parapet all round up to 10° of elevation hides `sin² 10°` of
+    /// the cosine-weighted hemisphere. A cell near the horizon spans
+    /// its lowest 23.6°, so one probe at its middle sees over the
+    /// parapet, and so do its neighbours': the horizon cells' probes find
+    /// the edge.
+    #[test]
+    fn a_parapet_at_the_horizon_is_found_by_the_horizon_cells_probes() {
+        let (_, dome) = plate_under_a_sky();
+        let h = Hemisphere::new(24, 3);
+        let light = SkyLight::Uniform(Rgb::splat(1.0));
+        let sin_e = 10f64.to_radians().sin();
+        let exact = 1.0 - sin_e * sin_e;
+        let parapet = |end: Vec3| f64::from(end.normalize().y) < sin_e;
+        let (all, _) = h.gather(&dome, &light, Vec3::ZERO, Vec3::Y, false, parapet);
+        let (probed, rays) = h.gather(&dome, &light, Vec3::ZERO, Vec3::Y, true, parapet);
+        assert!((all.r - exact).abs() < 0.002, "{} against {exact}", all.r);
+        assert!(
+            (probed.r - all.r).abs() < 0.003,
+            "{} against {}",
+            probed.r,
+            all.r
+        );
+        // Every cell probed, the outer ring's five strata each.
+        assert!(rays >= 576 + 4 * 92, "{rays}");
     }
 
     #[test]

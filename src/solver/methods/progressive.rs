@@ -18,6 +18,10 @@ impl<'a> Method<'a> for Progressive<'a> {
         Progressive::in_step(self)
     }
 
+    fn gauge(&self) -> Option<std::sync::Arc<crate::solver::StepGauge>> {
+        Some(std::sync::Arc::clone(&self.gauge))
+    }
+
     fn stop_reason(&self) -> Option<StopReason> {
         Progressive::stop_reason(self)
     }

@@ -138,11 +138,16 @@ impl<'a> Progressive<'a> {
         // A step's first part counts choosing the shooter and reading it
         // (building its strata) against its budget.
         let start = std::time::Instant::now();
+        // The gauge reads the step under way; between calls none is.
         if self.sky.underway.is_some() || self.sky_due() {
-            return self.sky_step(start, cancel);
+            let report = self.sky_step(start, cancel);
+            self.gauge.idle();
+            return report;
         }
         if self.tail.underway.is_some() || (self.underway.is_none() && self.tail_due()) {
-            return self.tail_step(start, cancel);
+            let report = self.tail_step(start, cancel);
+            self.gauge.idle();
+            return report;
         }
         if self.underway.is_none() {
             let chosen = self.choose_step()?;

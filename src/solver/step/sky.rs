@@ -12,7 +12,8 @@
 //! chunks, so a window shows the sky arriving; without one it applies
 //! them all at the end, so a cancelled step leaves nothing changed. Vertices that receive as one
 //! ([`crate::solver::accel::shared`]) take their leader's value. The bits
-//! do not depend on the thread count or on the parts.
+//! do not depend on the thread count or on the parts. The step's gauge
+//! ([`crate::solver::gauge`]) counts the vertices that have gathered.
 
 use crate::color::Rgb;
 use crate::scene::PolygonId;
@@ -68,6 +69,10 @@ pub(in crate::solver) struct SkyUnderway {
     gathered: Vec<Rgb>,
     rays: u64,
     receivers: u64,
+    /// Vertices that gather themselves, and how many have: the step's
+    /// gauge ([`crate::solver::gauge`]).
+    heads: u64,
+    heads_done: u64,
     /// Parts delivered so far.
     part: u32,
     /// Whether the facets' unshot light has been spent.
@@ -82,6 +87,13 @@ impl<'a> Progressive<'a> {
     fn receives_sky(&self, j: usize) -> bool {
         let pm = &self.mesh.polygons[j];
         !pm.sky && pm.vertex_count() > 0 && !self.reflectance[j].is_black()
+    }
+
+    /// Whether element vertex `l` gathers the sky itself: its polygon
+    /// receives, and it is not a shared receiver's follower.
+    fn gathers_sky(&self, l: usize) -> bool {
+        self.receives_sky(self.mesh.vertex_polygon[l].index())
+            && self.leaders.get(l).is_none_or(|&x| x == ALONE)
     }
 
     /// What the sky's facets hold now, `None` when the sky is shot by
@@ -117,6 +129,7 @@ impl<'a> Progressive<'a> {
         let budget = self.options.part_budget;
         let vertices = self.mesh.vertex_count();
         let mut longest = std::time::Duration::ZERO;
+        self.gauge.set(u.heads_done, u.heads);
         while u.next < vertices {
             if cancel.load(Ordering::Relaxed) {
                 if budget.is_some() {
@@ -141,6 +154,7 @@ impl<'a> Progressive<'a> {
                 return None;
             }
             u.next = chunk.end;
+            self.gauge.set(u.heads_done, u.heads);
             if budget.is_some() {
                 self.apply_sky(&mut u);
             }
@@ -202,6 +216,10 @@ impl<'a> Progressive<'a> {
             gathered: vec![Rgb::BLACK; self.mesh.vertex_count()],
             rays: 0,
             receivers: 0,
+            heads: (0..self.mesh.vertex_count())
+                .filter(|&l| self.gathers_sky(l))
+                .count() as u64,
+            heads_done: 0,
             part: 0,
             spent: false,
             fraction_before: self.last_fraction,
@@ -223,8 +241,7 @@ impl<'a> Progressive<'a> {
         };
         let mesh = &self.mesh;
         let heads: Vec<u32> = vertices
-            .filter(|&l| self.receives_sky(mesh.vertex_polygon[l].index()))
-            .filter(|&l| self.leaders.get(l).is_none_or(|&x| x == ALONE))
+            .filter(|&l| self.gathers_sky(l))
             .map(|l| l as u32)
             .collect();
         let (light, probing, visibility) = (&u.light, self.sky.probing, self.visibility);
@@ -250,6 +267,7 @@ impl<'a> Progressive<'a> {
             u.gathered[l as usize] = e;
             u.rays += rays;
         }
+        u.heads_done += heads.len() as u64;
         true
     }
 

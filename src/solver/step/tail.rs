@@ -515,6 +515,7 @@ impl<'a> Progressive<'a> {
                 }
             }
             u.next = batch_end;
+            self.gauge.set(u.next, u.chunks);
             if budget.is_some_and(|b| start.elapsed() >= b) && u.next < u.chunks {
                 break;
             }
