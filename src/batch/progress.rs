@@ -62,6 +62,8 @@ struct Shown {
     /// the pace is measured from there, not from the step's start (its
     /// set-up and the first chunk's are not the rest's).
     since: Option<(Instant, f64)>,
+    /// Set when the bar is cleared: not redrawn until the next step.
+    cleared: bool,
     /// Set when the bar is dropped: the thread ends.
     done: bool,
 }
@@ -88,6 +90,7 @@ impl Progress {
             began: Instant::now(),
             gauge: None,
             since: None,
+            cleared: false,
             done: false,
         }));
         // Only a bar someone sees is redrawn.
@@ -98,6 +101,9 @@ impl Progress {
                 let mut shown = shown.lock().unwrap_or_else(PoisonError::into_inner);
                 if shown.done {
                     break;
+                }
+                if shown.cleared {
+                    continue;
                 }
                 bar.set_message(shown.message(Instant::now()));
                 bar.tick();
@@ -155,6 +161,7 @@ impl Progress {
         shown.step = report.step + 1;
         shown.began = Instant::now();
         shown.since = None;
+        shown.cleared = false;
     }
 
     /// What the bar says of the time left at unshot fraction `fraction`
@@ -192,8 +199,11 @@ impl Progress {
         self.bar.suspend(|| eprintln!("{line}"));
     }
 
-    /// Removes the bar from the terminal.
+    /// Removes the bar from the terminal (until the next step).
     pub fn clear(&self) {
+        // Under the lock the redrawing thread holds while it draws: it
+        // draws nothing after this.
+        self.shown().cleared = true;
         self.bar.finish_and_clear();
     }
 }
@@ -335,6 +345,7 @@ mod tests {
             began: t0,
             gauge: Some(Arc::clone(&gauge)),
             since: None,
+            cleared: false,
             done: false,
         };
         let at = |ms: u64| t0 + Duration::from_millis(ms);
