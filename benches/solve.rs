@@ -109,14 +109,13 @@ fn bench_sky(c: &mut Criterion) {
         (false, "rtable.sc --sky 1 --without sky-at-once"),
     ] {
         let approximations = Approximations::DEFAULT.with(Heuristic::SkyAtOnce, at_once);
-        let auto = TailOption::Auto;
         bench_one(
             &mut group,
             label,
             &scene,
             approximations,
             DEFAULT_SETTLE,
-            auto,
+            TailOption::Auto,
         );
     }
     group.finish();

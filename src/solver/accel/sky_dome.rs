@@ -264,7 +264,7 @@ impl Hemisphere {
                 for s in 0..k {
                     let (seen, end) = open(self.jittered(c, s));
                     if seen {
-                        sum += light.at(dome, end);
+                        sum += light.at(dome, || end);
                     }
                 }
             }
@@ -314,7 +314,7 @@ impl Hemisphere {
             }
             for s in 0..k {
                 if ask(c, s) {
-                    sum += light.at(dome, dome.end(x, world(self.jittered(c, s))));
+                    sum += light.at(dome, || dome.end(x, world(self.jittered(c, s))));
                 }
             }
         }
@@ -523,12 +523,14 @@ impl SkyLight {
         }
     }
 
-    /// What the open direction ending at `end` brings.
+    /// What an open direction brings; `end()` gives where its ray ends,
+    /// asked only when the facets differ (a uniform sky's direction
+    /// brings the same wherever it ends).
     #[inline]
-    fn at(&self, dome: &Dome, end: Vec3) -> Rgb {
+    fn at(&self, dome: &Dome, end: impl FnOnce() -> Vec3) -> Rgb {
         match self {
             SkyLight::Uniform(v) => *v,
-            SkyLight::PerFacet(v) => v[dome.facet_at(end)],
+            SkyLight::PerFacet(v) => v[dome.facet_at(end())],
         }
     }
 
