@@ -479,11 +479,13 @@ fn a_format_message_lists_only_what_the_option_accepts() {
     assert!(listing(dir.path()).is_empty());
 }
 
-/// `--tail`'s help states the automatic tail's start and mesh size as the
-/// solver's tuning has them, and its refusals name what it takes.
+/// `--tail`'s help states the automatic tail's start, mesh size and early
+/// hand-over as the solver's tuning has them, and its refusals name what it takes.
 #[test]
 fn the_tail_help_quotes_the_tuning() {
-    use radiosity::solver::tuning::{TAIL_AUTO_FROM, TAIL_AUTO_VERTICES};
+    use radiosity::solver::tuning::{
+        TAIL_AUTO_FROM, TAIL_AUTO_VERTICES, TAIL_COSTLY_RATIO, TAIL_EARLY_FROM,
+    };
     let out = run_in(&root(), &["--help"]);
     let help = stdout(&out)
         .split_whitespace()
@@ -499,6 +501,10 @@ fn the_tail_help_quotes_the_tuning() {
     let said =
         format!("turns it on from {TAIL_AUTO_FROM} on meshes of {vertices} element vertices");
     assert!(help.contains(&said), "--help lacks {said:?}");
+    let early = format!(
+        "or from up to {TAIL_EARLY_FROM} right after a shooting step that cost {TAIL_COSTLY_RATIO} times"
+    );
+    assert!(help.contains(&early), "--help lacks {early:?}");
     for bad in ["1.5", "-0.1", "sometimes"] {
         let out = run_in(&root(), &["--tail", bad, "--no-window"]);
         assert_eq!(out.status.code(), Some(2), "--tail {bad}");

@@ -188,6 +188,7 @@ mod tests {
             steps: 42,
             rays: 1 << 40,
             charges: Vec::new(),
+            tail_from: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("solve.ckpt");

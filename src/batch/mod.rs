@@ -955,6 +955,7 @@ fn solve<'p>(
                         }
                     }
                 }
+                progress.set_tail(session.solver().tail_from());
                 progress.step(&report, session.solver().rays());
             }
             Event::Step(_) | Event::Stopped(_) | Event::Cancelled => {}

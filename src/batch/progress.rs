@@ -133,6 +133,13 @@ impl Progress {
         self.shown.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
+    /// The unshot fraction where the particle tail takes over is now
+    /// `tail` (an automatic tail may take over early after a costly
+    /// step: [`crate::solver::step::tail`]).
+    pub fn set_tail(&mut self, tail: Option<f64>) {
+        self.tail = tail;
+    }
+
     /// Shows a finished step; `rays` is every ray cast so far.
     pub fn step(&mut self, report: &StepReport, rays: u64) {
         let elapsed = self.start.elapsed();

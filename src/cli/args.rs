@@ -146,9 +146,12 @@ pub struct Args {
     /// share of each point's light that was left (the fraction over one
     /// minus the reflectance, spread over the model). `auto` (the
     /// default) turns it on from 0.3 on meshes of 100,000 element
-    /// vertices or more; `off` shoots to the end.
-    // The literals are crate::solver::tuning::TAIL_AUTO_FROM and
-    // TAIL_AUTO_VERTICES; a unit test keeps them equal.
+    /// vertices or more, or from up to 0.5 right after a shooting step
+    /// that cost 5 times more rays for its light than the particles
+    /// would; `off` shoots to the end.
+    // The literals are crate::solver::tuning::TAIL_AUTO_FROM,
+    // TAIL_AUTO_VERTICES, TAIL_EARLY_FROM and TAIL_COSTLY_RATIO; a test
+    // keeps them equal.
     #[arg(long, value_name = "F|auto|off", default_value = "auto", value_parser = parse_tail)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) tail: TailOption,

@@ -6,17 +6,19 @@
 //!
 //! A solve's future depends only on its per-vertex radiosity, its unshot
 //! radiosity, the interpolation error charged to each vertex
-//! ([`super::receivers`]), and the fixed inputs (scene, mesh, solver
+//! ([`super::receivers`]), the unshot fraction its particle tail takes
+//! over at (an automatic tail may take over early:
+//! [`super::step::tail`]), and the fixed inputs (scene, mesh, solver
 //! options); the step and ray counters are carried along for the
 //! statistics. Every value is
 //! stored as its exact `f64` bits, so a resumed solve continues bit for bit.
 //!
-//! The file format (version 3), all integers little-endian:
+//! The file format (version 4), all integers little-endian:
 //!
 //! ```text
 //! offset  size        field
 //! 0       8           magic "RADCKPT\0"
-//! 8       4           version (u32) = 3
+//! 8       4           version (u32) = 4
 //! 12      8           fingerprint (u64) of scene + mesh + solver options
 //! 20      8           steps taken (u64)
 //! 28      8           shadow rays cast (u64)
@@ -24,7 +26,8 @@
 //! 44      8           unshot entries U (u64)
 //! 52      8           driver record length X (u64, in bytes)
 //! 60      8           charge entries C (u64, 0 or one per mesh vertex)
-//! 68      24 R        radiosity: r, g, b as f64 bits per vertex
+//! 68      8           tail fraction (f64 bits; NaN when the tail is off)
+//! 76      24 R        radiosity: r, g, b as f64 bits per vertex
 //! ...     24 U        unshot radiosity: r, g, b as f64 bits per entry
 //! ...     24 C        interpolation error charged: r, g, b per vertex
 //! ...     X           the driver's record, opaque here (the batch run keeps
@@ -32,10 +35,11 @@
 //! end-8   8           checksum (u64): FNV-1a of every byte before it
 //! ```
 //!
-//! Version 2 is version 3 without the charges (its header is 60 bytes);
-//! version 1 is version 2 without the record-length field and the record
-//! (its header is 52 bytes). Both are still read, with no charges (and
-//! version 1 with an empty record).
+//! Version 3 is version 4 without the tail fraction (its header is 68
+//! bytes); version 2 is version 3 without the charges (60 bytes); version
+//! 1 is version 2 without the record-length field and the record (52
+//! bytes). All are still read, with the tail as the options set it, with
+//! no charges before version 3 and version 1 with an empty record.
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
 //! materials (those `--emit` changed, and the facets and radiosity of a
@@ -56,13 +60,16 @@ use crate::solver::{FormFactorMethod, ShooterSamples, SolverOptions};
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// The oldest format version this build still reads.
 pub const OLDEST_VERSION: u32 = 1;
 
 /// Bytes before the radiosity data.
-const HEADER_LEN: usize = 68;
+const HEADER_LEN: usize = 76;
+
+/// Bytes before the radiosity data in version 3.
+const V3_HEADER_LEN: usize = 68;
 
 /// Bytes before the radiosity data in version 2.
 const V2_HEADER_LEN: usize = 60;
@@ -105,6 +112,11 @@ pub struct SolverState {
     /// vertex ([`super::receivers::accept`]); empty when none was (a
     /// solve that never interpolated, or a checkpoint before version 3).
     pub charges: Vec<Rgb>,
+    /// The unshot fraction at or below which the particle tail takes
+    /// over, in `[0, 1]`, as the solve last had it (an automatic tail may
+    /// have taken over early); `None` when the tail is off, or the
+    /// checkpoint is older than version 4 (the options then decide).
+    pub tail_from: Option<f64>,
 }
 
 /// Why checkpoint bytes cannot be decoded. The messages read as the end of
@@ -312,26 +324,14 @@ pub struct Checkpoint {
 /// [`crate::solver::Method::state`]), with the driver's `record` (opaque
 /// here).
 pub fn encode(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
-    encode_parts(
-        fingerprint,
-        &state.radiosity,
-        &state.unshot,
-        &state.charges,
-        state.steps,
-        state.rays,
-        record,
-    )
-}
-
-fn encode_parts(
-    fingerprint: u64,
-    radiosity: &[Rgb],
-    unshot: &[Rgb],
-    charges: &[Rgb],
-    steps: u64,
-    rays: u64,
-    record: &[u8],
-) -> Vec<u8> {
+    let SolverState {
+        radiosity,
+        unshot,
+        steps,
+        rays,
+        charges,
+        tail_from,
+    } = state;
     let len = HEADER_LEN
         + RGB_LEN * (radiosity.len() + unshot.len() + charges.len())
         + record.len()
@@ -341,12 +341,13 @@ fn encode_parts(
     out.extend_from_slice(&VERSION.to_le_bytes());
     for w in [
         fingerprint,
-        steps,
-        rays,
+        *steps,
+        *rays,
         radiosity.len() as u64,
         unshot.len() as u64,
         record.len() as u64,
         charges.len() as u64,
+        tail_from.unwrap_or(f64::NAN).to_bits(),
     ] {
         out.extend_from_slice(&w.to_le_bytes());
     }
@@ -364,7 +365,7 @@ fn encode_parts(
 }
 
 /// Reads the fingerprint, state and driver record from checkpoint bytes
-/// (version 1, 2 or 3), or says what is wrong with them. Never allocates more
+/// (version 1 to 4), or says what is wrong with them. Never allocates more
 /// than the input's size.
 pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
@@ -387,6 +388,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     let header_len = match version {
         1 => V1_HEADER_LEN,
         2 => V2_HEADER_LEN,
+        3 => V3_HEADER_LEN,
         _ => HEADER_LEN,
     };
     if bytes.len() < header_len + CHECKSUM_LEN {
@@ -396,6 +398,11 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     let (n_radiosity, n_unshot) = (u64_at(36), u64_at(44));
     let n_record = if version == 1 { 0 } else { u64_at(52) };
     let n_charges = if version <= 2 { 0 } else { u64_at(60) };
+    let tail_from = if version <= 3 {
+        None
+    } else {
+        Some(f64::from_bits(u64_at(68))).filter(|f| !f.is_nan())
+    };
     let expected = n_radiosity
         .checked_add(n_unshot)
         .and_then(|n| n.checked_add(n_charges))
@@ -435,6 +442,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
             steps,
             rays,
             charges: (nr + nu..nr + nu + nc).map(rgb_at).collect(),
+            tail_from,
         },
         record: body[record_start..].to_vec(),
     })
@@ -451,6 +459,7 @@ mod tests {
             steps: 42,
             rays: 1 << 40,
             charges: vec![Rgb::new(0.0, 1e-9, 2.0), Rgb::BLACK],
+            tail_from: Some(0.307),
         }
     }
 
@@ -468,18 +477,20 @@ mod tests {
         assert_eq!(back.radiosity[1].b.to_bits(), 5e-324f64.to_bits());
     }
 
-    /// `state()` without charges, as versions 1 and 2 hold it.
+    /// `state()` without charges or tail fraction, as versions 1 and 2
+    /// hold it.
     fn uncharged() -> SolverState {
         SolverState {
             charges: Vec::new(),
+            tail_from: None,
             ..state()
         }
     }
 
-    /// Version `v` bytes made from version 3 bytes of an uncharged state:
-    /// the header cut to `header` bytes, the record kept or not.
-    fn older(v: u32, header: usize, record: &[u8]) -> Vec<u8> {
-        let v3 = encode(5, &uncharged(), record);
+    /// Version `v` bytes made from version 4 bytes of `state`: the header
+    /// cut to `header` bytes, the record kept or not.
+    fn older_of(state: &SolverState, v: u32, header: usize, record: &[u8]) -> Vec<u8> {
+        let v3 = encode(5, state, record);
         let mut out = v3[..8].to_vec();
         out.extend_from_slice(&v.to_le_bytes());
         out.extend_from_slice(&v3[12..header]);
@@ -495,8 +506,31 @@ mod tests {
         out
     }
 
+    /// [`older_of`] an uncharged state.
+    fn older(v: u32, header: usize, record: &[u8]) -> Vec<u8> {
+        older_of(&uncharged(), v, header, record)
+    }
+
     #[test]
-    fn version_1_and_2_files_still_read() {
+    fn a_tail_that_is_off_round_trips_as_none() {
+        let off = SolverState {
+            tail_from: None,
+            ..state()
+        };
+        assert_eq!(decode(&encode(3, &off, b"")).unwrap().state, off);
+    }
+
+    #[test]
+    fn version_1_2_and_3_files_still_read() {
+        // Version 3 is version 4 without the tail fraction: the options
+        // decide it.
+        let charged = SolverState {
+            tail_from: None,
+            ..state()
+        };
+        let back = decode(&older_of(&state(), 3, V3_HEADER_LEN, b"log")).unwrap();
+        assert_eq!(back.state, charged);
+        assert_eq!(back.record, b"log");
         // Version 1 is version 2 without the record-length field.
         let back = decode(&older(1, V1_HEADER_LEN, b"")).unwrap();
         assert_eq!(back.fingerprint, 5);

@@ -1092,6 +1092,7 @@ impl<'a> Progressive<'a> {
             rays: self.rays + rays,
             // Interpolation on the refined mesh starts with no charges.
             charges: Vec::new(),
+            tail_from: self.tail.from(),
         })
     }
 
@@ -1141,6 +1142,7 @@ impl<'a> Progressive<'a> {
             steps: self.steps,
             rays: self.rays,
             charges: self.charges().to_vec(),
+            tail_from: self.tail.from(),
         }
     }
 
@@ -1157,8 +1159,9 @@ impl<'a> Progressive<'a> {
 
     /// Replaces the solve's state by a saved one from a solve of the same
     /// scene, mesh and options; refuses (and changes nothing) when the
-    /// array sizes differ, a value is not finite, or a radiosity or charge
-    /// is negative.
+    /// array sizes differ, a value is not finite, a radiosity or charge
+    /// is negative, or the tail fraction is outside `[0, 1]`. The saved
+    /// tail fraction is taken only when this solve's tail is on.
     pub fn restore(&mut self, state: checkpoint::SolverState) -> Result<(), SolverError> {
         if state.radiosity.len() != self.radiosity.len()
             || state.unshot.len() != self.unshot.values().len()
@@ -1177,8 +1180,12 @@ impl<'a> Progressive<'a> {
             |c: &Rgb| !c.is_finite() || c.max_channel() > limit || c.min_channel() < -limit;
         if state.radiosity.iter().chain(&state.charges).any(bad)
             || state.unshot.iter().any(bad_unshot)
+            || state.tail_from.is_some_and(|f| !(0.0..=1.0).contains(&f))
         {
             return Err(SolverError::BadStateValue);
+        }
+        if let (Some(from), Some(_)) = (state.tail_from, self.tail.from) {
+            self.tail.from = Some(from);
         }
         self.spent = if state.charges.is_empty() {
             vec![Rgb::BLACK; self.radiosity.len()]

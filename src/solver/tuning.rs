@@ -19,7 +19,7 @@
 //! | gathering from a cluster | `step::gather_cluster`, `accel::cluster` | [`WEAK_STRATUM_SHARE`], [`STRATUM_NEAR_RATIO`], [`PLANE_DEPTH_RATIO`], [`TOP_DEPTH_RATIO`], [`RESTING_NEAR_FACTOR`], [`RESTING_TOLERANCE`] |
 //! | delivering a step in parts | `step::parts` | [`CHUNK_WORK`], [`PIECE_WORK`], [`CHUNK_GROWTH`], [`PIECE_GROWTH`], [`CHUNK_TARGET`], [`NEAR_WEIGHT`], [`WINDOW_PART_BUDGET`] |
 //! | the hemicube | `hemicube` | [`DEFAULT_HEMICUBE_RES`], [`HEMICUBE_EDGE_SLACK`], [`HEMICUBE_NEAR_FRACTION`] |
-//! | the particle tail | `step::tail` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_PART_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
+//! | the particle tail | `step::tail` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_COSTLY_RATIO`], [`TAIL_EARLY_FROM`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_PART_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
 //!
 //! Structural constants (how many ray slots a cluster step keeps, the
 //! sub-cell grid's side, file-format fields) stay with the code whose
@@ -509,6 +509,29 @@ pub const TAIL_AUTO_FROM: f64 = 0.3;
 /// scenes keep their noise-free answers.
 pub const TAIL_AUTO_VERTICES: u64 = 100_000;
 
+/// An automatic tail also takes over before [`TAIL_AUTO_FROM`], at an
+/// unshot fraction of at most [`TAIL_EARLY_FROM`], right after a shooting
+/// step that cast more than this many shadow rays per unit of power it
+/// shot for each particle per unit of power the tail would trace for the
+/// light then left ([`TAIL_PARTICLES_PER_VERTEX`] a vertex over the unshot
+/// power). A particle costs about six such rays (`fortitude.obj`: 4.6 µs
+/// of CPU a particle, 0.7 µs a shooting step's ray), so past 5 shooting
+/// is no cheaper than particles for the light it carries. Measured
+/// (`docs/accuracy.md`, The particle tail): the shooting steps of
+/// `room.glb` and `zdm2.glb` under `--sky 1` cast 0 to 3 times the
+/// tail's rays per unit of power and are unchanged; `fortitude.obj`'s 5
+/// to 8 times, two steps of a quarter of the level in one cluster 69 and
+/// 76 times. At 5 it hands over after its first step (33.5 % left):
+/// 3.76 % off the path tracer in 344 s of CPU, against 4.03 % in 536 s;
+/// at 25, after the 69-times step, 4.28 % in 459 s. `room.glb` lit by a
+/// lamp hands over at 50 %.
+pub const TAIL_COSTLY_RATIO: f64 = 5.0;
+
+/// The highest unshot fraction at which a costly shooting step hands the
+/// light left to an automatic tail ([`TAIL_COSTLY_RATIO`]): above it the
+/// particles would carry much of the light, and their noise with it.
+pub const TAIL_EARLY_FROM: f64 = 0.5;
+
 /// Particles per element vertex the tail traces over four steps, a
 /// quarter each, by default (`--tail-particles`): from 30 %, 16 left `room.glb`'s picture
 /// 3.35 % off the path tracer, 64 1.95 %, 128 1.66 % (measured with
@@ -885,6 +908,16 @@ pub const INDEX: &[Tuned] = &[
         name: "TAIL_AUTO_VERTICES",
         phase: Phase::Tail,
         value: TAIL_AUTO_VERTICES as f64,
+    },
+    Tuned {
+        name: "TAIL_COSTLY_RATIO",
+        phase: Phase::Tail,
+        value: TAIL_COSTLY_RATIO,
+    },
+    Tuned {
+        name: "TAIL_EARLY_FROM",
+        phase: Phase::Tail,
+        value: TAIL_EARLY_FROM,
     },
     Tuned {
         name: "TAIL_PARTICLES_PER_VERTEX",

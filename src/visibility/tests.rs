@@ -204,6 +204,45 @@ fn bvh_agrees_with_brute_force() {
     assert!(blocked > 500 && blocked < 4500, "{blocked}");
 }
 
+/// The nearest hit along a ray (the particle tail's query) is the one
+/// testing every polygon finds.
+#[test]
+fn first_hit_agrees_with_brute_force() {
+    let mut stream = crate::testutil::Xorshift(0x9e37_79b9_7f4a_7c15);
+    let mut rand = move || stream.unit_f32();
+    let polygons: Vec<Polygon> = (0..60)
+        .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
+        .collect();
+    let v_scene = scene(polygons);
+    let v = Visibility::new(&v_scene);
+    let mut hits = 0;
+    for _ in 0..5000 {
+        let origin = Vec3::new(rand() * 6.0, rand() * 6.0, -1.0 + rand() * 12.0);
+        let direction = Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5);
+        let fast = v.first_hit(origin, direction);
+        let ray = Ray::new(
+            origin.into(),
+            without_negative_zeros(direction.normalize_or_zero()).into(),
+            SEGMENT_END_EPSILON,
+            f32::INFINITY,
+        );
+        let nearest = v
+            .blockers
+            .iter()
+            .enumerate()
+            .map(|(p, b)| (p, b.intersect(&ray)))
+            .filter(|(_, t)| t.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        assert_eq!(
+            fast.map(|(_, t)| t),
+            nearest.map(|(_, t)| t),
+            "{origin} along {direction}"
+        );
+        hits += fast.is_some() as u32;
+    }
+    assert!(hits > 500 && hits < 4500, "{hits}");
+}
+
 /// Shaft culling loses no blocker: for segments between random points
 /// of two polygons, testing only the shaft's candidates answers exactly
 /// as testing every polygon.

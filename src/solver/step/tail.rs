@@ -35,6 +35,15 @@
 //! TAIL_STEPS`, so the picture moves between them, and a solve resumed
 //! from a checkpoint takes the same steps).
 //!
+//! An automatic tail also takes over early (at an unshot fraction of at
+//! most [`TAIL_EARLY_FROM`]) after a shooting step that cost more rays
+//! for its light than particles would ([`TAIL_COSTLY_RATIO`],
+//! [`costly`]): on a game level each shooting step after the sky's cost
+//! 5 to 8 times the rays of the particles for the light it carried, one
+//! of a cluster spanning a quarter of the level 69 times. Its levels
+//! then count down from the fraction it took over at, which a
+//! checkpoint keeps.
+//!
 //! Every particle's random numbers come from its own index, and the
 //! particles' deposits are summed in particle order, so the bits do not
 //! depend on the thread count. The brute-force twin is the shooting
@@ -47,8 +56,8 @@ use crate::mesh::Mesh;
 use crate::scene::{PolygonId, Scene};
 use crate::solver::accel::shared::ALONE;
 use crate::solver::tuning::{
-    TAIL_BATCH, TAIL_CHUNK, TAIL_MAX_BOUNCES, TAIL_PARTICLES_PER_VERTEX, TAIL_PART_BATCH,
-    TAIL_STEPS, TAIL_SURVIVAL_MAX,
+    TAIL_BATCH, TAIL_CHUNK, TAIL_COSTLY_RATIO, TAIL_EARLY_FROM, TAIL_MAX_BOUNCES,
+    TAIL_PARTICLES_PER_VERTEX, TAIL_PART_BATCH, TAIL_STEPS, TAIL_SURVIVAL_MAX,
 };
 use crate::solver::unshot::TriangleLocator;
 use crate::solver::{Progressive, StepReport, TailOption};
@@ -65,6 +74,9 @@ pub(in crate::solver) struct Tail {
     /// The unshot fraction at or below which it takes over, `None` when
     /// it is off.
     pub(in crate::solver) from: Option<f64>,
+    /// Whether it is automatic, and so takes over early after a costly
+    /// shooting step ([`Tail::hand_over_if_costly`]).
+    auto: bool,
     /// Particles over the whole tail per element vertex, `> 0`.
     per_vertex: f64,
     /// Particles traced so far.
@@ -99,6 +111,7 @@ impl Tail {
         };
         Tail {
             from,
+            auto: option == TailOption::Auto && from.is_some(),
             per_vertex: if per_vertex.is_finite() && per_vertex > 0.0 {
                 per_vertex
             } else {
@@ -131,6 +144,52 @@ impl Tail {
     pub(in crate::solver) fn from(&self) -> Option<f64> {
         self.from
     }
+
+    /// Test hook: an automatic tail from `from` on any mesh (the option
+    /// turns one on only from [`crate::solver::tuning::TAIL_AUTO_VERTICES`]
+    /// element vertices).
+    #[cfg(test)]
+    pub(in crate::solver) fn automatic_from(&mut self, from: f64) {
+        self.from = Some(from);
+        self.auto = true;
+    }
+
+    /// After a shooting step that cast `rays` shadow rays to shoot `shot`
+    /// of power, leaving `unshot` power at unshot fraction `fraction` on
+    /// a mesh of `vertices` element vertices: whether an automatic tail
+    /// takes over now, before its fraction, because the step was
+    /// [`costly`] and at most [`TAIL_EARLY_FROM`] is left. If so, the
+    /// tail's fraction becomes `fraction`.
+    pub(in crate::solver) fn hand_over_if_costly(
+        &mut self,
+        rays: u64,
+        shot: f64,
+        (unshot, fraction): (f64, f64),
+        vertices: usize,
+    ) -> bool {
+        let due = self.auto
+            && self.from.is_some_and(|from| fraction > from)
+            && fraction <= TAIL_EARLY_FROM
+            && costly(rays, shot, unshot, self.per_vertex * vertices as f64);
+        if due {
+            self.from = Some(fraction);
+        }
+        due
+    }
+}
+
+/// Whether a shooting step that cast `rays` shadow rays for `shot` of
+/// power (either sign) cost more than [`TAIL_COSTLY_RATIO`] times what a
+/// tail of `particles` particles for the `unshot` power left would per
+/// unit of power, counting a particle as a ray: `rays / |shot| >
+/// TAIL_COSTLY_RATIO · particles / unshot`. Powers in radiosity × area
+/// units. A step that shot nothing, or with nothing left, is not.
+pub(in crate::solver) fn costly(rays: u64, shot: f64, unshot: f64, particles: f64) -> bool {
+    let shot = shot.abs();
+    shot > 0.0
+        && unshot > 0.0
+        && particles > 0.0
+        && rays as f64 * unshot > TAIL_COSTLY_RATIO * particles * shot
 }
 
 /// The levels `from · k / TAIL_STEPS` (`k` from `TAIL_STEPS − 1` down to

@@ -197,6 +197,7 @@ fn a_cluster_shot_matches_lambert() {
             steps: 0,
             rays: 0,
             charges: Vec::new(),
+            tail_from: None,
         })
         .unwrap();
     let report = solver.step().unwrap();

@@ -209,6 +209,82 @@ fn a_tail_resumed_from_its_state_ends_as_the_uninterrupted_one() {
     assert_eq!(resumed.radiosity(), whole.radiosity());
 }
 
+/// A step is costly when it cast more than `TAIL_COSTLY_RATIO` times
+/// the tail's particles per unit of power, counting either sign of power
+/// shot; a step that shot nothing, or a solve with nothing left, is not.
+#[test]
+fn a_step_is_costly_past_the_ratio_of_the_tails_particles() {
+    use crate::solver::step::tail::costly;
+    use crate::solver::tuning::TAIL_COSTLY_RATIO;
+    // 1,000 particles for 100 of power left: 10 a unit; a step of 2 of
+    // power is costly past 2 · 10 · ratio rays.
+    let at = (2.0 * 10.0 * TAIL_COSTLY_RATIO) as u64;
+    assert!(!costly(at, 2.0, 100.0, 1000.0));
+    assert!(costly(at + 1, 2.0, 100.0, 1000.0));
+    assert!(costly(at + 1, -2.0, 100.0, 1000.0));
+    assert!(!costly(u64::MAX, 0.0, 100.0, 1000.0));
+    assert!(!costly(u64::MAX, 2.0, 0.0, 1000.0));
+}
+
+/// An automatic tail takes over early after a step that cost far more
+/// rays for its light than the tail's particles would
+/// (`TAIL_COSTLY_RATIO`). In the shadowed room with a tail of few
+/// particles every shooting step is costly: the tail takes over right
+/// after the first step that leaves at most `TAIL_EARLY_FROM`, at that
+/// step's fraction, not at its own 1 %. A solve saved right then and
+/// resumed ends as the uninterrupted one (the state keeps the fraction;
+/// without it the resumed solve would shoot on). A tail whose fraction is
+/// given waits for it.
+#[test]
+fn a_costly_step_hands_the_rest_to_an_automatic_tail() {
+    use crate::solver::tuning::TAIL_EARLY_FROM;
+    let s = shadowed_box();
+    let mesh = regular_mesh(&s, 0.1);
+    let vis = Visibility::new(&s);
+    let options = tail(0.01, 0.05);
+    let automatic = || {
+        let mut solver = Progressive::new(&s, &mesh, &vis, options);
+        solver.tail.automatic_from(0.01);
+        solver
+    };
+    let run = |solver: &mut Progressive| while !solver.is_done() && solver.step().is_some() {};
+    // Up to the step after which the tail takes over.
+    let mut first = automatic();
+    let mut last = None;
+    while first.tail_from() == Some(0.01) {
+        let report = first.step().expect("a step");
+        assert_eq!(report.particles, 0, "a tail step before the hand-over");
+        last = Some(report);
+    }
+    let last = last.unwrap();
+    let from = first.tail_from().unwrap();
+    eprintln!("handed over after step {} at {from}", last.step);
+    assert_eq!(from, last.unshot_fraction);
+    assert!(from > 0.01 && from <= TAIL_EARLY_FROM, "{from}");
+    assert!(first.step().is_some_and(|r| r.particles > 0));
+    // Saved at the hand-over and resumed.
+    let mut whole = automatic();
+    run(&mut whole);
+    let mut saved = automatic();
+    while saved.steps() < last.step {
+        saved.step();
+    }
+    assert_eq!(saved.state().tail_from, Some(from));
+    let mut resumed = automatic();
+    resumed.restore(saved.state()).unwrap();
+    run(&mut resumed);
+    assert_eq!(resumed.steps(), whole.steps());
+    assert_eq!(resumed.radiosity(), whole.radiosity());
+    // Given its fraction, the tail waits for it.
+    let mut given = Progressive::new(&s, &mesh, &vis, options);
+    let mut fraction = 1.0;
+    while let Some(r) = given.step().filter(|r| r.particles == 0) {
+        fraction = r.unshot_fraction;
+    }
+    assert_eq!(given.tail_from(), Some(0.01));
+    assert!(fraction <= 0.01, "{fraction}");
+}
+
 /// A tail step delivered in parts (the window's part budget) ends bit for
 /// bit as the step in one piece; between its parts the solution shows the
 /// light landed so far, rising part by part, and a cancel between parts
