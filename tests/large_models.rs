@@ -917,3 +917,60 @@ fn the_models_readme_quotes_the_small_models() {
     let script = std::fs::read_to_string(root().join("docs/images/render_models.sh")).unwrap();
     assert!(script.contains("--size 480x360") && readme.contains("(480x360;"));
 }
+
+/// `scripts/side_by_side.py`, which builds the quarter-million-triangle
+/// model of `docs/performance.md` from these levels, keeps every face of
+/// each model it is given, keeps their materials apart by a prefix (two
+/// copies, two sets), and places each copy clear of the one before along
+/// `+x`. Skipped where `python3` is missing.
+#[test]
+fn side_by_side_keeps_every_face_and_keeps_the_models_apart() {
+    let python = std::process::Command::new("python3")
+        .arg("--version")
+        .output();
+    if !python.is_ok_and(|o| o.status.success()) {
+        eprintln!("skipped: no python3");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("two.obj");
+    let one = model("mcguire/CornellBox-Original.obj");
+    let ran = std::process::Command::new("python3")
+        .arg(root().join("scripts/side_by_side.py"))
+        .args([&out, &one, &one])
+        .output()
+        .unwrap();
+    assert!(
+        ran.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ran.stderr)
+    );
+    let single = scene::load(&one).unwrap();
+    let both = scene::load(&out).unwrap();
+    let n = single.polygons.len();
+    assert_eq!(both.polygons.len(), 2 * n);
+    assert_eq!(both.materials.len(), 2 * single.materials.len());
+    for (copy, prefix) in [(0, "CornellBox-Original_"), (1, "CornellBox-Original2_")] {
+        for (p, q) in both.polygons[copy * n..(copy + 1) * n]
+            .iter()
+            .zip(&single.polygons)
+        {
+            let name = &both.materials[p.material.index()].name;
+            assert_eq!(
+                *name,
+                format!("{prefix}{}", single.materials[q.material.index()].name)
+            );
+            assert_eq!(p.vertices.len(), q.vertices.len());
+        }
+    }
+    let x_range = |polygons: &[radiosity::scene::Polygon]| {
+        polygons
+            .iter()
+            .flat_map(|p| &p.vertices)
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v.x), hi.max(v.x))
+            })
+    };
+    let (first, second) = (x_range(&both.polygons[..n]), x_range(&both.polygons[n..]));
+    assert!(second.0 > first.1, "{first:?} then {second:?}");
+}
