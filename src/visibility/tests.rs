@@ -168,16 +168,23 @@ fn empty_scene_blocks_nothing() {
     assert!(!v.occluded(Vec3::ZERO, Vec3::ONE, (PolygonId(0), PolygonId(0))));
 }
 
+/// Sixty squares of sides 0.3 to 1.3 scattered over 5 × 5 × 10 scene
+/// units, drawn from `rand`.
+fn scattered_squares(rand: &mut impl FnMut() -> f32) -> Scene {
+    scene(
+        (0..60)
+            .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
+            .collect(),
+    )
+}
+
 /// The BVH answers exactly as testing every triangle does, on a field
 /// of scattered squares and many pseudo-random segments.
 #[test]
 fn bvh_agrees_with_brute_force() {
     let mut stream = crate::testutil::Xorshift(0x2545_f491_4f6c_dd1d);
     let mut rand = move || stream.unit_f32();
-    let polygons: Vec<Polygon> = (0..60)
-        .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
-        .collect();
-    let v_scene = scene(polygons);
+    let v_scene = scattered_squares(&mut rand);
     let v = Visibility::new(&v_scene);
     // The same search built for baseline x86-64, which CPUs without
     // SSE4.2 run (this one may run the other).
@@ -210,10 +217,7 @@ fn bvh_agrees_with_brute_force() {
 fn first_hit_agrees_with_brute_force() {
     let mut stream = crate::testutil::Xorshift(0x9e37_79b9_7f4a_7c15);
     let mut rand = move || stream.unit_f32();
-    let polygons: Vec<Polygon> = (0..60)
-        .map(|_| square(rand() * 10.0, 0.3 + rand(), (rand() * 5.0, rand() * 5.0)))
-        .collect();
-    let v_scene = scene(polygons);
+    let v_scene = scattered_squares(&mut rand);
     let v = Visibility::new(&v_scene);
     let mut hits = 0;
     for _ in 0..5000 {

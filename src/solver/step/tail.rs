@@ -38,7 +38,7 @@
 //! An automatic tail also takes over early (at an unshot fraction of at
 //! most [`TAIL_EARLY_FROM`]) after a shooting step that cost more rays
 //! for its light than particles would ([`TAIL_COSTLY_RATIO`],
-//! [`costly`]): on a game level each shooting step after the sky's cost
+//! `costly`): on a game level each shooting step after the sky's cost
 //! 5 to 8 times the rays of the particles for the light it carried, one
 //! of a cluster spanning a quarter of the level 69 times. Its levels
 //! then count down from the fraction it took over at, which a
