@@ -129,12 +129,16 @@ impl<'a> Progressive<'a> {
         );
         self.last_fraction = report.unshot_fraction;
         // A step that cost far more than particles for the light it shot
-        // hands the rest to an automatic tail.
+        // hands the rest to an automatic tail. The power left is the
+        // fraction's numerator, not summed again over every vertex.
         if self.fault.is_none() {
             self.tail.hand_over_if_costly(
                 u.gathered.rays,
                 u.shot_power,
-                (self.unshot_power(), report.unshot_fraction),
+                (
+                    report.unshot_fraction * self.initial_unshot_power,
+                    report.unshot_fraction,
+                ),
                 self.mesh.vertex_count(),
             );
         }
