@@ -515,3 +515,17 @@ fn the_tail_help_quotes_the_tuning() {
         );
     }
 }
+
+/// `--inset`'s help states how much farther in a one-element polygon's
+/// corners are evaluated, as the mesher has it.
+#[test]
+fn the_inset_help_quotes_the_one_element_factor() {
+    use radiosity::mesh::ONE_ELEMENT_INSET;
+    let out = run_in(&root(), &["--help"]);
+    let help = stdout(&out)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let said = format!("has its corners evaluated {ONE_ELEMENT_INSET} times as far in");
+    assert!(help.contains(&said), "--help lacks {said:?}");
+}

@@ -86,7 +86,9 @@ pub struct Args {
     /// Inset of boundary vertices, as a fraction of lenmax.
     ///
     /// Boundary vertices are evaluated this far inside their polygon, so
-    /// room corners do not come out dark; 0 disables it.
+    /// room corners do not come out dark; 0 disables it. A polygon that
+    /// is a single element has its corners evaluated 3 times as far in,
+    /// at most half the way across it.
     #[arg(long, value_name = "F", default_value_t = DEFAULT_INSET, value_parser = parse_number::<f32>)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) inset: f32,

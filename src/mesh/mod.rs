@@ -41,6 +41,18 @@
 //! across the polygon ([`INSET_CLAMP`]). (A sliver's own size would not
 //! do: its shortest edge is a hair, and its vertices at a wall's foot
 //! would be evaluated in the corner itself.)
+//!
+//! A polygon that is one element moves its corners [`ONE_ELEMENT_INSET`]
+//! times as far ([`sample_inset`]). Its corners are its only samples, and the picture spreads each one's
+//! value linearly over the whole polygon: evaluated near a corner where
+//! the polygon meets a wall or a floor (a game level's block, the step
+//! of a ledge), the dark of that corner became a wedge across the
+//! polygon. Farther in, a corner's value stands more for the part of the
+//! polygon it is spread over (its hat, whose centroid lies halfway along
+//! the median from that corner). Vertices that stitching then puts on
+//! its edges, where a neighbour's finer mesh meets it, keep the polygon's
+//! own inset ([`PolygonMesh::inset`]), as do all its vertices once
+//! refinement splits it.
 
 use crate::budget::fmt_bytes;
 use crate::cancel::Cancel;
@@ -64,6 +76,21 @@ pub use handle::MeshRef;
 /// percent moves the sample far above `f32` rounding yet leaves it inside
 /// its elements.
 pub const DEFAULT_INSET: f32 = 0.05;
+
+/// How many times as far inside a polygon that is a single element its
+/// boundary vertices are evaluated as those of a polygon of many
+/// elements (see the module docs): the inset `inset × min(lenmax,
+/// diameter)` times this, still at most half the way across. Measured
+/// against the path-traced references of `docs/performance.md` (its
+/// cameras, `--sky 1`, default options): 1 (the same inset for all)
+/// left `pandora.obj` 5.21 % off, `fortitude.obj` 3.76 %, `zdm2.glb`
+/// 3.24 %, `zdm2.obj` 2.81 %; 3 gives 4.47 %, 3.42 %, 3.13 %, 2.71 %
+/// (`room.glb` and the vianney house within 0.01 % of before); 5 gave
+/// `pandora.obj` 4.75 % and `zdm2.obj` 2.89 %. Tripling the inset of
+/// every polygon instead made `zdm2.obj` worse (3.12 %): on a wall of
+/// many elements a boundary vertex stands for a strip one element wide,
+/// and its neighbours are near.
+pub const ONE_ELEMENT_INSET: f32 = 3.0;
 
 /// Default `lenmax` as a fraction of the scene's bounding-box diagonal,
 /// when its mesh is within the vertex budget ([`budget`]). For `rtable`
@@ -159,8 +186,10 @@ pub struct PolygonMesh {
     /// Length of its shortest element edge, in scene units.
     pub min_edge: f32,
     /// Distance its boundary vertices' evaluation points are moved inward
-    /// ([`Mesh::sample_positions`]), in scene units; refinement moves new
-    /// boundary vertices by the same distance.
+    /// ([`Mesh::sample_positions`]), in scene units: `inset × min(lenmax,
+    /// diameter)`; stitching and refinement move new boundary vertices by
+    /// the same distance. The corners of a polygon meshed as one element
+    /// move [`ONE_ELEMENT_INSET`] times as far ([`sample_inset`]).
     pub inset: f32,
     /// Adaptive refinement passes that split some of its elements (see
     /// [`refine`]); 0 for the regular subdivision of [`build`], whose
@@ -189,6 +218,17 @@ impl PolygonMesh {
     /// Number of element vertices of this polygon.
     pub fn vertex_count(&self) -> u32 {
         self.vertices.end - self.vertices.start
+    }
+}
+
+/// The distance the corners of a polygon meshed as `elements` elements
+/// are evaluated inside it, given its `inset` distance
+/// ([`PolygonMesh::inset`]), in scene units (see the module docs).
+pub fn sample_inset(inset: f32, elements: usize) -> f32 {
+    if elements == 1 {
+        inset * ONE_ELEMENT_INSET
+    } else {
+        inset
     }
 }
 
@@ -581,10 +621,11 @@ fn build_unstitched(
         let scale = options
             .lenmax
             .min(crate::scene::polygon_extent_f32(&polygon.vertices));
+        let elements = mesh.elements.len() - e_start as usize;
         mesh.sample_positions.extend(inset_positions(
             polygon,
             &mesh.positions[v_start as usize..],
-            options.inset * scale,
+            sample_inset(options.inset * scale, elements),
         ));
         mesh.polygons.push(PolygonMesh {
             nu,

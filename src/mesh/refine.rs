@@ -31,7 +31,9 @@
 //! New vertices are the midpoints of their straight edges (and the centre of
 //! a quadrilateral is the mean of its corners, which is the bilinear patch's
 //! centre), so they lie exactly on the polygon. A new vertex on the polygon's
-//! boundary gets the same inset as the polygon's other boundary vertices.
+//! boundary gets the same inset as the polygon's other boundary vertices
+//! ([`PolygonMesh::inset`]; the corners of a polygon left one element keep
+//! their farther one, [`super::sample_inset`]).
 
 use super::stitch::Origin;
 use super::{inset_positions, Element, Mesh, PolygonMesh, VertexId};
@@ -616,11 +618,6 @@ impl Refiner {
                 mesh.positions.push(self.positions[v as usize]);
                 mesh.vertex_polygon.push(id);
             }
-            mesh.sample_positions.extend(inset_positions(
-                polygon,
-                &mesh.positions[v_start as usize..],
-                initial.inset,
-            ));
             let e_start = mesh.elements.len() as u32;
             let at = |v: u32| VertexId(pool_to_mesh[v as usize]);
             for &k in &leaves_of[p] {
@@ -669,6 +666,24 @@ impl Refiner {
             pm.vertices = v_start..mesh.positions.len() as u32;
             pm.elements = e_start..mesh.elements.len() as u32;
             pm.min_edge = min_edge(&mesh, &pm).unwrap_or(initial.min_edge);
+            mesh.sample_positions.extend(inset_positions(
+                polygon,
+                &mesh.positions[v_start as usize..],
+                initial.inset,
+            ));
+            // A polygon still one element (one leaf, never split) keeps its
+            // corners' farther inset (`super::sample_inset`); vertices
+            // stitched into its edges keep the polygon's own.
+            if let [k] = leaves_of[p][..] {
+                let leaf = self.leaves[k];
+                let far = super::sample_inset(initial.inset, 1);
+                for &c in &leaf.corners[..leaf.len as usize] {
+                    let l = pool_to_mesh[c as usize] as usize;
+                    let at = mesh.positions[l];
+                    mesh.sample_positions[l] =
+                        inset_positions(polygon, &[at], far).next().unwrap_or(at);
+                }
+            }
             mesh.polygons.push(pm);
         }
         (mesh, fans)

@@ -216,6 +216,35 @@ fn inset_moves_boundary_vertices_inward_only() {
     assert!((m.sample_positions[0] - Vec3::new(d, d, 0.0)).length() < 1e-6);
 }
 
+/// A polygon meshed as one element has its corners evaluated
+/// [`ONE_ELEMENT_INSET`] times as far in as the boundary vertices of the
+/// same polygon meshed as many.
+#[test]
+fn a_one_element_polygons_corners_are_evaluated_farther_in() {
+    let s = scene(vec![all_shapes().remove(0)]);
+    // lenmax 4 is longer than the 2 × 1 polygon: one element, its scale
+    // the polygon's diameter.
+    let one = build(&s, &opts(4.0, 0.05)).unwrap();
+    assert_eq!(one.polygons[0].elements.len(), 1);
+    let d = 0.05 * 5f32.sqrt();
+    assert!((one.polygons[0].inset - d).abs() < 1e-6);
+    let far = ONE_ELEMENT_INSET * d;
+    for (p, q) in one.positions.iter().zip(&one.sample_positions) {
+        let expect = Vec3::new(
+            if p.x == 0.0 { far } else { -far },
+            if p.y == 0.0 { far } else { -far },
+            0.0,
+        );
+        assert!((*q - *p - expect).length() < 1e-5, "{p} -> {q}");
+    }
+    // Many elements: every boundary vertex a twentieth of lenmax in.
+    let many = build(&s, &opts(0.5, 0.05)).unwrap();
+    assert!(many.polygons[0].elements.len() > 1);
+    assert!((many.sample_positions[0] - Vec3::new(0.025, 0.025, 0.0)).length() < 1e-6);
+    assert_eq!(sample_inset(d, 2), d);
+    assert_eq!(sample_inset(d, 1), ONE_ELEMENT_INSET * d);
+}
+
 #[test]
 fn zero_inset_leaves_samples_on_the_vertices() {
     let m = build(&scene(all_shapes()), &opts(0.3, 0.0)).unwrap();

@@ -306,3 +306,64 @@ fn dark_noise_is_not_refined() {
         .refine(&scene, &values, &RefineOptions::default())
         .is_none());
 }
+
+/// A polygon meshed as one element has its corners evaluated farther in
+/// ([`crate::mesh::sample_inset`]). Refined into many elements, every
+/// boundary vertex, old or new, takes the polygon's own inset; a
+/// one-element polygon refinement leaves alone keeps its corners' samples.
+#[test]
+fn a_refined_one_element_polygon_takes_the_inset_of_many() {
+    let mut shapes = crate::mesh::tests::all_shapes();
+    // The 2 × 1 parallelogram at z = 0 and the triangle at z = 2.
+    let scene = testutil::scene(
+        vec![shapes.remove(0), shapes.remove(1)],
+        vec![testutil::grey("m", 0.0, 0.5)],
+    );
+    let mesh = build(
+        &scene,
+        &MeshOptions {
+            lenmax: 4.0,
+            inset: 0.05,
+        },
+    )
+    .unwrap();
+    for pm in &mesh.polygons {
+        assert_eq!(pm.elements.len(), 1);
+    }
+    let pm = &mesh.polygons[0];
+    let far = crate::mesh::sample_inset(pm.inset, 1);
+    assert!(far > pm.inset);
+    assert!((mesh.sample_positions[0].y - far).abs() < 1e-6);
+    // A step across the parallelogram only.
+    let values: Vec<f64> = mesh
+        .positions
+        .iter()
+        .map(|p| if p.z == 0.0 && p.x < 0.63 { 0.1 } else { 1.0 })
+        .collect();
+    let mut refiner = Refiner::new(&mesh);
+    let (refined, _) = refiner
+        .refine(&scene, &values, &RefineOptions::default())
+        .unwrap();
+    let pm = &refined.polygons[0];
+    assert!(pm.elements.len() > 1);
+    let mut boundary = 0;
+    for v in pm.vertices.clone() {
+        let (p, s) = (
+            refined.positions[v as usize],
+            refined.sample_positions[v as usize],
+        );
+        if p.y == 0.0 {
+            boundary += 1;
+            assert!((s.y - pm.inset).abs() < 1e-6, "{p} evaluated at {s}");
+        }
+    }
+    assert!(boundary >= 3, "{boundary}");
+    let (before, after) = (&mesh.polygons[1], &refined.polygons[1]);
+    assert_eq!(after.elements.len(), 1);
+    for (v, w) in before.vertices.clone().zip(after.vertices.clone()) {
+        assert_eq!(
+            mesh.sample_positions[v as usize],
+            refined.sample_positions[w as usize]
+        );
+    }
+}
