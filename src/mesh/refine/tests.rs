@@ -29,6 +29,24 @@ fn step(mesh: &Mesh) -> Vec<f64> {
         .collect()
 }
 
+/// Checks that every vertex of polygon `p` on its edge `y = 0` is
+/// evaluated the polygon's inset inside it; returns how many there are.
+fn inset_along_y0(mesh: &Mesh, p: usize) -> usize {
+    let pm = &mesh.polygons[p];
+    let mut boundary = 0;
+    for v in pm.vertices.clone() {
+        let (at, s) = (
+            mesh.positions[v as usize],
+            mesh.sample_positions[v as usize],
+        );
+        if at.y == 0.0 {
+            boundary += 1;
+            assert!((s.y - pm.inset).abs() < 1e-6, "{at} evaluated at {s}");
+        }
+    }
+    boundary
+}
+
 /// No vertex of a polygon lies inside an edge of one of its elements
 /// (a T-vertex), and the elements tile the polygon without overlap.
 fn assert_conforming(scene: &Scene, mesh: &Mesh) {
@@ -228,18 +246,7 @@ fn untouched_polygons_keep_their_mesh_and_new_boundary_vertices_are_inset() {
     }
     // New vertices on the first polygon's edge y = 0 are evaluated
     // inside it, as far in as the old ones.
-    let pm = &refined.polygons[0];
-    let mut boundary = 0;
-    for v in pm.vertices.clone() {
-        let (p, s) = (
-            refined.positions[v as usize],
-            refined.sample_positions[v as usize],
-        );
-        if p.y == 0.0 {
-            boundary += 1;
-            assert!((s.y - pm.inset).abs() < 1e-6, "{p} evaluated at {s}");
-        }
-    }
+    let boundary = inset_along_y0(&refined, 0);
     assert!(boundary > mesh.polygons[0].nu as usize + 1);
 }
 
@@ -344,19 +351,8 @@ fn a_refined_one_element_polygon_takes_the_inset_of_many() {
     let (refined, _) = refiner
         .refine(&scene, &values, &RefineOptions::default())
         .unwrap();
-    let pm = &refined.polygons[0];
-    assert!(pm.elements.len() > 1);
-    let mut boundary = 0;
-    for v in pm.vertices.clone() {
-        let (p, s) = (
-            refined.positions[v as usize],
-            refined.sample_positions[v as usize],
-        );
-        if p.y == 0.0 {
-            boundary += 1;
-            assert!((s.y - pm.inset).abs() < 1e-6, "{p} evaluated at {s}");
-        }
-    }
+    assert!(refined.polygons[0].elements.len() > 1);
+    let boundary = inset_along_y0(&refined, 0);
     assert!(boundary >= 3, "{boundary}");
     let (before, after) = (&mesh.polygons[1], &refined.polygons[1]);
     assert_eq!(after.elements.len(), 1);
