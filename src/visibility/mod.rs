@@ -178,15 +178,10 @@ impl Visibility {
                 }
             })
             .collect();
-        // The slowest build's tree: a sky step's rays through it took
-        // 4 to 7 % less CPU than through the medium build's (`room.glb`
-        // 36.3 s against 38.2 to 39.0 s, `fortitude.obj` 222 s against
-        // 232 s), for a build of 0.19 s instead of 0.08 s at 64,000
-        // polygons.
         let bvh = (!blockers.is_empty()).then(|| {
             build_cwbvh(
                 &blockers,
-                BvhBuildParams::very_slow_build(),
+                BvhBuildParams::medium_build(),
                 &mut Duration::default(),
             )
         });
