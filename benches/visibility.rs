@@ -5,6 +5,10 @@
 //! element vertices of the mesh, fixed by a seed. And the plane classes
 //! the visibility tests skip by, on floors of 2,500 to 40,000 coplanar
 //! tiles (issue: compared pair by pair, 20,000 tiles took minutes).
+//! And the rays of a sky's step on a real game level,
+//! `tests/models/redeclipse/fortitude.obj` (106,000 polygons): from the
+//! middle of random polygons out along cosine-weighted directions to
+//! beyond the level, most of which cross it whole.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
@@ -130,5 +134,69 @@ fn bench_plane_classes(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_visibility, bench_plane_classes);
+/// Segments from the middle of random polygons of `scene` along
+/// cosine-weighted directions about their normals, to twice the scene's
+/// extent away, with the polygon as both ends (as the sky's step asks).
+fn sky_segments(scene: &Scene) -> Vec<(Vec3, Vec3, (PolygonId, PolygonId))> {
+    let mut seed = 0x0dd5_ca1e_5eed_0042u64;
+    let mut unit = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let reach = 2.0 * scene.extent();
+    (0..SEGMENTS)
+        .map(|_| {
+            let j = ((unit() * scene.polygons.len() as f32) as usize).min(scene.polygons.len() - 1);
+            let p = &scene.polygons[j];
+            let middle = p.vertices.iter().sum::<Vec3>() / p.vertices.len() as f32;
+            // Malley: a uniform point of the disc lifted onto the hemisphere.
+            let (r, phi) = (unit().sqrt(), std::f32::consts::TAU * unit());
+            let local = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - r * r).max(0.0).sqrt());
+            let n = p.normal.normalize();
+            let (t, b) = n.any_orthonormal_pair();
+            let d = t * local.x + b * local.y + n * local.z;
+            (
+                middle,
+                middle + d * reach,
+                (PolygonId(j as u32), PolygonId(j as u32)),
+            )
+        })
+        .collect()
+}
+
+fn bench_level_rays(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models/redeclipse/fortitude.obj");
+    let level = scene::load(&path).expect("fortitude.obj");
+    let vis = Visibility::new(&level);
+    let segs = sky_segments(&level);
+    let blocked = segs
+        .iter()
+        .filter(|(a, b, e)| vis.occluded(*a, *b, *e))
+        .count();
+    eprintln!(
+        "fortitude.obj: {} polygons, {:.1} % of the sky rays blocked",
+        level.polygons.len(),
+        100.0 * blocked as f64 / SEGMENTS as f64
+    );
+    let mut group = c.benchmark_group("sky rays");
+    group.throughput(Throughput::Elements(SEGMENTS as u64));
+    group.sample_size(20);
+    group.bench_function("fortitude.obj/bvh", |bch| {
+        bch.iter(|| {
+            segs.iter()
+                .filter(|(a, b, e)| vis.occluded(*a, *b, *e))
+                .count()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_visibility,
+    bench_plane_classes,
+    bench_level_rays
+);
 criterion_main!(benches);

@@ -10,11 +10,14 @@
 //! intersected whole (plane, then inside every edge), not as triangles: a
 //! ray through the diagonal between two triangles of a split quad can slip
 //! between them, and symmetric scenes put vertices exactly below such
-//! diagonals. The two polygons a segment joins are never counted as
+//! diagonals. A polygon's ray test is laid out in the BVH's leaf order
+//! (`ray_polygons.rs`), so a leaf's polygons are neighbours in memory.
+//! The two polygons a segment joins are never counted as
 //! blockers: a segment from a receiver vertex to a shooter sample touches
 //! both.
 
 mod query;
+mod ray_polygons;
 pub mod shaft;
 
 pub use query::ShadowQuery;
@@ -28,6 +31,7 @@ use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::Ray;
 use obvhs::{Boundable, BvhBuildParams};
+use ray_polygons::{RayPolygon, RayPolygonParts, RayPolygons};
 use shaft::Shaft;
 use std::ops::ControlFlow;
 use std::time::Duration;
@@ -78,16 +82,13 @@ pub type CandidateRun = (std::ops::Range<u32>, (DVec3, DVec3));
 #[derive(Clone, Copy, Debug, Default)]
 pub struct LastBlocker(Option<u32>);
 
-/// A polygon prepared for ray tests.
+/// A polygon prepared for the BVHs and the shaft tests (its ray test is
+/// in [`RayPolygons`]).
 struct Blocker {
     /// First vertex (a point of the plane).
     origin: Vec3A,
     /// Unit normal.
     normal: Vec3A,
-    /// Per edge: its start and its unit in-plane inward normal.
-    edges: Vec<(Vec3A, Vec3A)>,
-    /// How far outside an edge still counts as inside, in scene units.
-    tolerance: f32,
     /// Padded bounds.
     bounds: Aabb,
     /// Its vertices, for shaft tests.
@@ -102,34 +103,16 @@ impl Boundable for Blocker {
     }
 }
 
-impl Blocker {
-    /// `t` of the hit in `ray.tmin..=ray.tmax`, or infinity.
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> f32 {
-        let denom = self.normal.dot(ray.direction);
-        if denom == 0.0 {
-            return f32::INFINITY;
-        }
-        let t = self.normal.dot(self.origin - ray.origin) / denom;
-        if !(t >= ray.tmin && t <= ray.tmax) {
-            return f32::INFINITY;
-        }
-        let p = ray.origin + t * ray.direction;
-        for &(start, inward) in &self.edges {
-            if inward.dot(p - start) < -self.tolerance {
-                return f32::INFINITY;
-            }
-        }
-        t
-    }
-}
-
 /// The scene's polygons in two BVHs: a compressed wide one for rays and a
 /// binary one for shaft queries.
 pub struct Visibility {
     bvh: Option<CwBvh>,
     regions: Option<Bvh2>,
     blockers: Vec<Blocker>,
+    /// The ray tests, in the order of `bvh`'s primitives.
+    rays: RayPolygons,
+    /// The ray tests, slot `p` polygon `p`.
+    rays_by_polygon: RayPolygons,
     /// Per polygon, its plane's number ([`scene::plane_classes`]): a
     /// polygon never blocks a segment from or to a polygon in its plane.
     planes: Vec<u32>,
@@ -144,10 +127,13 @@ impl Visibility {
     /// Builds the BVH over every polygon of `scene`.
     pub fn new(scene: &Scene) -> Self {
         let pad = BOX_PADDING * scene.extent().max(f32::MIN_POSITIVE);
-        let blockers: Vec<Blocker> = scene
+        let planes = scene::plane_classes(scene);
+        let (blockers, parts): (Vec<Blocker>, Vec<RayPolygonParts>) = scene
             .polygons
             .iter()
-            .map(|p| {
+            .enumerate()
+            .map(|(i, p)| {
+                let plane = planes.get(i).copied().unwrap_or(i as u32);
                 let v: Vec<Vec3A> = p.vertices.iter().map(|&v| v.into()).collect();
                 let normal = Vec3A::from(p.normal);
                 let mut bounds = Aabb::from_points(&v);
@@ -167,17 +153,23 @@ impl Visibility {
                     .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
                         (lo.min(v), hi.max(v))
                     });
-                Blocker {
+                let blocker = Blocker {
                     origin: v[0],
                     normal,
-                    edges,
-                    tolerance: EDGE_TOLERANCE * extent,
                     bounds,
                     vertices,
                     exact_bounds,
-                }
+                };
+                let part = RayPolygonParts {
+                    origin: v[0],
+                    normal,
+                    plane,
+                    tolerance: EDGE_TOLERANCE * extent,
+                    edges,
+                };
+                (blocker, part)
             })
-            .collect();
+            .unzip();
         let bvh = (!blockers.is_empty()).then(|| {
             build_cwbvh(
                 &blockers,
@@ -192,11 +184,18 @@ impl Visibility {
                 &mut Duration::default(),
             )
         });
+        let rays = RayPolygons::new(
+            &parts,
+            bvh.as_ref().map_or(&[], |b| b.primitive_indices.as_slice()),
+        );
+        let rays_by_polygon = RayPolygons::new(&parts, &[]);
         Visibility {
             bvh,
             regions,
             blockers,
-            planes: scene::plane_classes(scene),
+            rays,
+            rays_by_polygon,
+            planes,
             shaft_tolerance: SHAFT_TOLERANCE * f64::from(scene.extent()),
             plane_side_tolerance: PLANE_SIDE_TOLERANCE * f64::from(scene.extent()),
             #[cfg(target_arch = "x86_64")]
@@ -485,11 +484,7 @@ impl Visibility {
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        let hits = |p: u32| {
-            self.blockers
-                .get(p as usize)
-                .is_some_and(|blocker| blocker.intersect(&ray).is_finite())
-        };
+        let hits = |p: u32| self.hits(p, &ray);
         if last.0.is_some_and(hits) {
             return true;
         }
@@ -528,16 +523,14 @@ impl Visibility {
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        if self.last_blocks(last, &ray, ends) {
+        let planes = self.end_planes(ends);
+        if last.0.is_some_and(|p| self.blocks(p, &ray, ends, planes)) {
             return true;
         }
-        let found = candidates.iter().copied().find(|&p| {
-            !self.in_plane_of(p, ends)
-                && self
-                    .blockers
-                    .get(p as usize)
-                    .is_some_and(|blocker| blocker.intersect(&ray).is_finite())
-        });
+        let found = candidates
+            .iter()
+            .copied()
+            .find(|&p| self.blocks(p, &ray, ends, planes));
         if found.is_some() {
             last.0 = found;
         }
@@ -549,9 +542,48 @@ impl Visibility {
     /// it only at its end, so it never blocks.
     #[inline]
     fn in_plane_of(&self, p: u32, ends: (PolygonId, PolygonId)) -> bool {
-        let plane = |q: PolygonId| self.planes.get(q.index()).copied().unwrap_or(q.0);
         let own = self.planes.get(p as usize).copied().unwrap_or(p);
-        p == ends.0 .0 || p == ends.1 .0 || own == plane(ends.0) || own == plane(ends.1)
+        let (a, b) = self.end_planes(ends);
+        p == ends.0 .0 || p == ends.1 .0 || own == a || own == b
+    }
+
+    /// Whether polygon `p` crosses `ray` (false for an index out of
+    /// range).
+    #[inline]
+    fn hits(&self, p: u32, ray: &Ray) -> bool {
+        let by_polygon = &self.rays_by_polygon;
+        by_polygon
+            .get(p)
+            .is_some_and(|e| by_polygon.intersect(e, ray).is_finite())
+    }
+
+    /// Whether polygon `p` crosses `ray` and is neither one of `ends` nor
+    /// in the plane of one (their classes `planes`, from
+    /// [`Visibility::end_planes`]); false for an index out of range.
+    #[inline]
+    fn blocks(&self, p: u32, ray: &Ray, ends: (PolygonId, PolygonId), planes: (u32, u32)) -> bool {
+        let by_polygon = &self.rays_by_polygon;
+        by_polygon.get(p).is_some_and(|e| {
+            !Self::entry_in_plane_of(e, ends, planes) && by_polygon.intersect(e, ray).is_finite()
+        })
+    }
+
+    /// [`Visibility::in_plane_of`] for a ray test, given the plane classes
+    /// `planes` of `ends` (looked up once per ray).
+    #[inline(always)]
+    fn entry_in_plane_of(e: &RayPolygon, ends: (PolygonId, PolygonId), planes: (u32, u32)) -> bool {
+        e.polygon == ends.0 .0
+            || e.polygon == ends.1 .0
+            || e.plane == planes.0
+            || e.plane == planes.1
+    }
+
+    /// The plane classes of `ends`, as [`Visibility::in_plane_of`] reads
+    /// them (a polygon out of range is its own class).
+    #[inline]
+    fn end_planes(&self, ends: (PolygonId, PolygonId)) -> (u32, u32) {
+        let plane = |q: PolygonId| self.planes.get(q.index()).copied().unwrap_or(q.0);
+        (plane(ends.0), plane(ends.1))
     }
 
     /// True when polygons `a` and `b` lie in one plane
@@ -642,6 +674,7 @@ impl Visibility {
         let mut state = bvh.new_traversal(ray.direction);
         let mut node;
         let mut found = None;
+        let planes = self.end_planes(ends);
         'search: {
             obvhs::traverse!(
                 bvh,
@@ -649,11 +682,11 @@ impl Visibility {
                 state,
                 node.intersect_ray(&ray, state.oct_inv4),
                 {
-                    let p = bvh.primitive_indices[state.primitive_id as usize];
-                    if !self.in_plane_of(p, ends)
-                        && self.blockers[p as usize].intersect(&ray) < ray.tmax
+                    let e = self.rays.at_slot(state.primitive_id);
+                    if !Self::entry_in_plane_of(e, ends, planes)
+                        && self.rays.intersect(e, &ray) < ray.tmax
                     {
-                        found = Some(p);
+                        found = Some(e.polygon);
                         break 'search;
                     }
                 }
@@ -669,13 +702,8 @@ impl Visibility {
     /// block a segment joining `ends`.
     #[inline]
     fn last_blocks(&self, last: &LastBlocker, ray: &Ray, ends: (PolygonId, PolygonId)) -> bool {
-        last.0.is_some_and(|p| {
-            !self.in_plane_of(p, ends)
-                && self
-                    .blockers
-                    .get(p as usize)
-                    .is_some_and(|blocker| blocker.intersect(ray).is_finite())
-        })
+        let planes = self.end_planes(ends);
+        last.0.is_some_and(|p| self.blocks(p, ray, ends, planes))
     }
 
     /// The nearest polygon that the ray from `origin` along `direction`
@@ -696,11 +724,11 @@ impl Visibility {
         );
         let mut hit = obvhs::ray::RayHit::none();
         bvh.ray_traverse(ray, &mut hit, |ray, id| {
-            self.blockers[bvh.primitive_indices[id] as usize].intersect(ray)
+            self.rays.intersect(self.rays.at_slot(id as u32), ray)
         })
         .then(|| {
             (
-                PolygonId(bvh.primitive_indices[hit.primitive_id as usize]),
+                PolygonId(self.rays.at_slot(hit.primitive_id).polygon),
                 hit.t,
             )
         })
@@ -712,9 +740,8 @@ impl Visibility {
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        self.blockers.iter().enumerate().any(|(p, blocker)| {
-            !self.in_plane_of(p as u32, ends) && blocker.intersect(&ray).is_finite()
-        })
+        let planes = self.end_planes(ends);
+        (0..self.blockers.len() as u32).any(|p| self.blocks(p, &ray, ends, planes))
     }
 }
 

@@ -230,11 +230,14 @@ fn first_hit_agrees_with_brute_force() {
             SEGMENT_END_EPSILON,
             f32::INFINITY,
         );
-        let nearest = v
-            .blockers
-            .iter()
-            .enumerate()
-            .map(|(p, b)| (p, b.intersect(&ray)))
+        let nearest = (0..v.polygon_count())
+            .map(|p| {
+                let by_polygon = &v.rays_by_polygon;
+                (
+                    p,
+                    by_polygon.intersect(by_polygon.get(p as u32).unwrap(), &ray),
+                )
+            })
             .filter(|(_, t)| t.is_finite())
             .min_by(|a, b| a.1.total_cmp(&b.1));
         assert_eq!(
