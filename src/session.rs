@@ -154,6 +154,10 @@ pub struct Session<'p> {
     options: SessionOptions,
     /// The refiner and its options with the element limit applied.
     refiner: Option<(Refiner, RefineOptions)>,
+    /// A refined mesh whose carry-over gather an interrupt stopped
+    /// ([`Method::refined_state`]): the next [`Session::advance`] gathers
+    /// on it again rather than refine a second time.
+    pending: Option<(Mesh, RefineReport)>,
     solver: Box<dyn Method<'p> + 'p>,
     phase: Phase,
     passes: Vec<PassStats>,
@@ -197,6 +201,7 @@ impl<'p> Session<'p> {
             visibility,
             options,
             refiner,
+            pending: None,
             solver,
             phase: Phase::Solving,
             passes: Vec::new(),
@@ -238,7 +243,7 @@ impl<'p> Session<'p> {
     pub fn advance(&mut self, cancel: &AtomicBool) -> Result<Event, SolverError> {
         match self.phase {
             Phase::Finished => Ok(Event::Finished),
-            Phase::Stopped(reason) => self.refine_or_finish(reason),
+            Phase::Stopped(reason) => self.refine_or_finish(reason, cancel),
             Phase::Solving => {
                 if let Some(reason) = self.solver.stop_reason() {
                     self.phase = Phase::Stopped(reason);
@@ -281,25 +286,43 @@ impl<'p> Session<'p> {
     /// the session. A pass cut short by the step limit is not refined
     /// (that would mark what is merely unfinished); nor one after the
     /// allowed levels, nor one whose refinement would pass the element
-    /// limit.
-    fn refine_or_finish(&mut self, reason: StopReason) -> Result<Event, SolverError> {
+    /// limit. The gather that carries the solution over to the refined
+    /// mesh stops once `cancel` is set: this returns [`Event::Cancelled`],
+    /// the session still on its mesh, and keeps the refined mesh for the
+    /// next call to gather on again.
+    fn refine_or_finish(
+        &mut self,
+        reason: StopReason,
+        cancel: &AtomicBool,
+    ) -> Result<Event, SolverError> {
         let refining = Instant::now();
         let mut next = None;
         let mut refused = None;
         if let Some((refiner, options)) = &mut self.refiner {
-            if reason == StopReason::Converged && refiner.passes() < options.levels {
-                let luminance: Vec<f64> = self
-                    .solver
-                    .radiosity()
-                    .iter()
-                    .map(|b| b.luminance())
-                    .collect();
-                match refiner.refine(self.scene, &luminance, options) {
-                    Some((mesh, report)) => {
-                        let start = self.solver.refined_state(&mesh, refiner);
-                        next = Some((mesh, report, start));
+            let refined = match self.pending.take() {
+                Some(pending) => Some(pending),
+                None if reason == StopReason::Converged && refiner.passes() < options.levels => {
+                    let luminance: Vec<f64> = self
+                        .solver
+                        .radiosity()
+                        .iter()
+                        .map(|b| b.luminance())
+                        .collect();
+                    let refined = refiner.refine(self.scene, &luminance, options);
+                    if refined.is_none() {
+                        refused = refiner.refused();
                     }
-                    None => refused = refiner.refused(),
+                    refined
+                }
+                None => None,
+            };
+            if let Some((mesh, report)) = refined {
+                match self.solver.refined_state(&mesh, refiner, cancel) {
+                    Ok(start) => next = Some((mesh, report, start)),
+                    Err(crate::cancel::Cancelled) => {
+                        self.pending = Some((mesh, report));
+                        return Ok(Event::Cancelled);
+                    }
                 }
             }
         }

@@ -155,6 +155,47 @@ fn adaptive_passes_refine_and_add_up() {
     }
 }
 
+/// An interrupt during the gather that carries a pass over to its refined
+/// mesh stops that advance with the session still on its mesh; the next
+/// advance carries it over on the same refined mesh, and the session ends
+/// as an uninterrupted one does, bit for bit.
+#[test]
+fn a_cancelled_refinement_resumes_where_it_stopped() {
+    let s = shadowed_box();
+    let m = build(&s, 0.2);
+    let vis = Visibility::new(&s);
+    let refine = RefineOptions::default();
+    let mut whole = Session::new(&s, &m, &vis, options(Some(refine)));
+    run_to_end(&mut whole);
+    let mut cut = Session::new(&s, &m, &vis, options(Some(refine)));
+    let (go, stop) = (AtomicBool::new(false), AtomicBool::new(true));
+    let mut cancelled = 0;
+    loop {
+        let event = cut.advance(&go).unwrap();
+        if event == Event::Finished {
+            break;
+        }
+        if matches!(event, Event::Stopped(StopReason::Converged)) {
+            let (vertices, steps) = (cut.mesh().vertex_count(), cut.totals().steps);
+            match cut.advance(&stop).unwrap() {
+                Event::Cancelled => {
+                    cancelled += 1;
+                    assert_eq!(cut.mesh().vertex_count(), vertices);
+                    assert_eq!(cut.totals().steps, steps);
+                }
+                // The last pass: nothing to refine, nothing to stop.
+                Event::Finished => break,
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+    assert_eq!(cancelled, refine.levels);
+    assert_eq!(cut.passes().len(), whole.passes().len());
+    assert_eq!(cut.totals().steps, whole.totals().steps);
+    assert_eq!(cut.totals().rays, whole.totals().rays);
+    assert_eq!(cut.radiosity(), whole.radiosity());
+}
+
 /// The run's element limit clamps the refiner's: a refinement that would
 /// pass it is refused, said once, and the session finishes on the mesh
 /// it has.

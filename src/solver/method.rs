@@ -19,6 +19,7 @@
 use super::checkpoint::SolverState;
 use super::methods::hemicube::HemicubeMethod;
 use super::{FormFactorMethod, Progressive, SolverError, SolverOptions, StepReport, StopReason};
+use crate::cancel::Cancelled;
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
@@ -162,8 +163,14 @@ pub trait Method<'a> {
     /// built on `refined`), or `None` when this method starts a refined
     /// mesh afresh. `refined` must be the mesh `refiner` returned last,
     /// refining this solve's mesh; rays cast to carry the solution over
-    /// are counted in the state's [`SolverState::rays`].
-    fn refined_state(&self, refined: &Mesh, refiner: &Refiner) -> Option<SolverState>;
+    /// are counted in the state's [`SolverState::rays`]. Stops promptly
+    /// with [`Cancelled`] once `cancel` is set (this solve unchanged).
+    fn refined_state(
+        &self,
+        refined: &Mesh,
+        refiner: &Refiner,
+        cancel: &AtomicBool,
+    ) -> Result<Option<SolverState>, Cancelled>;
 
     /// Checks the invariants; returns the first broken one.
     fn validate(&self) -> Result<(), SolverError>;

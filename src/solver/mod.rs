@@ -111,6 +111,7 @@ use kernel::{cell_integrals, distribution, formfactor};
 pub use step::StepPhase;
 use step::Underway;
 
+use crate::cancel::Cancelled;
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
@@ -122,6 +123,7 @@ use far_shooters::FarShooter;
 use formfactor::{polygon_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use receivers::CoarseGrid;
+use std::sync::atomic::{AtomicBool, Ordering};
 use subcells::SubCells;
 use unshot::{Shot, UnshotField};
 
@@ -1010,22 +1012,29 @@ impl<'a> Progressive<'a> {
     ///   unshot power is unchanged.
     ///
     /// `refined` must be the mesh `refiner` returned last, refining this
-    /// solve's mesh. The gather's rays are added to the ray count.
+    /// solve's mesh. The gather's rays are added to the ray count. Each
+    /// new vertex gathers from every polygon, which on a large model
+    /// takes long: the gather checks `cancel` at every vertex and stops
+    /// with [`Cancelled`] once it is set.
     pub fn refined_state(
         &self,
         refined: &Mesh,
         refiner: &Refiner,
-    ) -> Option<checkpoint::SolverState> {
-        let unshot = self.unshot.carried(refiner)?;
+        cancel: &AtomicBool,
+    ) -> Result<Option<checkpoint::SolverState>, Cancelled> {
+        let Some(unshot) = self.unshot.carried(refiner) else {
+            return Ok(None);
+        };
         let previous = refiner.previous_index();
         if previous.len() != refined.vertex_count() || unshot.len() != refined.vertex_count() {
-            return None;
+            return Ok(None);
         }
         // Each polygon's cells as a step of it reads them: a split cell by
         // its sub-cells.
-        let shot: Vec<(Vec<Rgb>, Vec<Rgb>)> = self
-            .unshot
-            .shot_at_samples(&self.mesh, &self.radiosity)?
+        let Some(shot_at_samples) = self.unshot.shot_at_samples(&self.mesh, &self.radiosity) else {
+            return Ok(None);
+        };
+        let shot: Vec<(Vec<Rgb>, Vec<Rgb>)> = shot_at_samples
             .into_iter()
             .zip(&self.subcells)
             .map(|((mut values, readings), subs)| {
@@ -1039,6 +1048,9 @@ impl<'a> Progressive<'a> {
             .into_par_iter()
             .with_min_len(64)
             .map(|l| {
+                if cancel.load(Ordering::Relaxed) {
+                    return (Rgb::BLACK, 0);
+                }
                 let j = refined.vertex_polygon[l];
                 let b = match previous[l] {
                     Some(old) => return (self.radiosity[old as usize], 0),
@@ -1059,6 +1071,12 @@ impl<'a> Progressive<'a> {
                     .zip(&self.subcells)
                     .enumerate()
                 {
+                    // A vertex gathers from every polygon: tens of
+                    // milliseconds on a real level, so the interrupt is
+                    // looked at per polygon too.
+                    if cancel.load(Ordering::Relaxed) {
+                        return (Rgb::BLACK, 0);
+                    }
                     // Coplanar polygons exchange no light (see
                     // `Visibility::coplanar`).
                     if i == j.index() || visibility.coplanar(PolygonId(i as u32), j) {
@@ -1084,8 +1102,11 @@ impl<'a> Progressive<'a> {
                 (b + rho * (sum + Rgb::splat(sun)), rays)
             })
             .collect();
+        if cancel.load(Ordering::Relaxed) {
+            return Err(Cancelled);
+        }
         let rays = gathered.iter().map(|g| g.1).sum::<u64>();
-        Some(checkpoint::SolverState {
+        Ok(Some(checkpoint::SolverState {
             radiosity: gathered.into_iter().map(|g| g.0).collect(),
             unshot,
             steps: self.steps,
@@ -1093,7 +1114,7 @@ impl<'a> Progressive<'a> {
             // Interpolation on the refined mesh starts with no charges.
             charges: Vec::new(),
             tail_from: self.tail.from(),
-        })
+        }))
     }
 
     /// Checks the invariants; returns the first broken one.

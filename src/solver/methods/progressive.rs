@@ -2,6 +2,7 @@
 //! call itself (its state lives in [`crate::solver`], its step's phases
 //! in [`crate::solver::step`]).
 
+use crate::cancel::Cancelled;
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
@@ -94,8 +95,13 @@ impl<'a> Method<'a> for Progressive<'a> {
         Progressive::restore(self, state)
     }
 
-    fn refined_state(&self, refined: &Mesh, refiner: &Refiner) -> Option<SolverState> {
-        Progressive::refined_state(self, refined, refiner)
+    fn refined_state(
+        &self,
+        refined: &Mesh,
+        refiner: &Refiner,
+        cancel: &AtomicBool,
+    ) -> Result<Option<SolverState>, Cancelled> {
+        Progressive::refined_state(self, refined, refiner, cancel)
     }
 
     fn validate(&self) -> Result<(), SolverError> {

@@ -80,7 +80,9 @@ fn solve_continued(s: &Scene, lenmax: f32, cut: f32, options: SolverOptions) -> 
         };
         match next {
             Some((refined, _)) => {
-                start = solver.refined_state(&refined, &refiner);
+                start = solver
+                    .refined_state(&refined, &refiner, &AtomicBool::new(false))
+                    .expect("not cancelled");
                 assert!(start.is_some());
                 drop(solver);
                 mesh = refined;

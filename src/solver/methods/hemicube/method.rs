@@ -20,6 +20,7 @@
 //! progressive solve's.
 
 use super::{HemicubeRes, Shooting};
+use crate::cancel::Cancelled;
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
@@ -289,8 +290,13 @@ impl<'a> Method<'a> for HemicubeMethod<'a> {
 
     /// The progressive solve's carry ([`Progressive::refined_state`]): the
     /// new vertices gather by Wallace's rays.
-    fn refined_state(&self, refined: &Mesh, refiner: &Refiner) -> Option<SolverState> {
-        self.progressive.refined_state(refined, refiner)
+    fn refined_state(
+        &self,
+        refined: &Mesh,
+        refiner: &Refiner,
+        cancel: &AtomicBool,
+    ) -> Result<Option<SolverState>, Cancelled> {
+        self.progressive.refined_state(refined, refiner, cancel)
     }
 
     fn validate(&self) -> Result<(), SolverError> {
