@@ -1014,8 +1014,8 @@ impl<'a> Progressive<'a> {
     /// `refined` must be the mesh `refiner` returned last, refining this
     /// solve's mesh. The gather's rays are added to the ray count. Each
     /// new vertex gathers from every polygon, which on a large model
-    /// takes long: the gather checks `cancel` at every vertex and stops
-    /// with [`Cancelled`] once it is set.
+    /// takes long: the gather checks `cancel` before each polygon and
+    /// stops with [`Cancelled`] once it is set.
     pub fn refined_state(
         &self,
         refined: &Mesh,
@@ -1048,9 +1048,6 @@ impl<'a> Progressive<'a> {
             .into_par_iter()
             .with_min_len(64)
             .map(|l| {
-                if cancel.load(Ordering::Relaxed) {
-                    return (Rgb::BLACK, 0);
-                }
                 let j = refined.vertex_polygon[l];
                 let b = match previous[l] {
                     Some(old) => return (self.radiosity[old as usize], 0),
@@ -1071,9 +1068,8 @@ impl<'a> Progressive<'a> {
                     .zip(&self.subcells)
                     .enumerate()
                 {
-                    // A vertex gathers from every polygon: tens of
-                    // milliseconds on a real level, so the interrupt is
-                    // looked at per polygon too.
+                    // A vertex reads every polygon, so a vertex's gather
+                    // alone is long on a real level.
                     if cancel.load(Ordering::Relaxed) {
                         return (Rgb::BLACK, 0);
                     }

@@ -628,16 +628,17 @@ impl Visibility {
         let Some(ray) = segment_ray(a, b) else {
             return false;
         };
-        if self.last_blocks(last, &ray, ends) {
+        let planes = self.end_planes(ends);
+        if last.0.is_some_and(|p| self.blocks(p, &ray, ends, planes)) {
             return true;
         }
         #[cfg(target_arch = "x86_64")]
         if self.sse42 {
             // SAFETY: `sse42` is set only where the CPU reports the
             // features `traverse_sse42` is compiled for.
-            return unsafe { self.traverse_sse42(bvh, ray, ends, last) };
+            return unsafe { self.traverse_sse42(bvh, ray, ends, planes, last) };
         }
-        self.traverse(bvh, ray, ends, last)
+        self.traverse(bvh, ray, ends, planes, last)
     }
 
     /// [`Visibility::traverse`] compiled for SSE4.2 and POPCNT: the wide
@@ -652,19 +653,22 @@ impl Visibility {
         bvh: &CwBvh,
         ray: Ray,
         ends: (PolygonId, PolygonId),
+        planes: (u32, u32),
         last: &mut LastBlocker,
     ) -> bool {
-        self.traverse(bvh, ray, ends, last)
+        self.traverse(bvh, ray, ends, planes, last)
     }
 
-    /// The BVH search of [`Visibility::occluded_remembering`], keeping the
-    /// blocker it finds in `last`.
+    /// The BVH search of [`Visibility::occluded_remembering`] (`planes`:
+    /// the plane classes of `ends`, [`Visibility::end_planes`]), keeping
+    /// the blocker it finds in `last`.
     #[inline(always)]
     fn traverse(
         &self,
         bvh: &CwBvh,
         ray: Ray,
         ends: (PolygonId, PolygonId),
+        planes: (u32, u32),
         last: &mut LastBlocker,
     ) -> bool {
         use glam::UVec2;
@@ -674,7 +678,6 @@ impl Visibility {
         let mut state = bvh.new_traversal(ray.direction);
         let mut node;
         let mut found = None;
-        let planes = self.end_planes(ends);
         'search: {
             obvhs::traverse!(
                 bvh,
@@ -696,14 +699,6 @@ impl Visibility {
             last.0 = found;
         }
         found.is_some()
-    }
-
-    /// Whether the blocker `last` names (if any) crosses `ray` and may
-    /// block a segment joining `ends`.
-    #[inline]
-    fn last_blocks(&self, last: &LastBlocker, ray: &Ray, ends: (PolygonId, PolygonId)) -> bool {
-        let planes = self.end_planes(ends);
-        last.0.is_some_and(|p| self.blocks(p, ray, ends, planes))
     }
 
     /// The nearest polygon that the ray from `origin` along `direction`
