@@ -218,7 +218,7 @@ pub struct Args {
     /// Each is one switch, measured against its twin: emitters-first,
     /// overshoot, settling, near-field, shaft-culling, clusters, strata,
     /// receiver-interpolation, weak-strata, crowded-cells, facet-rays,
-    /// sky-probes, far-shooters, shared-receivers, sky-at-once.
+    /// sky-probes, far-shooters, shared-receivers, sky-at-once, hat-centroids.
     /// `docs/accuracy.md` gives what each costs and buys.
     #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
     #[arg(help_heading = heading::SOLVER, hide_short_help = true)]

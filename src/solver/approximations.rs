@@ -93,6 +93,12 @@ pub struct Approximations {
     /// and not on a daylight sky (its luminance varies within a facet).
     /// Off: one step per sky facet, from its own directions.
     pub sky_at_once: bool,
+    /// In the sky step ([`Approximations::sky_at_once`]), a vertex asks
+    /// its hemisphere from the centroid of the elements around it (its
+    /// hat, [`super::accel::hat`]), so that its value is close to their
+    /// mean rather than the light at its own point: at a surface's edge, a
+    /// third of an element in. Off: from the vertex's evaluation point.
+    pub hat_centroids: bool,
 }
 
 /// The name of one switch of [`Approximations`], as the command line
@@ -158,11 +164,14 @@ pub enum Heuristic {
         help = "the sky is shot in one step, each vertex asking its own hemisphere of directions"
     )]
     SkyAtOnce,
+    /// [`Approximations::hat_centroids`].
+    #[value(help = "under the sky a vertex asks from the centroid of the elements around it")]
+    HatCentroids,
 }
 
 impl Heuristic {
     /// Every switch, in the order of [`Approximations`]' fields.
-    pub const ALL: [Heuristic; 15] = [
+    pub const ALL: [Heuristic; 16] = [
         Heuristic::EmittersFirst,
         Heuristic::Overshoot,
         Heuristic::Settling,
@@ -178,6 +187,7 @@ impl Heuristic {
         Heuristic::FarShooters,
         Heuristic::SharedReceivers,
         Heuristic::SkyAtOnce,
+        Heuristic::HatCentroids,
     ];
 
     /// The switches `--exact-receivers` turns off: every receiving vertex
@@ -211,6 +221,7 @@ impl Approximations {
         far_shooters: true,
         shared_receivers: true,
         sky_at_once: true,
+        hat_centroids: true,
     };
 
     /// The brute-force twin: no heuristic that trades accuracy or a
@@ -235,6 +246,7 @@ impl Approximations {
         far_shooters: false,
         shared_receivers: false,
         sky_at_once: false,
+        hat_centroids: false,
     };
 
     /// Whether switch `h` is on.
@@ -281,6 +293,7 @@ impl Approximations {
             Heuristic::FarShooters => &mut self.far_shooters,
             Heuristic::SharedReceivers => &mut self.shared_receivers,
             Heuristic::SkyAtOnce => &mut self.sky_at_once,
+            Heuristic::HatCentroids => &mut self.hat_centroids,
         }
     }
 }

@@ -741,6 +741,7 @@ impl<'a> Progressive<'a> {
                 mesh,
                 clustered && approx.sky_at_once && scene.sky_pattern.is_none(),
                 clustered && approx.sky_probes,
+                approx.hat_centroids,
             ),
             gauge: std::sync::Arc::default(),
         };

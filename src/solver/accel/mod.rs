@@ -8,6 +8,8 @@
 //! - [`receivers`]: hierarchical receivers, interpolated between coarse
 //!   vertices where a check shows the interpolation holds;
 //! - [`facets`]: small receiving facets sharing their shadow rays;
+//! - [`hat`]: the elements around a vertex, and their centroid, where
+//!   the sky step asks from;
 //! - [`probes`]: a sky facet's directions probed first;
 //! - [`far_shooters`]: a far shooter's samples probed first;
 //! - [`subcells`]: shooter cells much larger than their elements, shot as
@@ -19,6 +21,7 @@
 pub mod cluster;
 pub mod facets;
 pub mod far_shooters;
+pub mod hat;
 pub mod probes;
 pub mod receivers;
 pub mod shared;

@@ -11,12 +11,15 @@
 //! polygon once all its vertices are gathered and returns between
 //! chunks, so a window shows the sky arriving; without one it applies
 //! them all at the end, so a cancelled step leaves nothing changed. Vertices that receive as one
-//! ([`crate::solver::accel::shared`]) take their leader's value. The bits
+//! ([`crate::solver::accel::shared`]) take their leader's value, and a
+//! vertex asks from the centroid of the elements around it (of its whole
+//! group's, for a leader: [`crate::solver::accel::hat`]). The bits
 //! do not depend on the thread count or on the parts. The step's gauge
 //! ([`crate::solver::gauge`]) counts the vertices that have gathered.
 
 use crate::color::Rgb;
 use crate::scene::PolygonId;
+use crate::solver::accel::hat::Hats;
 use crate::solver::accel::shared::ALONE;
 use crate::solver::accel::sky_dome::{Dome, Hemisphere, SkyLight};
 use crate::solver::step::StepPhase;
@@ -35,19 +38,28 @@ pub(in crate::solver) struct SkyGather {
     tables: Option<(Hemisphere, Dome)>,
     /// Whether a vertex's probes may answer for their cells.
     probing: bool,
+    /// Whether a vertex asks from its hat's centroid
+    /// ([`crate::solver::accel::hat`]).
+    hat_centroids: bool,
     /// The sky step begun and not finished, when steps come in parts.
     pub(in crate::solver) underway: Option<Box<SkyUnderway>>,
 }
 
 impl SkyGather {
     /// The sky step of `mesh`: on when `on` and the mesh has a sky.
-    pub(in crate::solver) fn new(mesh: &crate::mesh::Mesh, on: bool, probing: bool) -> SkyGather {
+    pub(in crate::solver) fn new(
+        mesh: &crate::mesh::Mesh,
+        on: bool,
+        probing: bool,
+        hat_centroids: bool,
+    ) -> SkyGather {
         SkyGather {
             tables: on
                 .then(|| Dome::new(mesh))
                 .flatten()
                 .map(|dome| (Hemisphere::new(SKY_CELLS, SKY_CELL_STRATA), dome)),
             probing,
+            hat_centroids,
             underway: None,
         }
     }
@@ -77,6 +89,9 @@ pub(in crate::solver) struct SkyUnderway {
     part: u32,
     /// Whether the facets' unshot light has been spent.
     spent: bool,
+    /// The elements around each vertex, when it asks from its hat's
+    /// centroid.
+    hats: Option<Hats>,
     /// The unshot fraction before the step.
     fraction_before: f64,
 }
@@ -222,6 +237,10 @@ impl<'a> Progressive<'a> {
             heads_done: 0,
             part: 0,
             spent: false,
+            hats: self
+                .sky
+                .hat_centroids
+                .then(|| Hats::new(&self.mesh, &self.leaders)),
             fraction_before: self.last_fraction,
         })
     }
@@ -245,6 +264,7 @@ impl<'a> Progressive<'a> {
             .map(|l| l as u32)
             .collect();
         let (light, probing, visibility) = (&u.light, self.sky.probing, self.visibility);
+        let hats = u.hats.as_ref();
         let results: Vec<(Rgb, u64)> = heads
             .par_iter()
             .map(|&l| {
@@ -253,7 +273,10 @@ impl<'a> Progressive<'a> {
                 }
                 let j = mesh.vertex_polygon[l as usize];
                 let n = mesh.polygons[j.index()].normal.normalize_or_zero();
-                let x = mesh.sample_positions[l as usize];
+                let x = match hats {
+                    Some(hats) => hats.centroid(mesh, l, |m| visibility.coplanar(j, m)),
+                    None => mesh.sample_positions[l as usize],
+                };
                 let mut last = LastBlocker::default();
                 hemisphere.gather(dome, light, x, n, probing, |end| {
                     visibility.occluded_remembering(x, end, (j, j), &mut last)

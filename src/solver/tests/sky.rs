@@ -71,6 +71,52 @@ fn vertices_of<'a>(
         .map(move |l| (mesh.sample_positions[l as usize], radiosity[l as usize]))
 }
 
+/// The mean of `f` under vertex `l`'s hat on polygon `p`: integrated over
+/// the elements around it, weighted by its barycentric (triangle) or
+/// bilinear (quad) weight, on a 24 × 24 grid of each element's
+/// parameters, between the corners' evaluation points.
+fn hat_mean(mesh: &Mesh, p: usize, l: u32, f: impl Fn(Vec3) -> f64) -> f64 {
+    let pm = &mesh.polygons[p];
+    let elements = &mesh.elements[pm.elements.start as usize..pm.elements.end as usize];
+    let (mut weighted, mut weight) = (0.0f64, 0.0f64);
+    let n = 24;
+    for e in elements {
+        let c = e.corners();
+        let Some(k) = c.iter().position(|v| v.0 == l) else {
+            continue;
+        };
+        let at = |i: usize| mesh.sample_positions[c[(k + i) % c.len()].index()];
+        let area = mesh.element_area(e);
+        for i in 0..n {
+            for j in 0..n {
+                let (s, t) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let (x, w) = if c.len() == 4 {
+                    (
+                        at(0) * ((1.0 - s) * (1.0 - t))
+                            + at(1) * (s * (1.0 - t))
+                            + at(2) * (s * t)
+                            + at(3) * ((1.0 - s) * t),
+                        (1.0 - s) * (1.0 - t),
+                    )
+                } else {
+                    // The square folded onto the triangle: (s, t) above
+                    // the diagonal reflected below it.
+                    let (s, t) = if s + t > 1.0 {
+                        (1.0 - s, 1.0 - t)
+                    } else {
+                        (s, t)
+                    };
+                    let lambda = 1.0 - s - t;
+                    (at(0) * lambda + at(1) * s + at(2) * t, lambda)
+                };
+                weighted += area * f64::from(w) * f(x);
+                weight += area * f64::from(w);
+            }
+        }
+    }
+    weighted / weight
+}
+
 #[test]
 fn an_open_floor_under_a_sky_gets_its_reflectance_times_the_sky() {
     let sky = Rgb::new(1.0, 2.0, 4.0);
@@ -187,15 +233,29 @@ fn row_nearest(mesh: &Mesh, p: usize, z: f32) -> f32 {
 
 /// Per floor vertex on the row nearest to `z = 3` across the room, sorted by `x`:
 /// (x, solved radiosity, exact radiosity).
-/// `at_once`: the sky gathered at once, else shot facet by facet.
+/// `at_once`: the sky gathered at once, each vertex asking from its hat's
+/// centroid ([`crate::solver::accel::hat`]), so the exact value is
+/// Lambert's mean under the hat ([`hat_mean`]); else shot facet by facet,
+/// and the exact value is Lambert's at the vertex.
 fn skylight_profile(hole: f32, lenmax: f32, at_once: bool) -> Vec<(f32, f64, f64)> {
     let (s, corners) = room_with_skylight(hole);
     let approximations = Approximations::DEFAULT.with(Heuristic::SkyAtOnce, at_once);
     let (_, mesh, radiosity, _) = solve_under_sky_with(s, Rgb::splat(1.0), lenmax, approximations);
     let z = row_nearest(&mesh, 0, 3.0);
-    let mut line: Vec<(f32, f64, f64)> = vertices_of(&mesh, &radiosity, 0)
-        .filter(|(x, _)| x.z == z)
-        .map(|(x, b)| (x.x, b.r, 0.5 * point_to_polygon(x, Vec3::Y, &corners)))
+    let lambert = |x: Vec3| 0.5 * point_to_polygon(x, Vec3::Y, &corners);
+    let mut line: Vec<(f32, f64, f64)> = mesh.polygons[0]
+        .vertices
+        .clone()
+        .filter(|&l| mesh.sample_positions[l as usize].z == z)
+        .map(|l| {
+            let x = mesh.sample_positions[l as usize];
+            let exact = if at_once {
+                hat_mean(&mesh, 0, l, lambert)
+            } else {
+                lambert(x)
+            };
+            (x.x, radiosity[l as usize].r, exact)
+        })
         .collect();
     line.sort_by(|a, b| a.0.total_cmp(&b.0));
     line
@@ -466,4 +526,54 @@ fn sky_probes_match(at_once: bool, l1: f64, share: f64) {
         })
     };
     assert!(super::same_bits(&threads(1), &threads(2)));
+}
+
+/// A `4 × 4` floor (reflectance 0.5) along a black wall at its edge
+/// `x = 0`, `0.3` high and much longer than the floor, under a sky of 2,
+/// meshed in `1 × 1` elements: the floor's vertices on the wall's foot
+/// with `hat_centroids` and without, against the mean of Lambert's closed
+/// form under each one's hat. Returns the worst difference on the foot's
+/// row and over the whole floor, in units of the open floor's radiosity.
+fn foot_of_a_wall_against_hat_means(hat_centroids: bool) -> (f64, f64) {
+    let h = 0.3f32;
+    let wall = [[0., 0., -40.], [0., h, -40.], [0., h, 44.], [0., 0., 44.]];
+    let s = scene(
+        vec![floor(4.0), polygon(1, &wall)],
+        vec![grey("floor", 0.0, 0.5), grey("black", 0.0, 0.0)],
+    );
+    assert!(s.polygons[1].normal.x > 0.99, "the wall faces the floor");
+    let approximations = Approximations::DEFAULT.with(Heuristic::HatCentroids, hat_centroids);
+    let (_, mesh, radiosity, _) = solve_under_sky_with(s, Rgb::splat(2.0), 1.0, approximations);
+    let corners = wall.map(Vec3::from_array);
+    let open = |x: Vec3| 1.0 - point_to_polygon(x, Vec3::Y, &corners).abs();
+    let (mut foot, mut all) = (0.0f64, 0.0f64);
+    for l in mesh.polygons[0].vertices.clone() {
+        let d = (radiosity[l as usize].r / (0.5 * 2.0) - hat_mean(&mesh, 0, l, open)).abs();
+        all = all.max(d);
+        if mesh.positions[l as usize].x == 0.0 {
+            foot = foot.max(d);
+        }
+    }
+    (foot, all)
+}
+
+#[test]
+fn at_the_foot_of_a_wall_a_vertex_gets_its_elements_mean() {
+    // Evaluated at its own point, 5 % of an element from the wall, a
+    // vertex on the wall's foot sees 40 % of its sky blocked, where its
+    // elements lose about 15 % on the whole (26 % of the open floor's
+    // light apart); asked from its hat's centroid, a third of an element
+    // in, it gets their mean to within the curvature of the light across
+    // them (4 %).
+    let (centroid_foot, centroid_all) = foot_of_a_wall_against_hat_means(true);
+    let (point_foot, point_all) = foot_of_a_wall_against_hat_means(false);
+    eprintln!(
+        "against the hat means: centroids foot {centroid_foot:.4} all {centroid_all:.4}; \
+         points foot {point_foot:.4} all {point_all:.4}"
+    );
+    assert!(centroid_all < 0.06, "centroids: worst {centroid_all}");
+    assert!(
+        point_foot > 4.0 * centroid_foot,
+        "points: foot {point_foot} (centroids {centroid_foot})"
+    );
 }
