@@ -205,6 +205,22 @@ mod tests {
         (mesh, l)
     }
 
+    /// Polygons of one floor material meshed at `lenmax` without inset,
+    /// their shared receivers' leaders, and the leader at `at`.
+    fn leader_at(
+        polygons: Vec<crate::scene::Polygon>,
+        lenmax: f32,
+        at: Vec3,
+    ) -> (Mesh, Vec<u32>, u32) {
+        let s = testutil::scene(polygons, vec![testutil::grey("floor", 0.0, 0.5)]);
+        let mesh = build(&s, &MeshOptions { lenmax, inset: 0.0 }).unwrap();
+        let leaders = crate::solver::accel::shared::leaders(&s, &mesh, true);
+        let l = (0..mesh.vertex_count() as u32)
+            .find(|&v| mesh.positions[v as usize] == at && leaders[v as usize] == ALONE)
+            .expect("a leader there");
+        (mesh, leaders, l)
+    }
+
     #[test]
     fn inside_a_surface_the_centroid_is_the_vertex() {
         let (mesh, l) = floor(1.01, Vec3::new(2.0, 0.0, 2.0));
@@ -238,25 +254,14 @@ mod tests {
         // Two thin triangles of one floor meeting only at the origin, as
         // a V: their hat's centroid lies between the arms, on neither,
         // and so does every point back towards the vertex.
-        let s = testutil::scene(
+        let (mesh, leaders, l) = leader_at(
             vec![
                 testutil::polygon(0, &[[0., 0., 0.], [1., 0., -0.1], [1., 0., -0.2]]),
                 testutil::polygon(0, &[[0., 0., 0.], [-0.2, 0., 1.], [-0.1, 0., 1.]]),
             ],
-            vec![testutil::grey("floor", 0.0, 0.5)],
+            10.0,
+            Vec3::ZERO,
         );
-        let mesh = build(
-            &s,
-            &MeshOptions {
-                lenmax: 10.0,
-                inset: 0.0,
-            },
-        )
-        .unwrap();
-        let leaders = crate::solver::accel::shared::leaders(&s, &mesh, true);
-        let l = (0..mesh.vertex_count() as u32)
-            .find(|&v| mesh.positions[v as usize] == Vec3::ZERO && leaders[v as usize] == ALONE)
-            .expect("a leader at the origin");
         let hats = Hats::new(&mesh, &leaders);
         let own = mesh.sample_positions[l as usize];
         assert_eq!(hats.centroid(&mesh, l, |_| true), own);
@@ -286,26 +291,15 @@ mod tests {
     fn followers_in_the_plane_join_the_leaders_hat() {
         // Two floors side by side, 0 ≤ x ≤ 2 and 2 ≤ x ≤ 4: a vertex on
         // the seam at x = 2 has half a hat on each.
-        let s = testutil::scene(
+        let seam = Vec3::new(2.0, 0.0, 2.0);
+        let (mesh, leaders, l) = leader_at(
             vec![
                 testutil::polygon(0, &[[0., 0., 0.], [0., 0., 4.], [2., 0., 4.], [2., 0., 0.]]),
                 testutil::polygon(0, &[[2., 0., 0.], [2., 0., 4.], [4., 0., 4.], [4., 0., 0.]]),
             ],
-            vec![testutil::grey("floor", 0.0, 0.5)],
+            1.01,
+            seam,
         );
-        let mesh = build(
-            &s,
-            &MeshOptions {
-                lenmax: 1.01,
-                inset: 0.0,
-            },
-        )
-        .unwrap();
-        let leaders = crate::solver::accel::shared::leaders(&s, &mesh, true);
-        let seam = Vec3::new(2.0, 0.0, 2.0);
-        let l = (0..mesh.vertex_count() as u32)
-            .find(|&v| mesh.positions[v as usize] == seam && leaders[v as usize] == ALONE)
-            .expect("a leader on the seam");
         let hats = Hats::new(&mesh, &leaders);
         let both = hats.centroid(&mesh, l, |_| true);
         assert!(both.distance(seam) < 1e-5, "{both}");
