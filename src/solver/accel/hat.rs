@@ -32,7 +32,7 @@
 //! surface's corners, where walls end them early), and vertex-to-vertex
 //! noise under a skylight (docs/changelog.md).
 
-use crate::mesh::Mesh;
+use crate::mesh::{Element, Mesh};
 use crate::scene::PolygonId;
 use crate::solver::accel::shared::ALONE;
 use glam::Vec3;
@@ -113,53 +113,65 @@ impl Hats {
     /// point.
     pub fn centroid(&self, mesh: &Mesh, l: u32, same_plane: impl Fn(PolygonId) -> bool) -> Vec3 {
         let own = mesh.sample_positions[l as usize];
-        let members = std::iter::once(l).chain(
-            self.followers[self.follower_starts[l as usize] as usize
-                ..self.follower_starts[l as usize + 1] as usize]
-                .iter()
-                .copied(),
-        );
-        let mut pieces: Vec<[Vec3; 4]> = Vec::new();
         let (mut sum, mut weight) = (glam::DVec3::ZERO, 0.0f64);
-        for m in members {
-            if m != l && !same_plane(mesh.vertex_polygon[m as usize]) {
-                continue;
-            }
-            let range = self.element_starts[m as usize] as usize
-                ..self.element_starts[m as usize + 1] as usize;
-            for &ec in &self.corners[range] {
-                let e = &mesh.elements[(ec / 4) as usize];
-                let c = e.corners();
-                let k = (ec % 4) as usize;
-                let at = |i: usize| mesh.sample_positions[c[(k + i) % c.len()].index()];
-                let share = mesh.element_area(e) / c.len() as f64;
-                if !(share > 0.0 && share.is_finite()) {
-                    continue;
-                }
-                // A triangle's hat centroid is at barycentric (1/2, 1/4,
-                // 1/4) from the vertex; a quad's at bilinear (1/3, 1/3).
-                let centre = if c.len() == 3 {
-                    at(0) * 0.5 + (at(1) + at(2)) * 0.25
-                } else {
-                    at(0) * (4.0 / 9.0) + (at(1) + at(3)) * (2.0 / 9.0) + at(2) * (1.0 / 9.0)
-                };
-                sum += centre.as_dvec3() * share;
-                weight += share;
-                // Where the element is: its corners' own positions, as an
-                // inset leaves gaps between neighbouring elements' points.
-                let corner = |i: usize| mesh.positions[c[(k + i) % c.len()].index()];
-                pieces.push([corner(0), corner(1), corner(2), corner(c.len() - 1)]);
-            }
+        for (e, k) in self.pieces(mesh, l, &same_plane) {
+            let c = e.corners();
+            let at = |i: usize| mesh.sample_positions[c[(k + i) % c.len()].index()];
+            let share = mesh.element_area(e) / c.len() as f64;
+            // A triangle's hat centroid is at barycentric (1/2, 1/4, 1/4)
+            // from the vertex; a quad's at bilinear (1/3, 1/3).
+            let centre = if c.len() == 3 {
+                at(0) * 0.5 + (at(1) + at(2)) * 0.25
+            } else {
+                at(0) * (4.0 / 9.0) + (at(1) + at(3)) * (2.0 / 9.0) + at(2) * (1.0 / 9.0)
+            };
+            sum += centre.as_dvec3() * share;
+            weight += share;
         }
         if weight <= 0.0 {
             return own;
         }
         let centroid = (sum / weight).as_vec3();
+        // Where an element is: its corners' own positions, as an inset
+        // leaves gaps between neighbouring elements' evaluation points.
+        let inside = |p: Vec3| {
+            self.pieces(mesh, l, &same_plane).any(|(e, _)| {
+                let c = e.corners();
+                let q = |i: usize| mesh.positions[c[i.min(c.len() - 1)].index()];
+                in_element(&[q(0), q(1), q(2), q(3)], p)
+            })
+        };
         [1.0, 0.5, 0.25, 0.125]
             .into_iter()
             .map(|t| own + (centroid - own) * t)
-            .find(|&p| pieces.iter().any(|q| in_element(q, p)))
+            .find(|&p| inside(p))
             .unwrap_or(own)
+    }
+
+    /// The elements of vertex `l`'s hat with area, each with the corner
+    /// (`0..4`) of the vertex or follower it belongs to: those around `l`
+    /// and around its followers whose polygon `same_plane` accepts.
+    fn pieces<'m>(
+        &'m self,
+        mesh: &'m Mesh,
+        l: u32,
+        same_plane: &'m impl Fn(PolygonId) -> bool,
+    ) -> impl Iterator<Item = (&'m Element, usize)> + 'm {
+        let followers = &self.followers[self.follower_starts[l as usize] as usize
+            ..self.follower_starts[l as usize + 1] as usize];
+        std::iter::once(l)
+            .chain(followers.iter().copied())
+            .filter(move |&m| m == l || same_plane(mesh.vertex_polygon[m as usize]))
+            .flat_map(move |m| {
+                self.corners[self.element_starts[m as usize] as usize
+                    ..self.element_starts[m as usize + 1] as usize]
+                    .iter()
+                    .map(move |&ec| (&mesh.elements[(ec / 4) as usize], (ec % 4) as usize))
+            })
+            .filter(move |(e, _)| {
+                let area = mesh.element_area(e);
+                area > 0.0 && area.is_finite()
+            })
     }
 }
 
