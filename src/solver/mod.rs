@@ -716,7 +716,12 @@ impl<'a> Progressive<'a> {
             coarse_delta: vec![Rgb::BLACK; mesh.vertex_count()],
             facets: Facets::new(mesh, clustered && approx.facet_rays),
             probes: sky_probes,
-            leaders: shared::leaders(scene, mesh, clustered && approx.shared_receivers),
+            leaders: shared::leaders(
+                scene,
+                mesh,
+                visibility,
+                clustered && approx.shared_receivers,
+            ),
             far_shooters,
             spent: vec![Rgb::BLACK; mesh.vertex_count()],
             tile_of,

@@ -226,7 +226,8 @@ mod tests {
     ) -> (Mesh, Vec<u32>, u32) {
         let s = testutil::scene(polygons, vec![testutil::grey("floor", 0.0, 0.5)]);
         let mesh = build(&s, &MeshOptions { lenmax, inset: 0.0 }).unwrap();
-        let leaders = crate::solver::accel::shared::leaders(&s, &mesh, true);
+        let visibility = crate::visibility::Visibility::new(&s);
+        let leaders = crate::solver::accel::shared::leaders(&s, &mesh, &visibility, true);
         let l = (0..mesh.vertex_count() as u32)
             .find(|&v| mesh.positions[v as usize] == at && leaders[v as usize] == ALONE)
             .expect("a leader there");

@@ -17,7 +17,18 @@
 //! one plane. The vertex of lowest index leads the group; in a step, a
 //! follower whose leader is evaluated exactly (its polygon receives, and
 //! neither is interpolated) takes the leader's `Δrad` instead of its own
-//! ([`crate::solver::step::gather`]). The error is that of
+//! ([`crate::solver::step::gather`]).
+//!
+//! A member follows a leader only when it sees it: no polygon out of
+//! their planes crosses the segment between their evaluation points,
+//! lifted off the surface by half its length. A
+//! wall standing on the point splits the group into its sides, each led
+//! by its lowest vertex. Without this test, a game level's floor on both
+//! sides of a fin's foot followed one leader: on `pandora.obj` a vertex
+//! took 0.42 from a leader beside a shooting wall where its own point
+//! got 0.0015, and over a step the followers took 3 % more light than
+//! they would have alone; shooting to 10 % unshot made the picture 6 %
+//! too bright, 3 points of it from the shared receivers. The error left is that of
 //! evaluating a point a few degrees off its own normal, or at its
 //! neighbour's inset point (a twentieth of an element away); a back copy
 //! (normal reversed), another material, a crease or a sky facet never
@@ -30,6 +41,8 @@ use crate::mesh::weld::find;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solver::tuning::SHARE_CREASE_DEG;
+use crate::visibility::Visibility;
+use rayon::prelude::*;
 
 /// No leader: the vertex is evaluated alone.
 pub const ALONE: u32 = u32::MAX;
@@ -38,8 +51,11 @@ pub const ALONE: u32 = u32::MAX;
 ///
 /// Invariants: a leader has a lower index than its followers (so its
 /// polygon comes first) and is itself [`ALONE`]; a vertex and its leader
-/// stand at the same position on two polygons of one material.
-pub fn leaders(scene: &Scene, mesh: &Mesh, on: bool) -> Vec<u32> {
+/// stand at the same position on two polygons of one material, and no
+/// polygon of `visibility` (other than in their planes) crosses the
+/// segment between their evaluation points, each lifted along its
+/// polygon's normal by half the points' distance.
+pub fn leaders(scene: &Scene, mesh: &Mesh, visibility: &Visibility, on: bool) -> Vec<u32> {
     let n = mesh.vertex_count();
     let mut leader = vec![ALONE; if on { n } else { 0 }];
     if !on || n < 2 {
@@ -56,6 +72,8 @@ pub fn leaders(scene: &Scene, mesh: &Mesh, on: bool) -> Vec<u32> {
         .collect();
     by_position.sort_unstable();
     let mut parent: Vec<usize> = Vec::new();
+    // (group root, member) for every member that is not its root.
+    let mut groups: Vec<(u32, u32)> = Vec::new();
     let mut s = 0;
     while s < by_position.len() {
         let mut e = s + 1;
@@ -85,13 +103,62 @@ pub fn leaders(scene: &Scene, mesh: &Mesh, on: bool) -> Vec<u32> {
             }
         }
         // The run is sorted by vertex within equal positions, so each
-        // group's root (its lowest member here) is its lowest vertex.
+        // group's members are listed lowest vertex first.
         for i in 0..run.len() {
             let root = find(&mut parent, i);
             if root != i {
-                leader[run[i].1 as usize] = run[root].1;
+                groups.push((run[root].1, run[i].1));
             }
         }
+    }
+    // Per group (its root's run of pairs), who follows whom: each member
+    // follows the lowest member it sees, in turn.
+    let mut runs: Vec<&[(u32, u32)]> = Vec::new();
+    groups.sort_unstable();
+    let mut s = 0;
+    while s < groups.len() {
+        let e = s + groups[s..]
+            .iter()
+            .take_while(|g| g.0 == groups[s].0)
+            .count();
+        runs.push(&groups[s..e]);
+        s = e;
+    }
+    let follow: Vec<Vec<(u32, u32)>> = runs
+        .par_iter()
+        .map(|run| {
+            let mut left: Vec<u32> = std::iter::once(run[0].0)
+                .chain(run.iter().map(|g| g.1))
+                .collect();
+            let mut out = Vec::new();
+            while let Some((&lead, rest)) = left.split_first() {
+                // The segment is lifted off the surface by half its
+                // length: in the plane it would only graze the foot of
+                // a wall standing on the point, along the wall's edge.
+                let sees = |v: u32| {
+                    let (pv, pl) = (
+                        mesh.vertex_polygon[v as usize],
+                        mesh.vertex_polygon[lead as usize],
+                    );
+                    let (a, b) = (
+                        mesh.sample_positions[v as usize],
+                        mesh.sample_positions[lead as usize],
+                    );
+                    let lift = 0.5 * a.distance(b);
+                    let up = |p: crate::scene::PolygonId| {
+                        mesh.polygons[p.index()].normal.normalize_or_zero() * lift
+                    };
+                    !visibility.occluded(a + up(pv), b + up(pl), (pv, pl))
+                };
+                let (with, apart): (Vec<u32>, Vec<u32>) = rest.iter().partition(|&&v| sees(v));
+                out.extend(with.into_iter().map(|v| (v, lead)));
+                left = apart;
+            }
+            out
+        })
+        .collect();
+    for (v, lead) in follow.into_iter().flatten() {
+        leader[v as usize] = lead;
     }
     leader
 }
@@ -147,7 +214,7 @@ mod tests {
     #[test]
     fn a_flat_seam_of_one_material_shares_every_vertex_along_it() {
         let (scene, mesh) = hinge(0.0, [0, 0], false);
-        let leader = leaders(&scene, &mesh, true);
+        let leader = leaders(&scene, &mesh, &Visibility::new(&scene), true);
         let shared = pairs(&leader);
         // Every point of the first square's mesh on the seam x = 0.
         let seam = mesh.polygons[0]
@@ -178,18 +245,50 @@ mod tests {
         ] {
             let (scene, mesh) = hinge(angle, m, smooth);
             assert!(
-                pairs(&leaders(&scene, &mesh, true)).is_empty(),
+                pairs(&leaders(&scene, &mesh, &Visibility::new(&scene), true)).is_empty(),
                 "{angle} {m:?}"
             );
         }
         // Within the crease, a smooth pair shares.
         let (scene, mesh) = hinge(SHARE_CREASE_DEG - 5.0, [0, 0], true);
-        assert!(!pairs(&leaders(&scene, &mesh, true)).is_empty());
+        assert!(!pairs(&leaders(&scene, &mesh, &Visibility::new(&scene), true)).is_empty());
+    }
+
+    #[test]
+    fn a_wall_standing_on_a_seam_splits_it_into_its_sides() {
+        // Two floor squares meeting along x = 0, and a wall of another
+        // material standing on that seam.
+        let floor = |x0: f32, x1: f32| {
+            testutil::polygon(0, &[[x0, 0., 0.], [x1, 0., 0.], [x1, 1., 0.], [x0, 1., 0.]])
+        };
+        let wall = testutil::polygon(1, &[[0., 0., 0.], [0., 1., 0.], [0., 1., 1.], [0., 0., 1.]]);
+        let scene = testutil::scene(
+            vec![floor(-1.0, 0.0), floor(0.0, 1.0), wall],
+            vec![
+                testutil::grey("floor", 0.0, 0.5),
+                testutil::grey("wall", 0.0, 0.5),
+            ],
+        );
+        let options = MeshOptions {
+            lenmax: 0.25,
+            inset: crate::mesh::DEFAULT_INSET,
+        };
+        let mesh = build(&scene, &options).unwrap();
+        let visibility = Visibility::new(&scene);
+        assert!(pairs(&leaders(&scene, &mesh, &visibility, true)).is_empty());
+        // Without the wall, the same seam is shared.
+        let open = testutil::scene(
+            vec![floor(-1.0, 0.0), floor(0.0, 1.0)],
+            vec![testutil::grey("floor", 0.0, 0.5)],
+        );
+        let mesh = build(&open, &options).unwrap();
+        let shared = pairs(&leaders(&open, &mesh, &Visibility::new(&open), true));
+        assert!(shared.len() >= 5, "{shared:?}");
     }
 
     #[test]
     fn off_shares_nothing() {
         let (scene, mesh) = hinge(0.0, [0, 0], false);
-        assert!(leaders(&scene, &mesh, false).is_empty());
+        assert!(leaders(&scene, &mesh, &Visibility::new(&scene), false).is_empty());
     }
 }
