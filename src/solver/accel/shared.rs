@@ -113,17 +113,8 @@ pub fn leaders(scene: &Scene, mesh: &Mesh, visibility: &Visibility, on: bool) ->
     }
     // Per group (its root's run of pairs), who follows whom: each member
     // follows the lowest member it sees, in turn.
-    let mut runs: Vec<&[(u32, u32)]> = Vec::new();
     groups.sort_unstable();
-    let mut s = 0;
-    while s < groups.len() {
-        let e = s + groups[s..]
-            .iter()
-            .take_while(|g| g.0 == groups[s].0)
-            .count();
-        runs.push(&groups[s..e]);
-        s = e;
-    }
+    let runs: Vec<&[(u32, u32)]> = groups.chunk_by(|a, b| a.0 == b.0).collect();
     let follow: Vec<Vec<(u32, u32)>> = runs
         .par_iter()
         .map(|run| {
