@@ -189,6 +189,7 @@ mod tests {
             rays: 1 << 40,
             charges: Vec::new(),
             tail_from: None,
+            tail_began: Vec::new(),
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("solve.ckpt");

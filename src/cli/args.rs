@@ -160,10 +160,14 @@ pub struct Args {
 
     /// Particles per element vertex the tail traces over four steps.
     ///
-    /// The noise of the light the tail carries falls as one over the
-    /// square root of this.
+    /// The noise of the light they carry falls as one over the square root
+    /// of this. The tail ends with a final gather, in which every vertex
+    /// gathers one more bounce of their light over 64 directions: where
+    /// few particles landed (small elements) its answer replaces theirs,
+    /// which takes most of their noise out (`--without tail-gather` keeps
+    /// the particles' own).
     // The literal is crate::solver::tuning::TAIL_PARTICLES_PER_VERTEX.
-    #[arg(long, value_name = "N", default_value = "64", value_parser = parse_tail_particles)]
+    #[arg(long, value_name = "N", default_value = "16", value_parser = parse_tail_particles)]
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) tail_particles: f64,
 
@@ -218,7 +222,8 @@ pub struct Args {
     /// Each is one switch, measured against its twin: emitters-first,
     /// overshoot, settling, near-field, shaft-culling, clusters, strata,
     /// receiver-interpolation, weak-strata, crowded-cells, facet-rays,
-    /// sky-probes, far-shooters, shared-receivers, sky-at-once, hat-centroids.
+    /// sky-probes, far-shooters, shared-receivers, sky-at-once, hat-centroids,
+    /// tail-gather.
     /// `docs/accuracy.md` gives what each costs and buys.
     #[arg(long, value_name = "NAME,...", value_enum, value_delimiter = ',')]
     #[arg(help_heading = heading::SOLVER, hide_short_help = true)]

@@ -99,6 +99,11 @@ pub struct Approximations {
     /// mean rather than the light at its own point: at a surface's edge, a
     /// third of an element in. Off: from the vertex's evaluation point.
     pub hat_centroids: bool,
+    /// The particle tail's last step ends with a final gather: every
+    /// receiving vertex gathers one bounce of the tail's whole field over
+    /// its hemisphere, which replaces the particles' deposits on it
+    /// ([`super::step::tail_gather`]). Off: the particles' deposits stand.
+    pub tail_gather: bool,
 }
 
 /// The name of one switch of [`Approximations`], as the command line
@@ -167,11 +172,16 @@ pub enum Heuristic {
     /// [`Approximations::hat_centroids`].
     #[value(help = "under the sky a vertex asks from the centroid of the elements around it")]
     HatCentroids,
+    /// [`Approximations::tail_gather`].
+    #[value(
+        help = "the particle tail ends with each vertex gathering one bounce of its light, not the particles' deposits"
+    )]
+    TailGather,
 }
 
 impl Heuristic {
     /// Every switch, in the order of [`Approximations`]' fields.
-    pub const ALL: [Heuristic; 16] = [
+    pub const ALL: [Heuristic; 17] = [
         Heuristic::EmittersFirst,
         Heuristic::Overshoot,
         Heuristic::Settling,
@@ -188,6 +198,7 @@ impl Heuristic {
         Heuristic::SharedReceivers,
         Heuristic::SkyAtOnce,
         Heuristic::HatCentroids,
+        Heuristic::TailGather,
     ];
 
     /// The switches `--exact-receivers` turns off: every receiving vertex
@@ -222,6 +233,7 @@ impl Approximations {
         shared_receivers: true,
         sky_at_once: true,
         hat_centroids: true,
+        tail_gather: true,
     };
 
     /// The brute-force twin: no heuristic that trades accuracy or a
@@ -247,6 +259,7 @@ impl Approximations {
         shared_receivers: false,
         sky_at_once: false,
         hat_centroids: false,
+        tail_gather: false,
     };
 
     /// Whether switch `h` is on.
@@ -294,6 +307,7 @@ impl Approximations {
             Heuristic::SharedReceivers => &mut self.shared_receivers,
             Heuristic::SkyAtOnce => &mut self.sky_at_once,
             Heuristic::HatCentroids => &mut self.hat_centroids,
+            Heuristic::TailGather => &mut self.tail_gather,
         }
     }
 }

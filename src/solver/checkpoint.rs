@@ -8,17 +8,18 @@
 //! radiosity, the interpolation error charged to each vertex
 //! ([`super::receivers`]), the unshot fraction its particle tail takes
 //! over at (an automatic tail may take over early:
-//! [`super::step::tail`]), and the fixed inputs (scene, mesh, solver
+//! [`super::step::tail`]), the state its final gather reads
+//! ([`super::step::tail_gather`]), and the fixed inputs (scene, mesh, solver
 //! options); the step and ray counters are carried along for the
 //! statistics. Every value is
 //! stored as its exact `f64` bits, so a resumed solve continues bit for bit.
 //!
-//! The file format (version 4), all integers little-endian:
+//! The file format (version 5), all integers little-endian:
 //!
 //! ```text
 //! offset  size        field
 //! 0       8           magic "RADCKPT\0"
-//! 8       4           version (u32) = 4
+//! 8       4           version (u32) = 5
 //! 12      8           fingerprint (u64) of scene + mesh + solver options
 //! 20      8           steps taken (u64)
 //! 28      8           shadow rays cast (u64)
@@ -27,19 +28,28 @@
 //! 52      8           driver record length X (u64, in bytes)
 //! 60      8           charge entries C (u64, 0 or one per mesh vertex)
 //! 68      8           tail fraction (f64 bits; NaN when the tail is off)
-//! 76      24 R        radiosity: r, g, b as f64 bits per vertex
+//! 76      8           tail-began entries T (u64, 0 or three per mesh vertex)
+//! 84      24 R        radiosity: r, g, b as f64 bits per vertex
 //! ...     24 U        unshot radiosity: r, g, b as f64 bits per entry
 //! ...     24 C        interpolation error charged: r, g, b per vertex
+//! ...     24 T        the radiosity, then the unshot radiosity, per vertex
+//!                     when the particle tail began, then its particles'
+//!                     landings per vertex since (r: their count by
+//!                     barycentric weight, g: the sum of their deposits'
+//!                     squares; its final gather reads them)
 //! ...     X           the driver's record, opaque here (the batch run keeps
 //!                     its step log there, so a resumed log continues)
 //! end-8   8           checksum (u64): FNV-1a of every byte before it
 //! ```
 //!
-//! Version 3 is version 4 without the tail fraction (its header is 68
+//! Version 4 is version 5 without the tail-began entries (its header is
+//! 76 bytes); version 3 is version 4 without the tail fraction (68
 //! bytes); version 2 is version 3 without the charges (60 bytes); version
 //! 1 is version 2 without the record-length field and the record (52
 //! bytes). All are still read, with the tail as the options set it, with
-//! no charges before version 3 and version 1 with an empty record.
+//! no charges before version 3, version 1 with an empty record, and no
+//! tail-began entries before version 5 (a tail resumed from one gathers
+//! from the state it resumed at).
 //!
 //! The fingerprint covers what decides the solution: polygon geometry and
 //! materials (those `--emit` changed, and the facets and radiosity of a
@@ -60,13 +70,16 @@ use crate::solver::{FormFactorMethod, ShooterSamples, SolverOptions};
 pub const MAGIC: [u8; 8] = *b"RADCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 
 /// The oldest format version this build still reads.
 pub const OLDEST_VERSION: u32 = 1;
 
 /// Bytes before the radiosity data.
-const HEADER_LEN: usize = 76;
+const HEADER_LEN: usize = 84;
+
+/// Bytes before the radiosity data in version 4.
+const V4_HEADER_LEN: usize = 76;
 
 /// Bytes before the radiosity data in version 3.
 const V3_HEADER_LEN: usize = 68;
@@ -117,6 +130,12 @@ pub struct SolverState {
     /// have taken over early); `None` when the tail is off, or the
     /// checkpoint is older than version 4 (the options then decide).
     pub tail_from: Option<f64>,
+    /// The radiosity, then the unshot radiosity, per mesh vertex when
+    /// the particle tail began, then its particles' landings per vertex
+    /// since (`3 ×` the vertices), which its final gather reads ([`crate::solver::step::tail_gather`]); empty when no
+    /// tail is under way or it ends without the gather, and in
+    /// checkpoints before version 5.
+    pub tail_began: Vec<Rgb>,
 }
 
 /// Why checkpoint bytes cannot be decoded. The messages read as the end of
@@ -331,9 +350,10 @@ pub fn encode(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
         rays,
         charges,
         tail_from,
+        tail_began,
     } = state;
     let len = HEADER_LEN
-        + RGB_LEN * (radiosity.len() + unshot.len() + charges.len())
+        + RGB_LEN * (radiosity.len() + unshot.len() + charges.len() + tail_began.len())
         + record.len()
         + CHECKSUM_LEN;
     let mut out = Vec::with_capacity(len);
@@ -348,10 +368,16 @@ pub fn encode(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
         record.len() as u64,
         charges.len() as u64,
         tail_from.unwrap_or(f64::NAN).to_bits(),
+        tail_began.len() as u64,
     ] {
         out.extend_from_slice(&w.to_le_bytes());
     }
-    for c in radiosity.iter().chain(unshot).chain(charges) {
+    for c in radiosity
+        .iter()
+        .chain(unshot)
+        .chain(charges)
+        .chain(tail_began)
+    {
         for x in [c.r, c.g, c.b] {
             out.extend_from_slice(&x.to_bits().to_le_bytes());
         }
@@ -365,7 +391,7 @@ pub fn encode(fingerprint: u64, state: &SolverState, record: &[u8]) -> Vec<u8> {
 }
 
 /// Reads the fingerprint, state and driver record from checkpoint bytes
-/// (version 1 to 4), or says what is wrong with them. Never allocates more
+/// (version 1 to 5), or says what is wrong with them. Never allocates more
 /// than the input's size.
 pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
@@ -389,6 +415,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
         1 => V1_HEADER_LEN,
         2 => V2_HEADER_LEN,
         3 => V3_HEADER_LEN,
+        4 => V4_HEADER_LEN,
         _ => HEADER_LEN,
     };
     if bytes.len() < header_len + CHECKSUM_LEN {
@@ -403,9 +430,11 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
     } else {
         Some(f64::from_bits(u64_at(68))).filter(|f| !f.is_nan())
     };
+    let n_began = if version <= 4 { 0 } else { u64_at(76) };
     let expected = n_radiosity
         .checked_add(n_unshot)
         .and_then(|n| n.checked_add(n_charges))
+        .and_then(|n| n.checked_add(n_began))
         .and_then(|n| n.checked_mul(RGB_LEN as u64))
         .and_then(|n| n.checked_add(n_record))
         .and_then(|n| n.checked_add((header_len + CHECKSUM_LEN) as u64));
@@ -414,7 +443,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
             len: bytes.len(),
             radiosity: n_radiosity,
             unshot: n_unshot,
-            charges: n_charges,
+            charges: n_charges.saturating_add(n_began),
             record: n_record,
         });
     }
@@ -433,7 +462,8 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
         )
     };
     let (nr, nu, nc) = (n_radiosity as usize, n_unshot as usize, n_charges as usize);
-    let record_start = header_len + (nr + nu + nc) * RGB_LEN;
+    let nb = n_began as usize;
+    let record_start = header_len + (nr + nu + nc + nb) * RGB_LEN;
     Ok(Checkpoint {
         fingerprint,
         state: SolverState {
@@ -443,6 +473,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, DecodeError> {
             rays,
             charges: (nr + nu..nr + nu + nc).map(rgb_at).collect(),
             tail_from,
+            tail_began: (nr + nu + nc..nr + nu + nc + nb).map(rgb_at).collect(),
         },
         record: body[record_start..].to_vec(),
     })
@@ -460,6 +491,12 @@ mod tests {
             rays: 1 << 40,
             charges: vec![Rgb::new(0.0, 1e-9, 2.0), Rgb::BLACK],
             tail_from: Some(0.307),
+            tail_began: vec![
+                Rgb::new(0.5, 0.25, 0.125),
+                Rgb::BLACK,
+                Rgb::new(-1e-3, 4.0, 1e300),
+                Rgb::new(2.0, 2.0, 2.0),
+            ],
         }
     }
 
@@ -477,20 +514,26 @@ mod tests {
         assert_eq!(back.radiosity[1].b.to_bits(), 5e-324f64.to_bits());
     }
 
-    /// `state()` without charges or tail fraction, as versions 1 and 2
-    /// hold it.
+    /// `state()` without charges, tail fraction or tail-began entries, as
+    /// versions 1 and 2 hold it.
     fn uncharged() -> SolverState {
         SolverState {
             charges: Vec::new(),
             tail_from: None,
+            tail_began: Vec::new(),
             ..state()
         }
     }
 
-    /// Version `v` bytes made from version 4 bytes of `state`: the header
-    /// cut to `header` bytes, the record kept or not.
+    /// Version `v` bytes made from version 5 bytes of `state` (without
+    /// tail-began entries): the header cut to `header` bytes, the record
+    /// kept or not.
     fn older_of(state: &SolverState, v: u32, header: usize, record: &[u8]) -> Vec<u8> {
-        let v3 = encode(5, state, record);
+        let state = SolverState {
+            tail_began: Vec::new(),
+            ..state.clone()
+        };
+        let v3 = encode(5, &state, record);
         let mut out = v3[..8].to_vec();
         out.extend_from_slice(&v.to_le_bytes());
         out.extend_from_slice(&v3[12..header]);
@@ -521,11 +564,20 @@ mod tests {
     }
 
     #[test]
-    fn version_1_2_and_3_files_still_read() {
+    fn version_1_to_4_files_still_read() {
+        // Version 4 is version 5 without the tail-began entries.
+        let v4 = SolverState {
+            tail_began: Vec::new(),
+            ..state()
+        };
+        let back = decode(&older_of(&state(), 4, V4_HEADER_LEN, b"log")).unwrap();
+        assert_eq!(back.state, v4);
+        assert_eq!(back.record, b"log");
         // Version 3 is version 4 without the tail fraction: the options
         // decide it.
         let charged = SolverState {
             tail_from: None,
+            tail_began: Vec::new(),
             ..state()
         };
         let back = decode(&older_of(&state(), 3, V3_HEADER_LEN, b"log")).unwrap();

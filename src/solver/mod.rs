@@ -738,7 +738,13 @@ impl<'a> Progressive<'a> {
             state: 0,
             scans: std::sync::Mutex::new(Scans::default()),
             sun: sun::SunShot::for_scene(scene),
-            tail: step::tail::Tail::new(options.tail, options.tail_particles, scene, mesh),
+            tail: step::tail::Tail::new(
+                options.tail,
+                options.tail_particles,
+                options.approximations.tail_gather,
+                scene,
+                mesh,
+            ),
             // A daylight sky's luminance varies within a facet (its
             // samples are weighted by it), which the dome's per-facet
             // light does not hold: such a sky shoots facet by facet.
@@ -1116,6 +1122,8 @@ impl<'a> Progressive<'a> {
             // Interpolation on the refined mesh starts with no charges.
             charges: Vec::new(),
             tail_from: self.tail.from(),
+            // A tail on the refined mesh gathers from where it resumes.
+            tail_began: Vec::new(),
         }))
     }
 
@@ -1166,6 +1174,7 @@ impl<'a> Progressive<'a> {
             rays: self.rays,
             charges: self.charges().to_vec(),
             tail_from: self.tail.from(),
+            tail_began: self.tail.began_values(),
         }
     }
 
@@ -1204,9 +1213,12 @@ impl<'a> Progressive<'a> {
         if state.radiosity.iter().chain(&state.charges).any(bad)
             || state.unshot.iter().any(bad_unshot)
             || state.tail_from.is_some_and(|f| !(0.0..=1.0).contains(&f))
+            || !(state.tail_began.is_empty() || state.tail_began.len() == 3 * self.radiosity.len())
+            || state.tail_began.iter().any(bad_unshot)
         {
             return Err(SolverError::BadStateValue);
         }
+        self.tail.set_began(state.tail_began);
         if let (Some(from), Some(_)) = (state.tail_from, self.tail.from) {
             self.tail.from = Some(from);
         }

@@ -19,7 +19,7 @@
 //! | gathering from a cluster | `step::gather_cluster`, `accel::cluster` | [`WEAK_STRATUM_SHARE`], [`STRATUM_NEAR_RATIO`], [`PLANE_DEPTH_RATIO`], [`TOP_DEPTH_RATIO`], [`RESTING_NEAR_FACTOR`], [`RESTING_TOLERANCE`] |
 //! | delivering a step in parts | `step::parts` | [`CHUNK_WORK`], [`PIECE_WORK`], [`CHUNK_GROWTH`], [`PIECE_GROWTH`], [`CHUNK_TARGET`], [`NEAR_WEIGHT`], [`WINDOW_PART_BUDGET`] |
 //! | the hemicube | `hemicube` | [`DEFAULT_HEMICUBE_RES`], [`HEMICUBE_EDGE_SLACK`], [`HEMICUBE_NEAR_FRACTION`] |
-//! | the particle tail | `step::tail` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_COSTLY_RATIO`], [`TAIL_EARLY_FROM`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_PART_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
+//! | the particle tail | `step::tail`, `step::tail_gather` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_COSTLY_RATIO`], [`TAIL_EARLY_FROM`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_GATHER_RAYS`], [`TAIL_GATHER_BATCH`], [`TAIL_GATHER_PART_BATCH`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_PART_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
 //!
 //! Structural constants (how many ray slots a cluster step keeps, the
 //! sub-cell grid's side, file-format fields) stay with the code whose
@@ -533,10 +533,29 @@ pub const TAIL_COSTLY_RATIO: f64 = 5.0;
 pub const TAIL_EARLY_FROM: f64 = 0.5;
 
 /// Particles per element vertex the tail traces over four steps, a
-/// quarter each, by default (`--tail-particles`): from 30 %, 16 left `room.glb`'s picture
-/// 3.35 % off the path tracer, 64 1.95 %, 128 1.66 % (measured with
-/// [`TAIL_AUTO_FROM`]); a particle costs about 1.4 µs of CPU there.
-pub const TAIL_PARTICLES_PER_VERTEX: f64 = 64.0;
+/// quarter each, by default (`--tail-particles`). Without the final
+/// gather, from 30 %, 16 left `room.glb`'s picture 3.35 % off the path
+/// tracer, 64 1.95 %, 128 1.66 %; a particle costs about 1.4 µs of CPU
+/// there. The gather ([`TAIL_GATHER_RAYS`]) averages the particles'
+/// noise away: after it, 16 a vertex left `fortitude.obj` 2.25 % off in
+/// 126 s wall, 64 2.21 % in 171 s, and 8 2.36 % (64 without it: 2.91 %
+/// in 155 s).
+pub const TAIL_PARTICLES_PER_VERTEX: f64 = 16.0;
+
+/// Directions each receiving vertex gathers the tail's field over in the
+/// final gather (`step::tail_gather`): an 8 × 8 stratified grid of the
+/// cosine-weighted hemisphere. Measured on `fortitude.obj` after 16
+/// particles a vertex: 36 left it 2.98 % off the path tracer, 64 2.25 %;
+/// the 64 cost about 15 s of its 126 s wall.
+pub const TAIL_GATHER_RAYS: usize = 64;
+
+/// Gathering vertices run together between checks for an interrupt in
+/// the final gather (about 0.15 s on two cores at 64 directions each).
+pub const TAIL_GATHER_BATCH: usize = 4096;
+
+/// Gathering vertices run together in a final gather delivered in parts
+/// (the window's part budget): about 20 ms on two cores.
+pub const TAIL_GATHER_PART_BATCH: usize = 512;
 
 /// Steps over which the tail shoots the light left: each an equal share
 /// of it, so the picture moves between them.
@@ -923,6 +942,21 @@ pub const INDEX: &[Tuned] = &[
         name: "TAIL_PARTICLES_PER_VERTEX",
         phase: Phase::Tail,
         value: TAIL_PARTICLES_PER_VERTEX,
+    },
+    Tuned {
+        name: "TAIL_GATHER_RAYS",
+        phase: Phase::Tail,
+        value: TAIL_GATHER_RAYS as f64,
+    },
+    Tuned {
+        name: "TAIL_GATHER_BATCH",
+        phase: Phase::Tail,
+        value: TAIL_GATHER_BATCH as f64,
+    },
+    Tuned {
+        name: "TAIL_GATHER_PART_BATCH",
+        phase: Phase::Tail,
+        value: TAIL_GATHER_PART_BATCH as f64,
     },
     Tuned {
         name: "TAIL_STEPS",

@@ -29,6 +29,7 @@ pub mod parts;
 pub mod read;
 pub mod sky;
 pub mod tail;
+pub mod tail_gather;
 
 /// A step begun: what it shoots, how, and how far it has got.
 #[derive(Clone, Debug)]

@@ -104,6 +104,12 @@ impl<'a> Progressive<'a> {
         !pm.sky && pm.vertex_count() > 0 && !self.reflectance[j].is_black()
     }
 
+    /// Whether a vertex asks the sky from its hat's centroid
+    /// ([`crate::solver::accel::hat`]).
+    pub(in crate::solver) fn hat_centroids(&self) -> bool {
+        self.sky.hat_centroids
+    }
+
     /// Whether element vertex `l` gathers the sky itself: its polygon
     /// receives, and it is not a shared receiver's follower.
     fn gathers_sky(&self, l: usize) -> bool {

@@ -35,6 +35,10 @@
 //! TAIL_STEPS`, so the picture moves between them, and a solve resumed
 //! from a checkpoint takes the same steps).
 //!
+//! The last step ends with a final gather ([`super::tail_gather`]):
+//! where few particles landed on a vertex, one bounce of their light
+//! gathered over its hemisphere takes the place of their deposits.
+//!
 //! An automatic tail also takes over early (at an unshot fraction of at
 //! most [`TAIL_EARLY_FROM`]) after a shooting step that cost more rays
 //! for its light than particles would ([`TAIL_COSTLY_RATIO`],
@@ -55,9 +59,11 @@ use crate::color::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::{PolygonId, Scene};
 use crate::solver::accel::shared::ALONE;
+use crate::solver::step::tail_gather::{Began, FinalGather};
 use crate::solver::tuning::{
-    TAIL_BATCH, TAIL_CHUNK, TAIL_COSTLY_RATIO, TAIL_EARLY_FROM, TAIL_MAX_BOUNCES,
-    TAIL_PARTICLES_PER_VERTEX, TAIL_PART_BATCH, TAIL_STEPS, TAIL_SURVIVAL_MAX,
+    TAIL_BATCH, TAIL_CHUNK, TAIL_COSTLY_RATIO, TAIL_EARLY_FROM, TAIL_GATHER_BATCH,
+    TAIL_GATHER_PART_BATCH, TAIL_GATHER_RAYS, TAIL_MAX_BOUNCES, TAIL_PARTICLES_PER_VERTEX,
+    TAIL_PART_BATCH, TAIL_STEPS, TAIL_SURVIVAL_MAX,
 };
 use crate::solver::unshot::TriangleLocator;
 use crate::solver::{Progressive, StepReport, TailOption};
@@ -88,6 +94,12 @@ pub(in crate::solver) struct Tail {
     /// The tail step begun and not finished, when it is delivered in
     /// parts ([`crate::solver::SolverOptions::part_budget`]).
     pub(in crate::solver) underway: Option<Box<TailUnderway>>,
+    /// Whether the last step ends with the final gather
+    /// ([`super::tail_gather`]).
+    gather: bool,
+    /// The state when the tail began in this solve, which the final
+    /// gather reads; taken by it.
+    began: Option<Box<Began>>,
 }
 
 impl Tail {
@@ -98,6 +110,7 @@ impl Tail {
     pub(in crate::solver) fn new(
         option: TailOption,
         per_vertex: f64,
+        gather: bool,
         scene: &Scene,
         mesh: &Mesh,
     ) -> Tail {
@@ -125,6 +138,8 @@ impl Tail {
                 .collect(),
             tables: OnceLock::new(),
             underway: None,
+            gather,
+            began: None,
         }
     }
 
@@ -137,6 +152,42 @@ impl Tail {
         let from = self.from.unwrap_or(0.0);
         let level = levels_below(from, fraction).next().unwrap_or(0.0);
         (1.0 - level / fraction).clamp(0.0, 1.0)
+    }
+
+    /// The state the final gather reads, as a checkpoint stores it: per
+    /// vertex the radiosity, then the unshot radiosity, when the tail
+    /// began, then the particles' landings since (their count by weight
+    /// in `r`, the sum of their deposits' squares in `g`); empty when
+    /// none is held.
+    pub(in crate::solver) fn began_values(&self) -> Vec<Rgb> {
+        self.began
+            .as_ref()
+            .map(|b| {
+                let landed = b.landed.iter().map(|&(w, q)| Rgb::new(w, q, 0.0));
+                b.radiosity
+                    .iter()
+                    .chain(&b.unshot)
+                    .copied()
+                    .chain(landed)
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// Takes the state [`Tail::began_values`] gave (empty: none; else
+    /// three entries per vertex, checked by the caller). A tail without
+    /// the final gather holds none.
+    pub(in crate::solver) fn set_began(&mut self, mut values: Vec<Rgb>) {
+        self.began = (self.gather && !values.is_empty()).then(|| {
+            let n = values.len() / 3;
+            let landed = values.split_off(2 * n).iter().map(|c| (c.r, c.g)).collect();
+            let unshot = values.split_off(n);
+            Box::new(Began {
+                radiosity: values,
+                unshot,
+                landed,
+            })
+        });
     }
 
     /// The unshot fraction at or below which the tail takes over; `None`
@@ -272,16 +323,18 @@ impl Tables {
 }
 
 /// One particle's deposit: the reflected power that landed at a vertex,
-/// in radiosity × area units.
-type Deposit = (u32, Rgb);
+/// in radiosity × area units, and the landing's barycentric weight there.
+type Deposit = (u32, Rgb, f32);
 
 /// A random stream for one particle: SplitMix64 (Steele, Lea and Flood
 /// 2014) from a hash of the step and the particle's index, so that every
 /// particle draws the same numbers on any thread.
-struct Stream(u64);
+pub(in crate::solver) struct Stream(u64);
 
 impl Stream {
-    fn new(step: u64, particle: u64) -> Stream {
+    /// The stream of particle (or vertex) `particle` of step (or pass)
+    /// `step`.
+    pub(in crate::solver) fn new(step: u64, particle: u64) -> Stream {
         Stream(
             step.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ particle.wrapping_mul(0xD1B5_4A32_D192_ED03),
         )
@@ -296,7 +349,7 @@ impl Stream {
     }
 
     /// Uniform in `[0, 1)`.
-    fn uniform(&mut self) -> f64 {
+    pub(in crate::solver) fn uniform(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 }
@@ -311,7 +364,7 @@ fn cosine_direction(normal: DVec3, s: &mut Stream) -> DVec3 {
 }
 
 /// What one tail step needs to trace: read-only views of the solve.
-struct Tracer<'t> {
+pub(in crate::solver) struct Tracer<'t> {
     mesh: &'t Mesh,
     visibility: &'t Visibility,
     reflectance: &'t [Rgb],
@@ -338,6 +391,33 @@ impl Tracer<'_> {
             .flatten()
             .map(|b| b as usize)
             .filter(|&b| facing(b))
+    }
+
+    /// How far off a surface a ray starts, in scene units
+    /// ([`Tables::offset`]).
+    pub(in crate::solver) fn offset(&self) -> f32 {
+        self.tables.offset
+    }
+
+    /// Where a ray from `start` along unit `d` lands: the polygon whose
+    /// front it meets (one that reflects), the point, and the element
+    /// triangle there with its barycentric weights; `None` when it leaves
+    /// the model, meets a back that absorbs, or lands where nothing is
+    /// reflected.
+    pub(in crate::solver) fn land(&self, start: Vec3, d: Vec3) -> Option<Landing> {
+        let (hit, t) = self.visibility.first_hit(start, d)?;
+        let r = self.receiver(hit, d)?;
+        if !self.reflects[r] {
+            return None;
+        }
+        let at = start + d * t;
+        let (corners, weights) = self.landing(r, at)?;
+        Some(Landing {
+            polygon: r,
+            at,
+            corners,
+            weights,
+        })
     }
 
     /// The element triangle of polygon `j` holding `p`, its corners and
@@ -368,22 +448,18 @@ impl Tracer<'_> {
             let d = cosine_direction(normal, s).as_vec3();
             let start = origin + normal.as_vec3() * self.tables.offset;
             rays += 1;
-            let Some((hit, t)) = self.visibility.first_hit(start, d) else {
-                break;
-            };
-            let Some(r) = self.receiver(hit, d) else {
-                break;
-            };
-            if !self.reflects[r] {
-                break;
-            }
-            let at = start + d * t;
-            let Some((corners, w)) = self.landing(r, at) else {
+            let Some(Landing {
+                polygon: r,
+                at,
+                corners,
+                weights: w,
+            }) = self.land(start, d)
+            else {
                 break;
             };
             let reflected = power * self.reflectance[r];
             for (c, w) in corners.iter().zip(w) {
-                out.push((*c, reflected * w));
+                out.push((*c, reflected * w, w as f32));
             }
             let survival = self.reflectance[r].max_channel().min(TAIL_SURVIVAL_MAX);
             if survival <= 0.0 || s.uniform() >= survival {
@@ -395,6 +471,18 @@ impl Tracer<'_> {
         }
         rays
     }
+}
+
+/// Where a ray lands ([`Tracer::land`]).
+pub(in crate::solver) struct Landing {
+    /// The polygon whose front it meets.
+    pub(in crate::solver) polygon: usize,
+    /// The point, in scene units.
+    pub(in crate::solver) at: Vec3,
+    /// The element triangle's corners (mesh vertices) and the point's
+    /// barycentric weights in it (`>= 0`, summing to 1).
+    pub(in crate::solver) corners: [u32; 3],
+    pub(in crate::solver) weights: [f64; 3],
 }
 
 /// The emitting triangles of one tail step, for choosing where each
@@ -430,12 +518,17 @@ pub(in crate::solver) struct TailUnderway {
     next: u64,
     /// Received power per vertex, summed in particle order.
     received: Vec<Rgb>,
+    /// Per vertex, the landings on it, each counted by its barycentric
+    /// weight there.
+    landed: Vec<(f64, f64)>,
     rays: u64,
     /// Parts delivered so far.
     part: u32,
     /// The radiosity before the step, once a part has shown the light so
     /// far in its place.
     base: Option<Vec<Rgb>>,
+    /// The final gather, once the last step's particles are all traced.
+    gather: Option<Box<FinalGather>>,
 }
 
 impl<'a> Progressive<'a> {
@@ -489,7 +582,17 @@ impl<'a> Progressive<'a> {
     ) -> Option<StepReport> {
         let mut u = match self.tail.underway.take() {
             Some(u) => u,
-            None => Box::new(self.begin_tail()?),
+            None => {
+                let u = Box::new(self.begin_tail()?);
+                if self.tail.gather && self.tail.began.is_none() {
+                    self.tail.began = Some(Box::new(Began {
+                        radiosity: self.radiosity.clone(),
+                        unshot: self.unshot_at_vertices(),
+                        landed: vec![(0.0, 0.0); self.mesh.vertex_count()],
+                    }));
+                }
+                u
+            }
         };
         let budget = self.options.part_budget;
         let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
@@ -569,12 +672,18 @@ impl<'a> Progressive<'a> {
             }
             for (out, r) in results {
                 u.rays += r;
-                for (v, p) in out {
+                for (v, p, w) in out {
                     received[v as usize] += p;
+                    let at = &mut u.landed[v as usize];
+                    at.0 += f64::from(w);
+                    at.1 += p.mean() * p.mean();
                 }
             }
             u.next = batch_end;
-            self.gauge.set(u.next, u.chunks);
+            self.gauge.set(
+                u.next,
+                u.chunks + self.gather_units(&u, self.mesh.vertex_count()),
+            );
             if budget.is_some_and(|b| start.elapsed() >= b) && u.next < u.chunks {
                 break;
             }
@@ -593,30 +702,7 @@ impl<'a> Progressive<'a> {
         }
         let delta = self.tail_delta(&u.received);
         if u.next < u.chunks {
-            // A part: the light landed so far, over the radiosity before
-            // the step.
-            u.part += 1;
-            let base = u.base.get_or_insert_with(|| self.radiosity.clone());
-            for ((b, before), d) in self.radiosity.iter_mut().zip(base.iter()).zip(&delta) {
-                *b = (*before + *d).max(Rgb::BLACK);
-            }
-            self.changed();
-            let report = StepReport {
-                step: self.steps + 1,
-                shooter: PolygonId(heaviest(&u.per_polygon) as u32),
-                polygons: u.per_polygon.iter().filter(|&&w| w > 0.0).count() as u32,
-                shot_power: u.share * self.net_unshot_power(),
-                unshot_fraction: self.unshot_fraction(),
-                rays: u.rays,
-                pairs: u.rays,
-                receivers: 0,
-                clear_receivers: 0,
-                part: u.part,
-                complete: false,
-                particles: u.next.saturating_mul(TAIL_CHUNK).min(u.count),
-            };
-            self.tail.underway = Some(u);
-            return Some(report);
+            return Some(self.tail_part(u, &delta));
         }
         if !delta.iter().all(|d| d.is_finite()) {
             if let Some(base) = u.base.take() {
@@ -625,18 +711,50 @@ impl<'a> Progressive<'a> {
             }
             return None;
         }
+        // The last step ends with the final gather (`tail_gather`).
+        let mut gathered = None;
+        if u.share >= 1.0 {
+            if let Some(began) = self.tail.began.take() {
+                match self.run_final_gather(&mut u, &began, &delta, start, cancel) {
+                    Some(true) => {
+                        let g = u.gather.take().expect("a final gather that is done");
+                        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
+                        let hat = tables.hat.clone();
+                        u.rays += g.rays;
+                        let after = self.after_particles(&u, &delta);
+                        gathered =
+                            Some(self.final_gather_result(&g, &began, &after, &u.landed, &hat));
+                    }
+                    Some(false) => {
+                        self.tail.began = Some(began);
+                        return Some(self.tail_part(u, &delta));
+                    }
+                    None => {
+                        self.tail.began = Some(began);
+                        if budget.is_some() {
+                            self.tail.underway = Some(u);
+                        } else if let Some(base) = u.base.take() {
+                            self.radiosity = base;
+                            self.changed();
+                        }
+                        return None;
+                    }
+                }
+            }
+        }
         let shot_power = u.share * self.net_unshot_power();
         let shooter = heaviest(&u.per_polygon);
         let polygons = u.per_polygon.iter().filter(|&&w| w > 0.0).count() as u32;
         // Negative particles (light sent ahead coming back) may take a
         // dark vertex a hair below zero by their noise.
-        match u.base.take() {
-            Some(base) => {
+        match (gathered, u.base.take()) {
+            (Some(gathered), _) => self.radiosity = gathered,
+            (None, Some(base)) => {
                 for ((b, before), d) in self.radiosity.iter_mut().zip(&base).zip(&delta) {
                     *b = (*before + *d).max(Rgb::BLACK);
                 }
             }
-            None => {
+            (None, None) => {
                 for (b, d) in self.radiosity.iter_mut().zip(&delta) {
                     *b = (*b + *d).max(Rgb::BLACK);
                 }
@@ -644,6 +762,12 @@ impl<'a> Progressive<'a> {
         }
         self.unshot.scale(1.0 - u.share);
         self.changed();
+        if let Some(b) = self.tail.began.as_mut() {
+            for (a, w) in b.landed.iter_mut().zip(&u.landed) {
+                a.0 += w.0;
+                a.1 += w.1;
+            }
+        }
         self.tail.particles += u.count;
         self.steps += 1;
         self.rays += u.rays;
@@ -670,6 +794,110 @@ impl<'a> Progressive<'a> {
             complete: true,
             particles: u.count,
         })
+    }
+
+    /// A part of tail step `u`: the light landed so far (`delta` per
+    /// vertex) shown over the radiosity before the step, and its report;
+    /// the step stays under way.
+    fn tail_part(&mut self, mut u: Box<TailUnderway>, delta: &[Rgb]) -> StepReport {
+        u.part += 1;
+        let base = u.base.get_or_insert_with(|| self.radiosity.clone());
+        for ((b, before), d) in self.radiosity.iter_mut().zip(base.iter()).zip(delta) {
+            *b = (*before + *d).max(Rgb::BLACK);
+        }
+        self.changed();
+        let gather_rays = u.gather.as_ref().map_or(0, |g| g.rays);
+        let report = StepReport {
+            step: self.steps + 1,
+            shooter: PolygonId(heaviest(&u.per_polygon) as u32),
+            polygons: u.per_polygon.iter().filter(|&&w| w > 0.0).count() as u32,
+            shot_power: u.share * self.net_unshot_power(),
+            unshot_fraction: self.unshot_fraction(),
+            rays: u.rays + gather_rays,
+            pairs: u.rays + gather_rays,
+            receivers: 0,
+            clear_receivers: 0,
+            part: u.part,
+            complete: false,
+            particles: u.next.saturating_mul(TAIL_CHUNK).min(u.count),
+        };
+        self.tail.underway = Some(u);
+        report
+    }
+
+    /// The radiosity once step `u`'s particles have all landed, `delta`
+    /// per vertex: over the radiosity before the step.
+    fn after_particles(&self, u: &TailUnderway, delta: &[Rgb]) -> Vec<Rgb> {
+        let before = u.base.as_ref().unwrap_or(&self.radiosity);
+        before
+            .iter()
+            .zip(delta)
+            .map(|(b, d)| (*b + *d).max(Rgb::BLACK))
+            .collect()
+    }
+
+    /// The final gather's work, in the units of the particles' chunks (a
+    /// chunk's particles cast about four rays each), for step `u` over
+    /// `vertices` gathering vertices: 0 unless `u` is the tail's last
+    /// step and ends with the gather.
+    fn gather_units(&self, u: &TailUnderway, vertices: usize) -> u64 {
+        if u.share >= 1.0 && self.tail.began.is_some() {
+            (vertices as u64 * TAIL_GATHER_RAYS as u64).div_ceil(4 * TAIL_CHUNK)
+        } else {
+            0
+        }
+    }
+
+    /// Runs step `u`'s final gather (begun from `began` and the
+    /// particles' `delta` if not yet) until it is done (`Some(true)`),
+    /// the part budget since `start` is spent (`Some(false)`) or `cancel`
+    /// is set (`None`; the batch cut short is dropped).
+    fn run_final_gather(
+        &mut self,
+        u: &mut TailUnderway,
+        began: &Began,
+        delta: &[Rgb],
+        start: std::time::Instant,
+        cancel: &AtomicBool,
+    ) -> Option<bool> {
+        if u.gather.is_none() {
+            let after = self.after_particles(u, delta);
+            u.gather = Some(Box::new(self.begin_final_gather(
+                began,
+                &after,
+                &u.reflects,
+            )));
+        }
+        let budget = self.options.part_budget;
+        let batch = if budget.is_some() {
+            TAIL_GATHER_PART_BATCH
+        } else {
+            TAIL_GATHER_BATCH
+        };
+        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
+        let tracer = Tracer {
+            mesh: &self.mesh,
+            visibility: self.visibility,
+            reflectance: &self.reflectance,
+            reflects: &u.reflects,
+            twin: &self.tail.twin,
+            tables,
+        };
+        let g = u.gather.as_mut().expect("begun above");
+        while !g.done() {
+            if cancel.load(Ordering::Relaxed) || !self.final_gather_batch(g, &tracer, batch, cancel)
+            {
+                return None;
+            }
+            let (done, heads) = g.progress();
+            let units = |n: u64| (n * TAIL_GATHER_RAYS as u64).div_ceil(4 * TAIL_CHUNK);
+            self.gauge
+                .set(u.chunks + units(done), u.chunks + units(heads));
+            if budget.is_some_and(|b| start.elapsed() >= b) && !g.done() {
+                return Some(false);
+            }
+        }
+        Some(true)
     }
 
     /// Begins a tail step: its share, where its particles start and what
@@ -740,9 +968,11 @@ impl<'a> Progressive<'a> {
             chunks: count.div_ceil(TAIL_CHUNK),
             next: 0,
             received: vec![Rgb::BLACK; self.mesh.vertex_count()],
+            landed: vec![(0.0, 0.0); self.mesh.vertex_count()],
             rays: 0,
             part: 0,
             base: None,
+            gather: None,
         })
     }
 

@@ -198,6 +198,7 @@ fn a_cluster_shot_matches_lambert() {
             rays: 0,
             charges: Vec::new(),
             tail_from: None,
+            tail_began: Vec::new(),
         })
         .unwrap();
     let report = solver.step().unwrap();
