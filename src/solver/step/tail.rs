@@ -595,15 +595,7 @@ impl<'a> Progressive<'a> {
             }
         };
         let budget = self.options.part_budget;
-        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
-        let tracer = Tracer {
-            mesh: &self.mesh,
-            visibility: self.visibility,
-            reflectance: &self.reflectance,
-            reflects: &u.reflects,
-            twin: &self.tail.twin,
-            tables,
-        };
+        let tracer = self.tracer(&u.reflects);
         let mut received = std::mem::take(&mut u.received);
         let mut cancelled = false;
         while u.next < u.chunks {
@@ -641,7 +633,8 @@ impl<'a> Progressive<'a> {
                             sources.cumulative[n - 1]
                         };
                         let weight = sources.cumulative[n] - before;
-                        let (corners, area) = tables.triangles[sources.triangles[n] as usize];
+                        let (corners, area) =
+                            tracer.tables.triangles[sources.triangles[n] as usize];
                         // A uniform point of the triangle.
                         let (r1, r2) = (s.uniform().sqrt(), s.uniform());
                         let b = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
@@ -796,6 +789,19 @@ impl<'a> Progressive<'a> {
         })
     }
 
+    /// What tail particles and the final gather trace with, `reflects`
+    /// per polygon.
+    fn tracer<'t>(&'t self, reflects: &'t [bool]) -> Tracer<'t> {
+        Tracer {
+            mesh: &self.mesh,
+            visibility: self.visibility,
+            reflectance: &self.reflectance,
+            reflects,
+            twin: &self.tail.twin,
+            tables: self.tail.tables.get_or_init(|| Tables::new(&self.mesh)),
+        }
+    }
+
     /// A part of tail step `u`: the light landed so far (`delta` per
     /// vertex) shown over the radiosity before the step, and its report;
     /// the step stays under way.
@@ -874,15 +880,7 @@ impl<'a> Progressive<'a> {
         } else {
             TAIL_GATHER_BATCH
         };
-        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
-        let tracer = Tracer {
-            mesh: &self.mesh,
-            visibility: self.visibility,
-            reflectance: &self.reflectance,
-            reflects: &u.reflects,
-            twin: &self.tail.twin,
-            tables,
-        };
+        let tracer = self.tracer(&u.reflects);
         let g = u.gather.as_mut().expect("begun above");
         while !g.done() {
             if cancel.load(Ordering::Relaxed) || !self.final_gather_batch(g, &tracer, batch, cancel)

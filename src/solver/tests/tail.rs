@@ -118,16 +118,7 @@ fn the_tail_balances_energy_in_a_closed_box() {
 #[test]
 fn the_tail_matches_shooting_to_the_end() {
     let s = shadowed_box();
-    let exact = solve(
-        &s,
-        0.1,
-        crate::mesh::DEFAULT_INSET,
-        SolverOptions {
-            tail: TailOption::Off,
-            threshold: 1e-4,
-            ..Default::default()
-        },
-    );
+    let exact = shot_to_the_end(&s);
     let tailed = solve(&s, 0.1, crate::mesh::DEFAULT_INSET, tail(0.05, 400.0));
     assert!(
         tailed.steps < exact.steps,
@@ -135,22 +126,42 @@ fn the_tail_matches_shooting_to_the_end() {
         tailed.steps,
         exact.steps
     );
-    let n = exact.radiosity.len() as f64;
-    let l1 = exact
-        .radiosity
-        .iter()
-        .zip(&tailed.radiosity)
-        .map(|(a, b)| (a.mean() - b.mean()).abs() / a.mean())
-        .sum::<f64>()
-        / n;
-    let mean = |r: &[Rgb]| r.iter().map(|b| b.mean()).sum::<f64>() / n;
-    let bias = mean(&tailed.radiosity) / mean(&exact.radiosity) - 1.0;
+    let (l1, bias) = l1_and_bias(&tailed.radiosity, &exact.radiosity);
     eprintln!(
         "steps {} vs {}: relative L1 {l1:.5}, bias {bias:+.5}",
         tailed.steps, exact.steps
     );
     assert!(l1 < 0.01, "{l1}");
     assert!(bias.abs() < 0.003, "{bias}");
+}
+
+/// `s` solved by shooting steps to 10⁻⁴ of the power, without the tail.
+fn shot_to_the_end(s: &Scene) -> Solved {
+    solve(
+        s,
+        0.1,
+        crate::mesh::DEFAULT_INSET,
+        SolverOptions {
+            tail: TailOption::Off,
+            threshold: 1e-4,
+            ..Default::default()
+        },
+    )
+}
+
+/// The mean relative difference per vertex of `radiosity` from `exact`
+/// (by the mean of the channels), and the relative difference of their
+/// means.
+fn l1_and_bias(radiosity: &[Rgb], exact: &[Rgb]) -> (f64, f64) {
+    let n = exact.len() as f64;
+    let l1 = exact
+        .iter()
+        .zip(radiosity)
+        .map(|(a, b)| (a.mean() - b.mean()).abs() / a.mean())
+        .sum::<f64>()
+        / n;
+    let mean = |r: &[Rgb]| r.iter().map(|b| b.mean()).sum::<f64>() / n;
+    (l1, mean(radiosity) / mean(exact) - 1.0)
 }
 
 /// The final gather ([`crate::solver::step::tail_gather`]) against its
@@ -163,32 +174,14 @@ fn the_tail_matches_shooting_to_the_end() {
 #[test]
 fn the_final_gather_takes_the_noise_out_of_few_particles() {
     let s = shadowed_box();
-    let exact = solve(
-        &s,
-        0.1,
-        crate::mesh::DEFAULT_INSET,
-        SolverOptions {
-            tail: TailOption::Off,
-            threshold: 1e-4,
-            ..Default::default()
-        },
-    );
-    let n = exact.radiosity.len() as f64;
-    let mean = |r: &[Rgb]| r.iter().map(|b| b.mean()).sum::<f64>() / n;
+    let exact = shot_to_the_end(&s);
     let off_by = |gather: bool| {
         let options = SolverOptions {
             approximations: Approximations::DEFAULT.with(Heuristic::TailGather, gather),
             ..tail(0.3, 4.0)
         };
         let tailed = solve(&s, 0.1, crate::mesh::DEFAULT_INSET, options);
-        let l1 = exact
-            .radiosity
-            .iter()
-            .zip(&tailed.radiosity)
-            .map(|(a, b)| (a.mean() - b.mean()).abs() / a.mean())
-            .sum::<f64>()
-            / n;
-        let bias = mean(&tailed.radiosity) / mean(&exact.radiosity) - 1.0;
+        let (l1, bias) = l1_and_bias(&tailed.radiosity, &exact.radiosity);
         eprintln!("gather {gather}: relative L1 {l1:.5}, bias {bias:+.5}");
         (l1, bias)
     };
