@@ -683,14 +683,7 @@ impl<'a> Progressive<'a> {
         }
         u.received = received;
         if cancelled {
-            // Without parts a cancelled step never happened; with them the
-            // next call continues after the last part delivered.
-            if budget.is_some() {
-                self.tail.underway = Some(u);
-            } else if let Some(base) = u.base.take() {
-                self.radiosity = base;
-                self.changed();
-            }
+            self.tail_cancelled(u);
             return None;
         }
         let delta = self.tail_delta(&u.received);
@@ -711,12 +704,11 @@ impl<'a> Progressive<'a> {
                 match self.run_final_gather(&mut u, &began, &delta, start, cancel) {
                     Some(true) => {
                         let g = u.gather.take().expect("a final gather that is done");
-                        let tables = self.tail.tables.get_or_init(|| Tables::new(&self.mesh));
-                        let hat = tables.hat.clone();
                         u.rays += g.rays;
                         let after = self.after_particles(&u, &delta);
+                        let hat = &self.tail.tables.get_or_init(|| Tables::new(&self.mesh)).hat;
                         gathered =
-                            Some(self.final_gather_result(&g, &began, &after, &u.landed, &hat));
+                            Some(self.final_gather_result(&g, &began, &after, &u.landed, hat));
                     }
                     Some(false) => {
                         self.tail.began = Some(began);
@@ -724,12 +716,7 @@ impl<'a> Progressive<'a> {
                     }
                     None => {
                         self.tail.began = Some(began);
-                        if budget.is_some() {
-                            self.tail.underway = Some(u);
-                        } else if let Some(base) = u.base.take() {
-                            self.radiosity = base;
-                            self.changed();
-                        }
+                        self.tail_cancelled(u);
                         return None;
                     }
                 }
@@ -787,6 +774,18 @@ impl<'a> Progressive<'a> {
             complete: true,
             particles: u.count,
         })
+    }
+
+    /// Tail step `u` was cancelled: without parts it never happened (the
+    /// radiosity before it comes back); with them the next call goes on
+    /// after the last part delivered.
+    fn tail_cancelled(&mut self, mut u: Box<TailUnderway>) {
+        if self.options.part_budget.is_some() {
+            self.tail.underway = Some(u);
+        } else if let Some(base) = u.base.take() {
+            self.radiosity = base;
+            self.changed();
+        }
     }
 
     /// What tail particles and the final gather trace with, `reflects`
