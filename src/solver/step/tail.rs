@@ -357,9 +357,15 @@ impl Stream {
 /// A cosine-weighted direction about the unit `normal`.
 fn cosine_direction(normal: DVec3, s: &mut Stream) -> DVec3 {
     let (u1, u2) = (s.uniform(), s.uniform());
+    let (t, b) = normal.any_orthonormal_pair();
+    cosine(normal, t, b, u1, u2)
+}
+
+/// The cosine-weighted direction of the unit square's point `(u1, u2)`
+/// about the unit `normal`, with `t` and `b` completing its frame.
+pub(in crate::solver) fn cosine(normal: DVec3, t: DVec3, b: DVec3, u1: f64, u2: f64) -> DVec3 {
     let r = u1.sqrt();
     let phi = std::f64::consts::TAU * u2;
-    let (t, b) = normal.any_orthonormal_pair();
     (t * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize()
 }
 
@@ -841,13 +847,12 @@ impl<'a> Progressive<'a> {
             .collect()
     }
 
-    /// The final gather's work, in the units of the particles' chunks (a
-    /// chunk's particles cast about four rays each), for step `u` over
-    /// `vertices` gathering vertices: 0 unless `u` is the tail's last
-    /// step and ends with the gather.
+    /// The final gather's work for step `u` over `vertices` gathering
+    /// vertices ([`gather_units`]): 0 unless `u` is the tail's last step
+    /// and ends with the gather.
     fn gather_units(&self, u: &TailUnderway, vertices: usize) -> u64 {
         if u.share >= 1.0 && self.tail.began.is_some() {
-            (vertices as u64 * TAIL_GATHER_RAYS as u64).div_ceil(4 * TAIL_CHUNK)
+            gather_units(vertices as u64)
         } else {
             0
         }
@@ -887,9 +892,10 @@ impl<'a> Progressive<'a> {
                 return None;
             }
             let (done, heads) = g.progress();
-            let units = |n: u64| (n * TAIL_GATHER_RAYS as u64).div_ceil(4 * TAIL_CHUNK);
-            self.gauge
-                .set(u.chunks + units(done), u.chunks + units(heads));
+            self.gauge.set(
+                u.chunks + gather_units(done),
+                u.chunks + gather_units(heads),
+            );
             if budget.is_some_and(|b| start.elapsed() >= b) && !g.done() {
                 return Some(false);
             }
@@ -1005,6 +1011,13 @@ impl<'a> Progressive<'a> {
             })
             .collect()
     }
+}
+
+/// The final gather's work over `vertices` gathering vertices, in the
+/// units of the particles' chunks (a chunk's particles cast about four
+/// rays each), for the step's gauge.
+fn gather_units(vertices: u64) -> u64 {
+    (vertices * TAIL_GATHER_RAYS as u64).div_ceil(4 * TAIL_CHUNK)
 }
 
 /// The index of the largest of `weights` (the first on ties; 0 when

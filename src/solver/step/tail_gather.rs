@@ -52,10 +52,9 @@
 use crate::color::Rgb;
 use crate::solver::accel::hat::Hats;
 use crate::solver::accel::shared::ALONE;
-use crate::solver::step::tail::{Stream, Tracer};
+use crate::solver::step::tail::{cosine, Stream, Tracer};
 use crate::solver::tuning::TAIL_GATHER_RAYS;
 use crate::solver::Progressive;
-use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -292,12 +291,4 @@ fn particle_weight(
     } else {
         0.0
     }
-}
-
-/// The cosine-weighted direction of the unit square's point `(u1, u2)`
-/// about the unit `normal`, with `t` and `b` completing its frame.
-fn cosine(normal: DVec3, t: DVec3, b: DVec3, u1: f64, u2: f64) -> DVec3 {
-    let r = u1.sqrt();
-    let phi = std::f64::consts::TAU * u2;
-    (t * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize()
 }
