@@ -82,6 +82,9 @@ pub struct FinalGather<'a> {
     /// polygon (a two-sided face): what [`FinalGather::behind_surfaces`]
     /// needs to tell the back of a surface.
     faces: Vec<(Vec3, bool)>,
+    /// The scene has a sky ([`crate::scene::Scene::add_sky`]): a ray that
+    /// leaves the model reaches it (the ray BVH leaves its facets out).
+    sky: bool,
     /// The scene's sun, whose direct light each point adds.
     sun: Option<super::sun::SunShot>,
 }
@@ -150,6 +153,7 @@ impl<'a> FinalGather<'a> {
                 .iter()
                 .map(|pm| (pm.normal, pm.has_back))
                 .collect(),
+            sky: scene.polygons.iter().any(|p| p.surface.sky),
             sun: super::sun::SunShot::for_scene(scene),
         }
     }
@@ -160,7 +164,9 @@ impl<'a> FinalGather<'a> {
     /// `x` along `n` and four directions square to it, every ray meets
     /// the back of a single-sided surface or leaves the scene, and at
     /// least one meets a back. A point under a table top sees the walls'
-    /// fronts sideways and is not behind; one in open space meets no back.
+    /// fronts sideways and is not behind; one in open space meets no back;
+    /// one that sees the sky (a ray leaving a model with a sky) is lit,
+    /// so not behind.
     /// Two-sided surfaces have no back, so nothing inside them is found.
     /// Such points receive no light, and a lighting designer leaves them
     /// out of a work plane's figures.
@@ -173,6 +179,7 @@ impl<'a> FinalGather<'a> {
         let mut backs = 0;
         for d in [n, t1, -t1, t2, -t2] {
             match self.visibility.first_hit(x, d) {
+                None if self.sky => return false,
                 None => {}
                 Some((p, _)) => match self.faces.get(p.index()) {
                     Some(&(normal, false)) if normal.dot(d) > 0.0 => backs += 1,

@@ -330,3 +330,44 @@ fn shaft_candidates_stop_past_the_limit() {
     // Both cases are exercised.
     assert!(whole > 50 && cut > 50, "whole {whole}, cut {cut}");
 }
+
+/// A sky's facets are not in the ray BVH: a ray that leaves the model
+/// meets nothing (not a facet), a segment out to the enclosure is clear
+/// unless the model blocks it, and every other first hit is the nearest
+/// of the model's own polygons.
+#[test]
+fn the_skys_facets_block_nothing_and_are_never_hit() {
+    let mut with_sky = testutil::floor_under_a_plate();
+    let model = with_sky.polygons.len();
+    with_sky.add_sky(crate::color::Rgb::splat(1.0)).unwrap();
+    assert!(with_sky.polygons.len() > model);
+    assert!(with_sky.polygons[model..].iter().all(|p| p.surface.sky));
+    let v = Visibility::new(&with_sky);
+    let without = Visibility::new(&testutil::floor_under_a_plate());
+    let mut stream = crate::testutil::Xorshift(0x2545_f491_4f6c_dd1d);
+    let mut rand = move || stream.unit_f32();
+    let (lo, hi) = with_sky.bounds();
+    let (mut left, mut blocked) = (0, 0);
+    for _ in 0..2000 {
+        let origin = lo + (hi - lo) * Vec3::new(rand(), rand(), rand());
+        let direction = Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5);
+        let hit = v.first_hit(origin, direction);
+        assert_eq!(
+            hit,
+            without.first_hit(origin, direction),
+            "{origin} {direction}"
+        );
+        if let Some((p, _)) = hit {
+            assert!(p.index() < model);
+        } else {
+            left += 1;
+        }
+        // Out to well past the enclosure's facets.
+        let far = origin + direction.normalize_or_zero() * 1e3 * (hi - lo).length();
+        let ends = (PolygonId(0), PolygonId(0));
+        let occluded = v.occluded(origin, far, ends);
+        assert_eq!(occluded, without.occluded(origin, far, ends));
+        blocked += occluded as u32;
+    }
+    assert!(left > 200 && blocked > 100, "{left} {blocked}");
+}
