@@ -144,7 +144,8 @@ fn exact_receivers() -> String {
          the others only when those disagree (a sky gathered at once: one of \
          each {SKY_CELL_STRATA} × {SKY_CELL_STRATA} of its hemisphere's \
          directions, five near the horizon, then the rest of those along an \
-         edge); a vertex {FAR_SHOOTER_RATIO} or \
+         edge, a dark patch one further off from an opening its four corners \
+         first); a vertex {FAR_SHOOTER_RATIO} or \
          more diameters from a lamp asks {FAR_PROBES} of its samples first, the \
          others only when those disagree. Vertices of polygons of one surface \
          at one point (coplanar, or smooth within {SHARE_CREASE_DEG}°) take \
