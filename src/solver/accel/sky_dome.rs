@@ -72,8 +72,8 @@ pub struct Hemisphere {
     /// along the horizon ([`horizon_probe`]).
     probes: Vec<Vec<u16>>,
     /// The corner strata of a cell (indices within it, no repeats): a
-    /// dark cell whose probe does not settle it asks these next, and
-    /// settles dark when they all are.
+    /// dark cell whose own ring of probes is dark but whose next ring is
+    /// not asks these next, and settles dark when they all are.
     corners: Vec<u16>,
     /// Per stratum (cell by cell, `per_cell²` each), the direction of its
     /// centre, unit, `z >= 0`: where a settled cell's directions reach
@@ -311,23 +311,21 @@ impl Hemisphere {
         let is_open = |c: usize| seen[c / 64] >> (c % 64) & 1 == 1;
         for c in 0..cells {
             let here = is_open(c);
-            let settled = uniform[c / 64] >> (c % 64) & 1 == 1
-                && if here {
-                    self.ring1[c].iter().all(|&o| is_open(usize::from(o)))
-                } else {
-                    self.ring2[c].iter().all(|&o| !is_open(usize::from(o)))
-                };
             // A dark cell whose own ring is dark but the next ring is not
             // asks its corners before every stratum: an opening poking
             // into it from two cells away reaches a corner. One next to
             // an open cell asks every stratum, as the edge may cross it
             // anywhere.
-            let confirmed = settled
-                || !here
-                    && uniform[c / 64] >> (c % 64) & 1 == 1
-                    && self.ring1[c].iter().all(|&o| !is_open(usize::from(o)))
-                    && self.corners.iter().all(|&s| ask(c, usize::from(s)) == here);
-            if confirmed {
+            let dark = |ring: &[u16]| ring.iter().all(|&o| !is_open(usize::from(o)));
+            let settled = uniform[c / 64] >> (c % 64) & 1 == 1
+                && if here {
+                    self.ring1[c].iter().all(|&o| is_open(usize::from(o)))
+                } else {
+                    dark(&self.ring2[c])
+                        || dark(&self.ring1[c])
+                            && self.corners.iter().all(|&s| !ask(c, usize::from(s)))
+                };
+            if settled {
                 if here {
                     sum += light.cell(self, dome, x, world, c);
                 }
