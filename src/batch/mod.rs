@@ -958,6 +958,16 @@ fn solve<'p>(
                 progress.set_tail(session.solver().tail_from());
                 progress.step(&report, session.solver().rays());
             }
+            Event::Stopped(crate::solver::StopReason::Converged)
+                if config.progress && session.pass() <= session.max_refinements() =>
+            {
+                // The refinement's gather at the new vertices takes a
+                // while on a large model, with no step to show.
+                progress.say(&format!(
+                    "adaptive pass {} converged: refining, the new vertices gather the light shot so far",
+                    session.pass()
+                ));
+            }
             Event::Step(_) | Event::Stopped(_) | Event::Cancelled => {}
             Event::Refined(report) => {
                 // The sky shoots in the first pass; the watch does not

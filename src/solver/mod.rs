@@ -84,6 +84,7 @@
 pub mod accel;
 mod ambient;
 mod approximations;
+pub mod carry;
 pub mod checkpoint;
 pub mod final_gather;
 pub mod gauge;
@@ -111,9 +112,7 @@ use kernel::{cell_integrals, distribution, formfactor};
 pub use step::StepPhase;
 use step::Underway;
 
-use crate::cancel::Cancelled;
 use crate::color::Rgb;
-use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
 use crate::scene::{PolygonId, Scene};
 use crate::visibility::Visibility;
@@ -123,7 +122,7 @@ use far_shooters::FarShooter;
 use formfactor::{polygon_samples, SampleSet, ShooterSample};
 use rayon::prelude::*;
 use receivers::CoarseGrid;
-use std::sync::atomic::{AtomicBool, Ordering};
+
 use subcells::SubCells;
 use unshot::{Shot, UnshotField};
 
@@ -1009,122 +1008,6 @@ impl<'a> Progressive<'a> {
     /// clustering).
     pub fn clusters(&self) -> &Clusters {
         &self.clusters
-    }
-
-    /// The state a solve on `refined`, a refinement of this solve's mesh,
-    /// starts from to continue this one rather than start afresh (per-vertex
-    /// scheme only; `None` for the per-polygon one):
-    ///
-    /// - a vertex both meshes have keeps its radiosity and unshot radiosity;
-    /// - a new vertex gathers, from every polygon, the light that polygon
-    ///   has shot so far (`b − Δb` read at its samples, as shooting reads
-    ///   `Δb`): `b = e + ρ Σ_i F(x → i)(b − Δb)_i`, with the same form
-    ///   factors and visibility as a step. Its unshot radiosity is the
-    ///   coarse field carried over ([`Refiner::carry`]), so the polygon's
-    ///   unshot power is unchanged.
-    ///
-    /// `refined` must be the mesh `refiner` returned last, refining this
-    /// solve's mesh. The gather's rays are added to the ray count. Each
-    /// new vertex gathers from every polygon, which on a large model
-    /// takes long: the gather checks `cancel` before each polygon and
-    /// stops with [`Cancelled`] once it is set.
-    pub fn refined_state(
-        &self,
-        refined: &Mesh,
-        refiner: &Refiner,
-        cancel: &AtomicBool,
-    ) -> Result<Option<checkpoint::SolverState>, Cancelled> {
-        let Some(unshot) = self.unshot.carried(refiner) else {
-            return Ok(None);
-        };
-        let previous = refiner.previous_index();
-        if previous.len() != refined.vertex_count() || unshot.len() != refined.vertex_count() {
-            return Ok(None);
-        }
-        // Each polygon's cells as a step of it reads them: a split cell by
-        // its sub-cells.
-        let Some(shot_at_samples) = self.unshot.shot_at_samples(&self.mesh, &self.radiosity) else {
-            return Ok(None);
-        };
-        let shot: Vec<(Vec<Rgb>, Vec<Rgb>)> = shot_at_samples
-            .into_iter()
-            .zip(&self.subcells)
-            .map(|((mut values, readings), subs)| {
-                subcells::carry_means(subs, &readings, &mut values);
-                (values, readings)
-            })
-            .collect();
-        let visibility = self.visibility;
-        let near_field = self.options.approximations.near_field;
-        let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
-            .into_par_iter()
-            .with_min_len(64)
-            .map(|l| {
-                let j = refined.vertex_polygon[l];
-                let b = match previous[l] {
-                    Some(old) => return (self.radiosity[old as usize], 0),
-                    None => self.emission[j.index()],
-                };
-                let rho = self.reflectance[j.index()];
-                if rho.is_black() {
-                    return (b, 0);
-                }
-                let x = refined.sample_positions[l];
-                let normal = refined.polygons[j.index()].normal;
-                let mut sum = Rgb::BLACK;
-                let mut rays = 0;
-                for (i, ((samples, (values, readings)), subs)) in self
-                    .samples
-                    .iter()
-                    .zip(&shot)
-                    .zip(&self.subcells)
-                    .enumerate()
-                {
-                    // A vertex reads every polygon, so a vertex's gather
-                    // alone is long on a real level.
-                    if cancel.load(Ordering::Relaxed) {
-                        return (Rgb::BLACK, 0);
-                    }
-                    // Coplanar polygons exchange no light (see
-                    // `Visibility::coplanar`).
-                    if i == j.index() || visibility.coplanar(PolygonId(i as u32), j) {
-                        continue;
-                    }
-                    let shooter = PolygonId(i as u32);
-                    let (f, asked) = distribution::shot_point_to_samples(
-                        self.directional[i].as_ref(),
-                        x,
-                        normal,
-                        self.mesh.polygons[i].normal,
-                        samples,
-                        |k| values[k],
-                        subcells::Split::of_polygon(subs, readings).as_ref(),
-                        near_field,
-                        |_, s| visibility.occluded(s, x, (shooter, j)),
-                    );
-                    sum += f;
-                    rays += asked;
-                }
-                // The sun's light reaches it as it reached the old ones.
-                let sun = self.sun_irradiance(x, normal, j);
-                (b + rho * (sum + Rgb::splat(sun)), rays)
-            })
-            .collect();
-        if cancel.load(Ordering::Relaxed) {
-            return Err(Cancelled);
-        }
-        let rays = gathered.iter().map(|g| g.1).sum::<u64>();
-        Ok(Some(checkpoint::SolverState {
-            radiosity: gathered.into_iter().map(|g| g.0).collect(),
-            unshot,
-            steps: self.steps,
-            rays: self.rays + rays,
-            // Interpolation on the refined mesh starts with no charges.
-            charges: Vec::new(),
-            tail_from: self.tail.from(),
-            // A tail on the refined mesh gathers from where it resumes.
-            tail_began: Vec::new(),
-        }))
     }
 
     /// Checks the invariants; returns the first broken one.

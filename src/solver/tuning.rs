@@ -20,6 +20,7 @@
 //! | delivering a step in parts | `step::parts` | [`CHUNK_WORK`], [`PIECE_WORK`], [`CHUNK_GROWTH`], [`PIECE_GROWTH`], [`CHUNK_TARGET`], [`NEAR_WEIGHT`], [`WINDOW_PART_BUDGET`] |
 //! | the hemicube | `hemicube` | [`DEFAULT_HEMICUBE_RES`], [`HEMICUBE_EDGE_SLACK`], [`HEMICUBE_NEAR_FRACTION`] |
 //! | the particle tail | `step::tail`, `step::tail_gather` | [`TAIL_AUTO_FROM`], [`TAIL_AUTO_VERTICES`], [`TAIL_COSTLY_RATIO`], [`TAIL_EARLY_FROM`], [`TAIL_PARTICLES_PER_VERTEX`], [`TAIL_GATHER_RAYS`], [`TAIL_GATHER_BATCH`], [`TAIL_GATHER_PART_BATCH`], [`TAIL_STEPS`], [`TAIL_CHUNK`], [`TAIL_BATCH`], [`TAIL_PART_BATCH`], [`TAIL_MAX_BOUNCES`], [`TAIL_SURVIVAL_MAX`] |
+//! | carrying a solve to a refined mesh | `carry` | [`CARRY_GATHER_RAYS`], [`CARRY_EXACT_SAMPLES`] |
 //!
 //! Structural constants (how many ray slots a cluster step keeps, the
 //! sub-cell grid's side, file-format fields) stay with the code whose
@@ -587,6 +588,23 @@ pub const TAIL_MAX_BOUNCES: u32 = 200;
 /// thousands of bounces.
 pub const TAIL_SURVIVAL_MAX: f64 = 0.95;
 
+// ---- Carrying a solve to a refined mesh: carry ----
+
+/// Directions a new vertex of a refined mesh gathers the light reflected
+/// so far over (`carry`, with clusters): a 16 × 16 stratified grid of
+/// the cosine-weighted hemisphere. Four times the tail's final gather
+/// ([`TAIL_GATHER_RAYS`]): a new vertex sits between vertices that were
+/// shot exactly, where a gather's noise would show as a blotch, and the
+/// sky's and lamps' light, the sharp part, is gathered apart from it.
+pub const CARRY_GATHER_RAYS: usize = 256;
+
+/// The most samples of all polygons together for which a new vertex of a
+/// refined mesh still gathers from every polygon's samples, exactly as a
+/// step would (`carry`): that costs a ray per sample, so 20,000 is about
+/// ten times the hemisphere's rays, and a scene of a few hundred polygons
+/// (the bundled ones) keeps the exact gather.
+pub const CARRY_EXACT_SAMPLES: usize = 20_000;
+
 /// Which phase of a step reads a constant of [`INDEX`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
@@ -606,6 +624,8 @@ pub enum Phase {
     Hemicube,
     /// The particle tail.
     Tail,
+    /// Carrying a solve to a refined mesh.
+    Carry,
 }
 
 /// One constant of the index: its name, the phase that reads it, and its
@@ -987,6 +1007,16 @@ pub const INDEX: &[Tuned] = &[
         name: "TAIL_SURVIVAL_MAX",
         phase: Phase::Tail,
         value: TAIL_SURVIVAL_MAX,
+    },
+    Tuned {
+        name: "CARRY_GATHER_RAYS",
+        phase: Phase::Carry,
+        value: CARRY_GATHER_RAYS as f64,
+    },
+    Tuned {
+        name: "CARRY_EXACT_SAMPLES",
+        phase: Phase::Carry,
+        value: CARRY_EXACT_SAMPLES as f64,
     },
 ];
 

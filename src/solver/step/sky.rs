@@ -27,6 +27,7 @@ use crate::solver::tuning::{SKY_CELLS, SKY_CELL_STRATA, SKY_CHUNK_VERTICES};
 use crate::solver::unshot::Shot;
 use crate::solver::{Progressive, SolverError, StepReport};
 use crate::visibility::LastBlocker;
+use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -369,5 +370,37 @@ impl<'a> Progressive<'a> {
             complete,
             particles: 0,
         }
+    }
+}
+
+impl Progressive<'_> {
+    /// What the sky's facets have sent so far (`e − Δb`, by facet), when
+    /// the sky is gathered at once; `None` when it is shot by facets.
+    pub(in crate::solver) fn sky_shot_light(&self) -> Option<SkyLight> {
+        let (_, dome) = self.sky.tables.as_ref()?;
+        Some(SkyLight::of(dome, |j| {
+            self.emission[j] - self.unshot.mean(&self.mesh, j)
+        }))
+    }
+
+    /// What a point `x` on polygon `j` with unit normal `n` receives of
+    /// the sky's `light` before its reflectance, asked as the sky step
+    /// asks a vertex (probes first where they are on), and the rays
+    /// cast; black without a sky gathered at once.
+    pub(in crate::solver) fn gather_sky_at(
+        &self,
+        light: &SkyLight,
+        x: Vec3,
+        n: Vec3,
+        j: PolygonId,
+    ) -> (Rgb, u64) {
+        let Some((hemisphere, dome)) = self.sky.tables.as_ref() else {
+            return (Rgb::BLACK, 0);
+        };
+        let mut last = LastBlocker::default();
+        hemisphere.gather(dome, light, x, n, self.sky.probing, |end| {
+            self.visibility
+                .occluded_remembering(x, end, (j, j), &mut last)
+        })
     }
 }

@@ -559,7 +559,7 @@ impl<'a> Progressive<'a> {
 
     /// Per vertex, its unshot radiosity as the shooters read it: the
     /// vertex's own value, or its polygon's in the per-polygon scheme.
-    fn unshot_at_vertices(&self) -> Vec<Rgb> {
+    pub(in crate::solver) fn unshot_at_vertices(&self) -> Vec<Rgb> {
         let values = self.unshot.values();
         if values.len() == self.mesh.vertex_count() {
             values.to_vec()
@@ -796,7 +796,7 @@ impl<'a> Progressive<'a> {
 
     /// What tail particles and the final gather trace with, `reflects`
     /// per polygon.
-    fn tracer<'t>(&'t self, reflects: &'t [bool]) -> Tracer<'t> {
+    pub(in crate::solver) fn tracer<'t>(&'t self, reflects: &'t [bool]) -> Tracer<'t> {
         Tracer {
             mesh: &self.mesh,
             visibility: self.visibility,

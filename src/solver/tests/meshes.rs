@@ -3,13 +3,13 @@
 //! independence.
 
 use super::*;
+use std::sync::atomic::AtomicBool;
 
 /// Solves `s` adaptively as `--adaptive` does, through the solve session:
 /// on its regular mesh, then refined by the solution's luminance and
 /// continued twice ([`Progressive::refined_state`]).
 fn solve_adaptively(s: &Scene, lenmax: f32, options: SolverOptions) -> Solved {
     use crate::session::{Session, SessionOptions};
-    use std::sync::atomic::AtomicBool;
     let mesh = mesh::build(
         s,
         &MeshOptions {
@@ -214,4 +214,156 @@ fn cornell_walls_are_grid_independent() {
         checked += 1;
     }
     assert_eq!(checked, 5);
+}
+
+/// The scene of the carry's tests: an open-topped box under a sky of
+/// radiosity 2, with a lamp hanging under the open top and a square
+/// casting shadows on the floor.
+fn courtyard_with_lamp() -> Scene {
+    let mut polygons = closed_box(2.0, [1, 2, 1, 0, 1, 2]);
+    polygons.remove(3);
+    polygons.push(polygon(
+        1,
+        &[
+            [0.6, 0.3, 0.6],
+            [0.6, 0.3, 1.4],
+            [1.4, 0.3, 1.4],
+            [1.4, 0.3, 0.6],
+        ],
+    ));
+    polygons.push(polygon(
+        0,
+        &[
+            [1.3, 1.9, 0.3],
+            [1.3, 1.9, 0.8],
+            [0.8, 1.9, 0.8],
+            [0.8, 1.9, 0.3],
+        ],
+    ));
+    let mut s = scene(polygons, shadowed_box().materials);
+    assert!(s.polygons.last().unwrap().normal.y < 0.0);
+    s.add_sky(Rgb::splat(2.0)).unwrap();
+    s
+}
+
+/// A new vertex's carry over its hemisphere (lamps by polygon, the sky
+/// by the sky step's directions, reflected light by rays;
+/// [`crate::solver::carry`]) against its twin, every polygon's samples,
+/// both asking from the vertex's own point: in [`courtyard_with_lamp`]
+/// solved to 0.1 % and refined once by its luminance, the new vertices
+/// differ from the twin's by 1.2 % of their mean on average, 0.4 %
+/// brighter on the whole, and 4.6 % at worst (measured), with a fifth of
+/// the twin's rays.
+#[test]
+fn new_vertices_gather_over_the_hemisphere_as_from_every_polygon() {
+    use crate::mesh::refine::{RefineOptions, Refiner};
+    use crate::solver::carry::Carry;
+    let s = courtyard_with_lamp();
+    let mesh = crate::testutil::regular_mesh(&s, 0.2);
+    let vis = Visibility::new(&s);
+    let options = SolverOptions {
+        approximations: Approximations::DEFAULT.without(&[Heuristic::HatCentroids]),
+        ..Default::default()
+    };
+    let mut solver = Progressive::new(&s, &mesh, &vis, options);
+    while !solver.is_done() && solver.step().is_some() {}
+    solver.validate().unwrap();
+    let luminance: Vec<f64> = solver.radiosity().iter().map(|b| b.luminance()).collect();
+    let mut refiner = Refiner::new(&mesh);
+    let (refined, _) = refiner
+        .refine(&s, &luminance, &RefineOptions::default())
+        .expect("the shadows refine");
+    let cancel = AtomicBool::new(false);
+    let state = |how| {
+        solver
+            .refined_state_by(&refined, &refiner, &cancel, how)
+            .unwrap()
+            .unwrap()
+    };
+    let (fast, twin) = (state(Carry::Hemisphere), state(Carry::EveryPolygon));
+    let previous = refiner.previous_index();
+    let sky = |l: usize| refined.polygons[refined.vertex_polygon[l].index()].sky;
+    let new: Vec<usize> = (0..refined.vertex_count())
+        .filter(|&l| previous[l].is_none() && !sky(l))
+        .collect();
+    assert!(new.len() > 100, "{} new vertices", new.len());
+    let n = new.len() as f64;
+    let lum = |state: &checkpoint::SolverState, l: usize| state.radiosity[l].luminance();
+    let mean = new.iter().map(|&l| lum(&twin, l)).sum::<f64>() / n;
+    let differences: Vec<f64> = new
+        .iter()
+        .map(|&l| (lum(&fast, l) - lum(&twin, l)) / mean)
+        .collect();
+    let signed = differences.iter().sum::<f64>() / n;
+    let average = differences.iter().map(|d| d.abs()).sum::<f64>() / n;
+    let worst = differences.iter().map(|d| d.abs()).fold(0.0, f64::max);
+    let (fast_rays, twin_rays) = (fast.rays - solver.rays(), twin.rays - solver.rays());
+    eprintln!(
+        "{n} new vertices, against the twin: {average} on average, {signed} signed, \
+         {worst} at worst, of their mean; rays {fast_rays} against {twin_rays}"
+    );
+    assert!(
+        average < 0.02 && signed.abs() < 0.01 && worst < 0.08,
+        "{average} {signed} {worst}"
+    );
+    assert!(fast_rays * 5 <= twin_rays, "{fast_rays} {twin_rays}");
+    // Old vertices keep their values, in both.
+    for l in (0..refined.vertex_count()).filter(|&l| previous[l].is_some()) {
+        assert_eq!(fast.radiosity[l], twin.radiosity[l]);
+    }
+}
+
+/// The hemisphere's rays read the reflected light exactly where it is
+/// even: in a closed grey box (reflectance 0.7 and 0.4, no lamp) whose
+/// every vertex has sent radiosity 3 and holds none unshot, every new
+/// vertex of a refinement gathers `ρ · 3`, whichever element each ray
+/// lands in.
+#[test]
+fn new_vertices_gather_an_even_field_exactly() {
+    use crate::mesh::refine::{RefineOptions, Refiner};
+    use crate::solver::carry::Carry;
+    let s = scene(
+        closed_box(2.0, [1, 2, 1, 1, 1, 2]),
+        shadowed_box().materials,
+    );
+    let mesh = crate::testutil::regular_mesh(&s, 0.25);
+    let vis = Visibility::new(&s);
+    let mut solver = Progressive::new(&s, &mesh, &vis, SolverOptions::default());
+    let mut state = solver.state();
+    state.radiosity = vec![Rgb::splat(3.0); mesh.vertex_count()];
+    state.unshot = vec![Rgb::BLACK; state.unshot.len()];
+    solver.restore(state).unwrap();
+    let field: Vec<f64> = mesh
+        .positions
+        .iter()
+        .map(|p| if p.x < 0.9 { 0.2 } else { 1.0 })
+        .collect();
+    let mut refiner = Refiner::new(&mesh);
+    let (refined, _) = refiner
+        .refine(&s, &field, &RefineOptions::default())
+        .expect("the cut refines");
+    let carried = solver
+        .refined_state_by(
+            &refined,
+            &refiner,
+            &AtomicBool::new(false),
+            Carry::Hemisphere,
+        )
+        .unwrap()
+        .unwrap();
+    let previous = refiner.previous_index();
+    let mut checked = 0;
+    for l in (0..refined.vertex_count()).filter(|&l| previous[l].is_none()) {
+        let rho = [0.3, 0.7, 0.4][s.polygons[refined.vertex_polygon[l].index()]
+            .material
+            .index()];
+        let b = carried.radiosity[l].r;
+        assert!(
+            (b - 3.0 * rho).abs() < 1e-5,
+            "vertex {l}: {b}, not {}",
+            3.0 * rho
+        );
+        checked += 1;
+    }
+    assert!(checked > 50, "{checked}");
 }
