@@ -317,7 +317,10 @@ impl<'p> Session<'p> {
                 None => None,
             };
             if let Some((mesh, report)) = refined {
-                match self.solver.refined_state(&mesh, refiner, cancel) {
+                match self
+                    .solver
+                    .refined_state(self.scene, &mesh, refiner, cancel)
+                {
                     Ok(start) => next = Some((mesh, report, start)),
                     Err(crate::cancel::Cancelled) => {
                         self.pending = Some((mesh, report));

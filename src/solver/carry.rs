@@ -33,7 +33,11 @@
 //!   (`solver::tests::meshes`) new vertices differ by about 1 % of their
 //!   mean, 5 % at worst, at a fifth of its rays; on `pandora.obj`
 //!   (138,429 polygons) one refinement's 305,000 new vertices gathered in
-//!   76 s on 2 cores, where the twin had not finished after 20 minutes.
+//!   60 s on 2 cores, where the twin had not finished after 20 minutes.
+//!
+//! New vertices of one surface at one point (a split edge's midpoint, on
+//! both triangles beside it) gather as one, as a step's shared receivers
+//! do ([`crate::solver::accel::shared`]), from their group's hat.
 //!
 //! A new vertex's unshot radiosity is the coarse field carried over
 //! ([`Refiner::carry`]) either way, so each polygon's unshot power is
@@ -43,8 +47,9 @@ use crate::cancel::Cancelled;
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::Mesh;
-use crate::scene::PolygonId;
+use crate::scene::{PolygonId, Scene};
 use crate::solver::accel::hat::Hats;
+use crate::solver::accel::shared::{self, ALONE};
 use crate::solver::accel::subcells;
 use crate::solver::checkpoint::SolverState;
 use crate::solver::kernel::distribution;
@@ -83,6 +88,7 @@ impl Progressive<'_> {
     /// it is set.
     pub fn refined_state(
         &self,
+        scene: &Scene,
         refined: &Mesh,
         refiner: &Refiner,
         cancel: &AtomicBool,
@@ -95,12 +101,13 @@ impl Progressive<'_> {
         } else {
             Carry::EveryPolygon
         };
-        self.refined_state_by(refined, refiner, cancel, how)
+        self.refined_state_by(scene, refined, refiner, cancel, how)
     }
 
     /// [`Progressive::refined_state`], gathering as `how` says.
     pub(in crate::solver) fn refined_state_by(
         &self,
+        scene: &Scene,
         refined: &Mesh,
         refiner: &Refiner,
         cancel: &AtomicBool,
@@ -161,8 +168,17 @@ impl Progressive<'_> {
             Carry::EveryPolygon => Vec::new(),
         };
         let tracer = self.tracer(&reads);
-        let hats =
-            (how == Carry::Hemisphere && self.hat_centroids()).then(|| Hats::new(refined, &[]));
+        // New vertices of one surface at one point gather as one, as in a
+        // step ([`crate::solver::accel::shared`]).
+        let leaders = shared::leaders(
+            scene,
+            refined,
+            self.visibility,
+            how == Carry::Hemisphere && self.options.approximations.shared_receivers,
+        );
+        let follows = |l: usize| leaders.get(l).copied().filter(|&x| x != ALONE);
+        let hats = (how == Carry::Hemisphere && self.hat_centroids())
+            .then(|| Hats::new(refined, &leaders));
         let side = (CARRY_GATHER_RAYS as f64).sqrt().round().max(1.0) as usize;
         let visibility = self.visibility;
         let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
@@ -174,6 +190,10 @@ impl Progressive<'_> {
                     Some(old) => return (self.radiosity[old as usize], 0),
                     None => self.emission[j.index()],
                 };
+                if follows(l).is_some() {
+                    // Its leader's value, set below.
+                    return (b, 0);
+                }
                 let rho = self.reflectance[j.index()];
                 if rho.is_black() || cancel.load(Ordering::Relaxed) {
                     return (b, 0);
@@ -224,8 +244,17 @@ impl Progressive<'_> {
             return Err(Cancelled);
         }
         let rays = gathered.iter().map(|g| g.1).sum::<u64>();
+        let mut radiosity: Vec<Rgb> = gathered.into_iter().map(|g| g.0).collect();
+        // A leader comes before its followers and follows no one, and
+        // both have one material: a new follower takes its leader's
+        // radiosity, whether the leader is new or kept.
+        for l in 0..radiosity.len() {
+            if let (None, Some(x)) = (previous[l], follows(l)) {
+                radiosity[l] = radiosity[x as usize];
+            }
+        }
         Ok(Some(SolverState {
-            radiosity: gathered.into_iter().map(|g| g.0).collect(),
+            radiosity,
             unshot,
             steps: self.steps,
             rays: self.rays + rays,

@@ -167,6 +167,7 @@ pub trait Method<'a> {
     /// with [`Cancelled`] once `cancel` is set (this solve unchanged).
     fn refined_state(
         &self,
+        scene: &Scene,
         refined: &Mesh,
         refiner: &Refiner,
         cancel: &AtomicBool,

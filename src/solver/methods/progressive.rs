@@ -6,6 +6,7 @@ use crate::cancel::Cancelled;
 use crate::color::Rgb;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, MeshRef};
+use crate::scene::Scene;
 use crate::solver::checkpoint::SolverState;
 use crate::solver::{Method, Progressive, SolverError, SolverOptions, StepReport, StopReason};
 use std::sync::atomic::AtomicBool;
@@ -97,11 +98,12 @@ impl<'a> Method<'a> for Progressive<'a> {
 
     fn refined_state(
         &self,
+        scene: &Scene,
         refined: &Mesh,
         refiner: &Refiner,
         cancel: &AtomicBool,
     ) -> Result<Option<SolverState>, Cancelled> {
-        Progressive::refined_state(self, refined, refiner, cancel)
+        Progressive::refined_state(self, scene, refined, refiner, cancel)
     }
 
     fn validate(&self) -> Result<(), SolverError> {

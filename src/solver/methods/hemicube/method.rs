@@ -292,11 +292,13 @@ impl<'a> Method<'a> for HemicubeMethod<'a> {
     /// new vertices gather by Wallace's rays.
     fn refined_state(
         &self,
+        scene: &Scene,
         refined: &Mesh,
         refiner: &Refiner,
         cancel: &AtomicBool,
     ) -> Result<Option<SolverState>, Cancelled> {
-        self.progressive.refined_state(refined, refiner, cancel)
+        self.progressive
+            .refined_state(scene, refined, refiner, cancel)
     }
 
     fn validate(&self) -> Result<(), SolverError> {
