@@ -313,6 +313,39 @@ fn new_vertices_gather_over_the_hemisphere_as_from_every_polygon() {
     }
 }
 
+/// Refines `mesh` once where `field` (of a vertex's position) changes,
+/// and carries `solver`'s solution over by the hemisphere
+/// ([`crate::solver::carry`]): the refined mesh, the new vertices, and
+/// the carried state.
+fn carried_across(
+    s: &Scene,
+    mesh: &Mesh,
+    solver: &Progressive,
+    field: impl Fn(glam::Vec3) -> f64,
+) -> (Mesh, Vec<usize>, checkpoint::SolverState) {
+    use crate::mesh::refine::{RefineOptions, Refiner};
+    use crate::solver::carry::Carry;
+    let field: Vec<f64> = mesh.positions.iter().map(|&p| field(p)).collect();
+    let mut refiner = Refiner::new(mesh);
+    let (refined, _) = refiner
+        .refine(s, &field, &RefineOptions::default())
+        .expect("the field refines");
+    let state = solver
+        .refined_state_by(
+            s,
+            &refined,
+            &refiner,
+            &AtomicBool::new(false),
+            Carry::Hemisphere,
+        )
+        .unwrap()
+        .unwrap();
+    let new = (0..refined.vertex_count())
+        .filter(|&l| refiner.previous_index()[l].is_none())
+        .collect();
+    (refined, new, state)
+}
+
 /// The hemisphere's rays read the reflected light exactly where it is
 /// even: in a closed grey box (reflectance 0.7 and 0.4, no lamp) whose
 /// every vertex has sent radiosity 3 and holds none unshot, every new
@@ -320,8 +353,6 @@ fn new_vertices_gather_over_the_hemisphere_as_from_every_polygon() {
 /// lands in.
 #[test]
 fn new_vertices_gather_an_even_field_exactly() {
-    use crate::mesh::refine::{RefineOptions, Refiner};
-    use crate::solver::carry::Carry;
     let s = scene(
         closed_box(2.0, [1, 2, 1, 1, 1, 2]),
         shadowed_box().materials,
@@ -333,28 +364,10 @@ fn new_vertices_gather_an_even_field_exactly() {
     state.radiosity = vec![Rgb::splat(3.0); mesh.vertex_count()];
     state.unshot = vec![Rgb::BLACK; state.unshot.len()];
     solver.restore(state).unwrap();
-    let field: Vec<f64> = mesh
-        .positions
-        .iter()
-        .map(|p| if p.x < 0.9 { 0.2 } else { 1.0 })
-        .collect();
-    let mut refiner = Refiner::new(&mesh);
-    let (refined, _) = refiner
-        .refine(&s, &field, &RefineOptions::default())
-        .expect("the cut refines");
-    let carried = solver
-        .refined_state_by(
-            &s,
-            &refined,
-            &refiner,
-            &AtomicBool::new(false),
-            Carry::Hemisphere,
-        )
-        .unwrap()
-        .unwrap();
-    let previous = refiner.previous_index();
+    let (refined, new, carried) =
+        carried_across(&s, &mesh, &solver, |p| if p.x < 0.9 { 0.2 } else { 1.0 });
     let mut checked = 0;
-    for l in (0..refined.vertex_count()).filter(|&l| previous[l].is_none()) {
+    for l in new {
         let rho = [0.3, 0.7, 0.4][s.polygons[refined.vertex_polygon[l].index()]
             .material
             .index()];
@@ -377,8 +390,6 @@ fn new_vertices_gather_an_even_field_exactly() {
 /// 1 % of those values on average.
 #[test]
 fn new_vertices_of_one_surface_at_one_point_gather_as_one() {
-    use crate::mesh::refine::{RefineOptions, Refiner};
-    use crate::solver::carry::Carry;
     let quad =
         |x0: f32, x1: f32| polygon(1, &[[x0, 0., 0.], [x0, 0., 2.], [x1, 0., 2.], [x1, 0., 0.]]);
     let wall = {
@@ -410,28 +421,13 @@ fn new_vertices_of_one_surface_at_one_point_gather_as_one() {
         };
         let mut solver = Progressive::new(&s, &mesh, &vis, options);
         while !solver.is_done() && solver.step().is_some() {}
-        let field: Vec<f64> = mesh
-            .positions
-            .iter()
-            .map(|p| if (p.x - 1.0).abs() < 0.1 { 1.0 } else { 0.2 })
-            .collect();
-        let mut refiner = Refiner::new(&mesh);
-        let (refined, _) = refiner
-            .refine(&s, &field, &RefineOptions::default())
-            .expect("the edge refines");
-        let state = solver
-            .refined_state_by(
-                &s,
-                &refined,
-                &refiner,
-                &AtomicBool::new(false),
-                Carry::Hemisphere,
-            )
-            .unwrap()
-            .unwrap();
-        let new: Vec<usize> = (0..refined.vertex_count())
-            .filter(|&l| refiner.previous_index()[l].is_none())
-            .collect();
+        let (refined, new, state) = carried_across(&s, &mesh, &solver, |p| {
+            if (p.x - 1.0).abs() < 0.1 {
+                1.0
+            } else {
+                0.2
+            }
+        });
         (refined, new, state.radiosity, state.rays - solver.rays())
     };
     let (refined, new, shared, shared_rays) = carry(Approximations::DEFAULT);
