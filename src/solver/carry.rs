@@ -53,7 +53,8 @@ use crate::solver::accel::shared::{self, ALONE};
 use crate::solver::accel::subcells;
 use crate::solver::checkpoint::SolverState;
 use crate::solver::kernel::distribution;
-use crate::solver::step::tail::{cosine, Stream};
+use crate::solver::step::tail::Stream;
+use crate::solver::step::tail_gather::over_hemisphere;
 use crate::solver::tuning::{CARRY_EXACT_SAMPLES, CARRY_GATHER_RAYS};
 use crate::solver::Progressive;
 use rayon::prelude::*;
@@ -217,21 +218,11 @@ impl Progressive<'_> {
                         sum += s;
                         rays += r;
                     }
-                    let n = normal.as_dvec3();
-                    let (t, bt) = n.any_orthonormal_pair();
                     let start = x + normal * tracer.offset();
                     let mut s = Stream::new(CARRY_SEED, l as u64);
                     let mut field = Rgb::BLACK;
-                    for k in 0..side * side {
-                        let u1 = ((k % side) as f64 + s.uniform()) / side as f64;
-                        let u2 = ((k / side) as f64 + s.uniform()) / side as f64;
-                        let d = cosine(n, t, bt, u1, u2).as_vec3();
-                        if let Some(landing) = tracer.land(start, d) {
-                            for (c, w) in landing.corners.iter().zip(landing.weights) {
-                                field += reflected[*c as usize] * w;
-                            }
-                        }
-                    }
+                    let n = normal.as_dvec3();
+                    over_hemisphere(&tracer, start, n, side, &mut s, &reflected, |f| field += f);
                     sum += field * (1.0 / (side * side) as f64);
                     rays += (side * side) as u64;
                 }

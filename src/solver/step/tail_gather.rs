@@ -55,6 +55,7 @@ use crate::solver::accel::shared::ALONE;
 use crate::solver::step::tail::{cosine, Stream, Tracer};
 use crate::solver::tuning::TAIL_GATHER_RAYS;
 use crate::solver::Progressive;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -167,24 +168,14 @@ impl Progressive<'_> {
                     None => mesh.sample_positions[l as usize],
                 };
                 let start = x + normal.as_vec3() * tracer.offset();
-                let (t, b) = normal.any_orthonormal_pair();
                 let mut s = Stream::new(GATHER_SEED, u64::from(l));
                 let mut sum = Rgb::BLACK;
                 let (mut lum, mut lum2) = (0.0f64, 0.0f64);
-                for k in 0..side * side {
-                    let u1 = ((k % side) as f64 + s.uniform()) / side as f64;
-                    let u2 = ((k / side) as f64 + s.uniform()) / side as f64;
-                    let d = cosine(normal, t, b, u1, u2).as_vec3();
-                    if let Some(landing) = tracer.land(start, d) {
-                        let mut f = Rgb::BLACK;
-                        for (c, w) in landing.corners.iter().zip(landing.weights) {
-                            f += field[*c as usize] * w;
-                        }
-                        sum += f;
-                        lum += f.mean();
-                        lum2 += f.mean() * f.mean();
-                    }
-                }
+                over_hemisphere(tracer, start, normal, side, &mut s, field, |f| {
+                    sum += f;
+                    lum += f.mean();
+                    lum2 += f.mean() * f.mean();
+                });
                 let n = (side * side) as f64;
                 let rho = self.reflectance[j.index()];
                 // The mean's variance from the directions' spread (the
@@ -263,7 +254,36 @@ impl Progressive<'_> {
     }
 }
 
-/// The weight of the particles' answer `particles` (luminance) at a
+/// Casts `side²` cosine-weighted directions from `start` about unit
+/// normal `n`, one jittered in each cell of a `side × side` grid of the
+/// unit square (jitter from `s`), and hands `each` the value of `field`
+/// (per vertex) interpolated in the element triangle each direction lands
+/// in; directions that land nowhere `tracer` reads bring nothing.
+pub(in crate::solver) fn over_hemisphere(
+    tracer: &Tracer<'_>,
+    start: Vec3,
+    n: DVec3,
+    side: usize,
+    s: &mut Stream,
+    field: &[Rgb],
+    mut each: impl FnMut(Rgb),
+) {
+    let (t, b) = n.any_orthonormal_pair();
+    for k in 0..side * side {
+        let u1 = ((k % side) as f64 + s.uniform()) / side as f64;
+        let u2 = ((k / side) as f64 + s.uniform()) / side as f64;
+        let d = cosine(n, t, b, u1, u2).as_vec3();
+        if let Some(landing) = tracer.land(start, d) {
+            let mut f = Rgb::BLACK;
+            for (c, w) in landing.corners.iter().zip(landing.weights) {
+                f += field[*c as usize] * w;
+            }
+            each(f);
+        }
+    }
+}
+
+/// The weight of the particles' answer/// The weight of the particles' answer `particles` (luminance) at a
 /// vertex against the gather's `gathered`, each weighted by the inverse
 /// of its variance: the particles' from their deposits' squares
 /// (`squares`, over the hat's area squared: the deposits taken as
