@@ -967,6 +967,7 @@ fn solve<'p>(
                     "adaptive pass {} converged: refining, the new vertices gather the light shot so far",
                     session.pass()
                 ));
+                progress.refining();
             }
             Event::Step(_) | Event::Stopped(_) | Event::Cancelled => {}
             Event::Refined(report) => {

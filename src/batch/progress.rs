@@ -54,6 +54,9 @@ struct Shown {
     base: String,
     /// The number of the step under way.
     step: u64,
+    /// What is under way when it is not a step (the refinement's
+    /// gather): named instead of `step N`.
+    activity: Option<&'static str>,
     /// When it began.
     began: Instant,
     /// Its solver's gauge, if the solver has one.
@@ -87,6 +90,7 @@ impl Progress {
         let shown = Arc::new(Mutex::new(Shown {
             base: String::new(),
             step: 1,
+            activity: None,
             began: Instant::now(),
             gauge: None,
             since: None,
@@ -166,6 +170,7 @@ impl Progress {
         let mut shown = self.shown();
         shown.base = message;
         shown.step = report.step + 1;
+        shown.activity = None;
         shown.began = Instant::now();
         shown.since = None;
         shown.cleared = false;
@@ -199,6 +204,17 @@ impl Progress {
             _ if fraction <= self.threshold => "settling".to_string(),
             _ => format!("ETA {}", by_rate(self.total_log)),
         }
+    }
+
+    /// The pass has converged and its refinement's gather begins (the
+    /// solver's gauge counts the new vertices gathered): the bar says so
+    /// in place of the next step, with how far the gather has got.
+    pub fn refining(&self) {
+        let mut shown = self.shown();
+        shown.base = "converged".to_string();
+        shown.activity = Some("refining: new vertices gathering");
+        shown.began = Instant::now();
+        shown.since = None;
     }
 
     /// Prints `line` on stderr above the bar, which stays.
@@ -249,14 +265,24 @@ impl Shown {
                 } else {
                     String::new()
                 };
-                format!("step {} {:.0}% done{left}", self.step, f * 100.0)
+                format!("{} {:.0}% done{left}", self.doing(), f * 100.0)
             }
-            _ => format!("step {} running {:.0}s", self.step, running.as_secs_f64()),
+            _ => format!("{} running {:.0}s", self.doing(), running.as_secs_f64()),
         };
         if self.base.is_empty() {
             now_says
         } else {
             format!("{} · {now_says}", self.base)
+        }
+    }
+}
+
+impl Shown {
+    /// What is under way: `step N`, or the activity named.
+    fn doing(&self) -> String {
+        match self.activity {
+            Some(what) => what.to_string(),
+            None => format!("step {}", self.step),
         }
     }
 }
@@ -349,6 +375,7 @@ mod tests {
         let mut shown = Shown {
             base: String::new(),
             step: 1,
+            activity: None,
             began: t0,
             gauge: Some(Arc::clone(&gauge)),
             since: None,
@@ -385,6 +412,40 @@ mod tests {
     }
 
     /// A step's report is the base of the next one's message.
+    /// Once a pass converges, the refinement's gather fills the gauge:
+    /// the bar names it in place of a step, and the next step's report
+    /// names steps again.
+    #[test]
+    fn the_refinements_gather_is_named_on_the_bar() {
+        let gauge = Arc::new(StepGauge::default());
+        let mut p = Progress::new(false, 0.001, None);
+        p.follow(Some(Arc::clone(&gauge)));
+        p.step(&report(5, 0.0005, 0), 10);
+        p.refining();
+        let later = |p: &Progress, s: u64| {
+            let mut shown = p.shown();
+            let began = shown.began;
+            shown.message(began + Duration::from_secs(s))
+        };
+        gauge.set(0, 200);
+        assert_eq!(
+            later(&p, 2),
+            "converged · refining: new vertices gathering 0% done"
+        );
+        gauge.set(50, 200);
+        assert_eq!(
+            later(&p, 4),
+            "converged · refining: new vertices gathering 25% done, 6s left in it"
+        );
+        gauge.idle();
+        p.step(&report(6, 0.0004, 0), 20);
+        assert!(
+            later(&p, 3).ends_with("step 7 running 3s"),
+            "{}",
+            later(&p, 3)
+        );
+    }
+
     #[test]
     fn a_finished_step_starts_the_next_ones_clock() {
         let mut p = Progress::new(false, 0.001, None);

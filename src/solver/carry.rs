@@ -39,6 +39,11 @@
 //! both triangles beside it) gather as one, as a step's shared receivers
 //! do ([`crate::solver::accel::shared`]), from their group's hat.
 //!
+//! The gather goes in chunks of [`CARRY_CHUNK_VERTICES`] vertices, and
+//! the step gauge ([`crate::solver::gauge`]) counts the new vertices that
+//! gather themselves as they are done, so a progress bar shows the
+//! minute it takes on a real level.
+//!
 //! A new vertex's unshot radiosity is the coarse field carried over
 //! ([`Refiner::carry`]) either way, so each polygon's unshot power is
 //! unchanged.
@@ -55,7 +60,7 @@ use crate::solver::checkpoint::SolverState;
 use crate::solver::kernel::distribution;
 use crate::solver::step::tail::Stream;
 use crate::solver::step::tail_gather::over_hemisphere;
-use crate::solver::tuning::{CARRY_EXACT_SAMPLES, CARRY_GATHER_RAYS};
+use crate::solver::tuning::{CARRY_CHUNK_VERTICES, CARRY_EXACT_SAMPLES, CARRY_GATHER_RAYS};
 use crate::solver::Progressive;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -182,55 +187,80 @@ impl Progressive<'_> {
             .then(|| Hats::new(refined, &leaders));
         let side = (CARRY_GATHER_RAYS as f64).sqrt().round().max(1.0) as usize;
         let visibility = self.visibility;
-        let gathered: Vec<(Rgb, u64)> = (0..refined.vertex_count())
-            .into_par_iter()
-            .with_min_len(16)
-            .map(|l| {
-                let j = refined.vertex_polygon[l];
-                let b = match previous[l] {
-                    Some(old) => return (self.radiosity[old as usize], 0),
-                    None => self.emission[j.index()],
+        let gather_one = |l: usize| -> (Rgb, u64) {
+            let j = refined.vertex_polygon[l];
+            let b = match previous[l] {
+                Some(old) => return (self.radiosity[old as usize], 0),
+                None => self.emission[j.index()],
+            };
+            if follows(l).is_some() {
+                // Its leader's value, set below.
+                return (b, 0);
+            }
+            let rho = self.reflectance[j.index()];
+            if rho.is_black() || cancel.load(Ordering::Relaxed) {
+                return (b, 0);
+            }
+            let own = refined.sample_positions[l];
+            let normal = refined.polygons[j.index()].normal.normalize_or_zero();
+            let Some((mut sum, mut rays)) =
+                self.gather_from_polygons(own, normal, j, &by_polygon, &shot, cancel)
+            else {
+                return (Rgb::BLACK, 0);
+            };
+            if how == Carry::Hemisphere {
+                // The sky and the reflected light from the hat's
+                // centroid, as the sky step and the final gather ask.
+                let x = match &hats {
+                    Some(h) => h.centroid(refined, l as u32, |m| visibility.coplanar(j, m)),
+                    None => own,
                 };
-                if follows(l).is_some() {
-                    // Its leader's value, set below.
-                    return (b, 0);
+                if let Some(light) = &sky_light {
+                    let (s, r) = self.gather_sky_at(light, x, normal, j);
+                    sum += s;
+                    rays += r;
                 }
-                let rho = self.reflectance[j.index()];
-                if rho.is_black() || cancel.load(Ordering::Relaxed) {
-                    return (b, 0);
-                }
-                let own = refined.sample_positions[l];
-                let normal = refined.polygons[j.index()].normal.normalize_or_zero();
-                let Some((mut sum, mut rays)) =
-                    self.gather_from_polygons(own, normal, j, &by_polygon, &shot, cancel)
-                else {
-                    return (Rgb::BLACK, 0);
-                };
-                if how == Carry::Hemisphere {
-                    // The sky and the reflected light from the hat's
-                    // centroid, as the sky step and the final gather ask.
-                    let x = match &hats {
-                        Some(h) => h.centroid(refined, l as u32, |m| visibility.coplanar(j, m)),
-                        None => own,
-                    };
-                    if let Some(light) = &sky_light {
-                        let (s, r) = self.gather_sky_at(light, x, normal, j);
-                        sum += s;
-                        rays += r;
-                    }
-                    let start = x + normal * tracer.offset();
-                    let mut s = Stream::new(CARRY_SEED, l as u64);
-                    let mut field = Rgb::BLACK;
-                    let n = normal.as_dvec3();
-                    over_hemisphere(&tracer, start, n, side, &mut s, &reflected, |f| field += f);
-                    sum += field * (1.0 / (side * side) as f64);
-                    rays += (side * side) as u64;
-                }
-                // The sun's light reaches it as it reached the old ones.
-                let sun = self.sun_irradiance(own, normal, j);
-                (b + rho * (sum + Rgb::splat(sun)), rays)
-            })
-            .collect();
+                let start = x + normal * tracer.offset();
+                let mut s = Stream::new(CARRY_SEED, l as u64);
+                let mut field = Rgb::BLACK;
+                let n = normal.as_dvec3();
+                over_hemisphere(&tracer, start, n, side, &mut s, &reflected, |f| field += f);
+                sum += field * (1.0 / (side * side) as f64);
+                rays += (side * side) as u64;
+            }
+            // The sun's light reaches it as it reached the old ones.
+            let sun = self.sun_irradiance(own, normal, j);
+            (b + rho * (sum + Rgb::splat(sun)), rays)
+        };
+        // In chunks, so that the gauge ([`crate::solver::gauge`]) counts
+        // the new vertices that gather themselves as they are done: on a
+        // real level the gather takes a minute.
+        let n = refined.vertex_count();
+        let gathers = |range: std::ops::Range<usize>| {
+            range
+                .filter(|&l| previous[l].is_none() && follows(l).is_none())
+                .count() as u64
+        };
+        let total = gathers(0..n);
+        let mut done = 0;
+        self.gauge.set(done, total);
+        let mut gathered: Vec<(Rgb, u64)> = Vec::with_capacity(n);
+        for start in (0..n).step_by(CARRY_CHUNK_VERTICES) {
+            let chunk = start..(start + CARRY_CHUNK_VERTICES).min(n);
+            gathered.par_extend(
+                chunk
+                    .clone()
+                    .into_par_iter()
+                    .with_min_len(16)
+                    .map(gather_one),
+            );
+            done += gathers(chunk);
+            self.gauge.set(done, total);
+            if cancel.load(Ordering::Relaxed) {
+                break;
+            }
+        }
+        self.gauge.idle();
         if cancel.load(Ordering::Relaxed) {
             return Err(Cancelled);
         }
