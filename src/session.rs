@@ -115,6 +115,9 @@ pub struct PassStats {
     pub refine_seconds: f64,
     /// Elements its result marked for splitting (0 for the last solve).
     pub split: usize,
+    /// Elements over the threshold: `split`, or more when
+    /// `--adaptive-max-splits` kept the rest whole.
+    pub over_threshold: usize,
     /// Further elements split to keep the mesh conforming.
     pub closure: usize,
 }
@@ -346,6 +349,7 @@ impl<'p> Session<'p> {
         }
         pass.split = report.marked;
         pass.closure = report.closure;
+        pass.over_threshold = report.over_threshold;
         pass.refine_seconds = refining.elapsed().as_secs_f64();
         pass.seconds = self.pass_start.time.elapsed().as_secs_f64();
         self.close_pass(pass);
@@ -381,6 +385,7 @@ impl<'p> Session<'p> {
             seconds: 0.0,
             refine_seconds: 0.0,
             split: 0,
+            over_threshold: 0,
             closure: 0,
         }
     }

@@ -201,6 +201,10 @@ fn an_option_without_the_one_it_needs_is_one_error_naming_it() {
             "--adaptive-levels needs --adaptive",
         ),
         (
+            &["--adaptive-max-splits", "300"],
+            "--adaptive-max-splits needs --adaptive",
+        ),
+        (
             &["--illuminance-out", "e.csv"],
             "--illuminance-out needs --illuminance-at",
         ),

@@ -1036,6 +1036,11 @@ fn say_pass(session: &Session, refined: Option<&crate::mesh::refine::RefineRepor
         pass.steps,
         pass.seconds,
         match refined {
+            Some(r) if r.marked < r.over_threshold => format!(
+                "; splitting the {} of its {} elements over the threshold with the most light to gain \
+                 (--adaptive-max-splits; +{} to stay conforming)",
+                r.marked, r.over_threshold, r.closure
+            ),
             Some(r) => format!(
                 "; splitting {} elements (+{} to stay conforming)",
                 r.marked, r.closure

@@ -271,6 +271,17 @@ pub struct Args {
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive_levels: u32,
 
+    /// Split at most N elements per refinement (--adaptive).
+    ///
+    /// When more differ by more than --adaptive-threshold, those with the
+    /// most light to gain are split: their luminance difference times
+    /// their area. On a real level a refinement marks tens of thousands of
+    /// small elements; the few thousand largest take almost all the error
+    /// for a fraction of the time.
+    #[arg(long, value_name = "N", default_value_t = refine::DEFAULT_MAX_SPLITS, value_parser = parse_whole::<u64>)]
+    #[arg(help_heading = heading::SOLVER)]
+    pub(crate) adaptive_max_splits: u64,
+
     /// Samples per pixel side for written pictures (1 to 8).
     ///
     /// The picture is rendered at N × N samples a pixel and averaged in

@@ -93,9 +93,10 @@ pub enum UsageError {
     /// `--checkpoint-every` is negative or not a number.
     #[error("--checkpoint-every must be a number of seconds >= 0, got {0}")]
     CheckpointEvery(f64),
-    /// `--adaptive-threshold` or `--adaptive-levels` is out of range; the
-    /// refinement's messages start with the field's name (`threshold`,
-    /// `levels`), which the flag spells with `adaptive-` before it.
+    /// `--adaptive-threshold`, `--adaptive-levels` or
+    /// `--adaptive-max-splits` is out of range; the refinement's messages
+    /// start with the field's name (`threshold`, `levels`, `max-splits`),
+    /// which the flag spells with `adaptive-` before it.
     #[error("--adaptive-{0}")]
     Refine(#[from] refine::OptionsError),
     /// `--exposure` is not a number of stops within
@@ -281,6 +282,7 @@ impl TryFrom<Args> for Invocation {
         let refine = RefineOptions {
             threshold: args.adaptive_threshold,
             levels: args.adaptive_levels,
+            max_splits: args.adaptive_max_splits,
             max_elements: args.max_elements,
         };
         refine.validate()?;

@@ -47,6 +47,12 @@ pub const NEEDS: &[Need] = &[
         met: |a| a.adaptive,
     },
     Need {
+        id: "adaptive_max_splits",
+        flag: "--adaptive-max-splits",
+        parent: "--adaptive",
+        met: |a| a.adaptive,
+    },
+    Need {
         id: "checkpoint_every",
         flag: "--checkpoint-every",
         parent: "--checkpoint",

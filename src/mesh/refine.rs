@@ -11,6 +11,13 @@
 //!    unless it has already been split [`RefineOptions::levels`] times. The
 //!    `floor` is [`DARK_FLOOR`] times the area-weighted mean of the field,
 //!    so that noise in the near-black parts of a scene does not split them;
+//!    When more leaves are marked than [`RefineOptions::max_splits`],
+//!    only that many are kept: those with the most light to gain, their
+//!    values' spread times their area (`(max − min) · area`, the light
+//!    a linear drawing across them can miss). On a real level a pass
+//!    marks tens of thousands of leaves, most of them small; the few
+//!    thousand largest take almost all of the error
+//!    ([`DEFAULT_MAX_SPLITS`]);
 //! 2. **splits** each marked leaf into four: a quadrilateral at its edge
 //!    midpoints and its centre, a triangle at its edge midpoints;
 //! 3. **closes** the split: a leaf whose edge carries more than one new
@@ -51,6 +58,29 @@ pub const DEFAULT_THRESHOLD: f64 = 0.25;
 /// quarter of the initial edge length.
 pub const DEFAULT_LEVELS: u32 = 2;
 
+/// Default [`RefineOptions::max_splits`]: at most 5,000 leaves split for
+/// their values per pass, those with the most light to gain.
+///
+/// Chosen 2026-12-07 on the Sauerbraten level `pandora.obj` under
+/// `--sky 1` (`--adaptive-levels 1`; 230,066 elements, 46,056 over the
+/// default threshold), against a path tracer's picture of one view
+/// (`docs/performance.md`), one run each on two cores:
+///
+/// | leaves split | new vertices | gather | error | wall |
+/// |---|---|---|---|---|
+/// | none (no refinement) | 0 | | 3.44 % | 67 s |
+/// | 2,303 largest | 21,000 | 6 s | 2.96 % | 73 s |
+/// | 4,606 largest | 42,000 | 12 s | 2.78 % | 85 s |
+/// | **5,000 largest (this default)** | 45,000 | 11 s | 2.75 % | 77 s |
+/// | 9,212 largest | 80,000 | 20 s | 2.79 % | 92 s |
+/// | 18,423 largest | 147,000 | 36 s | 2.75 % | 106 s |
+/// | all 46,056 | 305,000 | 60 s | 2.69 % | 138 s |
+/// | the 27,250 over a threshold of 0.4 | 202,000 | 38 s | 2.88 % | 102 s |
+///
+/// A scene of a few thousand elements marks fewer than this and is
+/// refined where its threshold says.
+pub const DEFAULT_MAX_SPLITS: u64 = 5_000;
+
 /// Most [`RefineOptions::levels`] accepted: each level can quadruple the
 /// elements where it splits, and six already cut an element's edges into
 /// 64, more than any shadow boundary of a sensible initial mesh needs.
@@ -69,6 +99,9 @@ pub struct RefineOptions {
     /// Split an initial element at most this many times (each halves the
     /// edge length); in `1..=`[`MAX_LEVELS`].
     pub levels: u32,
+    /// Split at most this many leaves for their values in one pass, those
+    /// with the most light to gain (module docs); at least 1.
+    pub max_splits: u64,
     /// Refuse a pass whose mesh would have more elements than this (then
     /// [`Refiner::refine`] changes nothing and [`Refiner::refused`] says
     /// how many it would have had).
@@ -86,6 +119,9 @@ pub enum OptionsError {
     /// [`RefineOptions::levels`] is not in `1..=`[`MAX_LEVELS`].
     #[error("levels must be between 1 and {MAX_LEVELS}, got {0}")]
     Levels(u32),
+    /// [`RefineOptions::max_splits`] is 0: no pass could split anything.
+    #[error("max-splits must be at least 1, got {0}")]
+    MaxSplits(u64),
 }
 
 impl RefineOptions {
@@ -100,6 +136,9 @@ impl RefineOptions {
         if !(1..=MAX_LEVELS).contains(&self.levels) {
             return Err(OptionsError::Levels(self.levels));
         }
+        if self.max_splits == 0 {
+            return Err(OptionsError::MaxSplits(self.max_splits));
+        }
         Ok(())
     }
 }
@@ -109,6 +148,7 @@ impl Default for RefineOptions {
         RefineOptions {
             threshold: DEFAULT_THRESHOLD,
             levels: DEFAULT_LEVELS,
+            max_splits: DEFAULT_MAX_SPLITS,
             max_elements: super::MAX_ELEMENTS,
         }
     }
@@ -117,8 +157,13 @@ impl Default for RefineOptions {
 /// What one refinement pass did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RefineReport {
-    /// Leaves split because their values differ by more than the threshold.
+    /// Leaves split because their values differ by more than the
+    /// threshold: all of them, or the [`RefineOptions::max_splits`] with
+    /// the most light to gain.
     pub marked: usize,
+    /// Leaves whose values differ by more than the threshold, split or
+    /// not.
+    pub over_threshold: usize,
     /// Leaves split to keep the mesh conforming (closure).
     pub closure: usize,
     /// Leaves after the pass.
@@ -318,20 +363,32 @@ impl Refiner {
         let max_level = options.levels.min(u8::MAX as u32) as u8;
 
         let mut ring = Vec::new();
-        let marked: Vec<usize> = (0..self.leaves.len())
-            .filter(|&k| {
+        // Each leaf over the threshold, with the light it has to gain.
+        let mut over: Vec<(f64, usize)> = (0..self.leaves.len())
+            .filter_map(|k| {
                 let leaf = self.leaves[k];
                 if leaf.level >= max_level || self.is_sky(&leaf) {
-                    return false;
+                    return None;
                 }
                 self.ring(&leaf, &mut ring);
                 let (lo, hi) = ring.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &v| {
                     let x = pool_values[v as usize];
                     (lo.min(x), hi.max(x))
                 });
-                hi > 0.0 && (hi - lo) / hi.max(floor) > options.threshold
+                (hi > 0.0 && (hi - lo) / hi.max(floor) > options.threshold)
+                    .then(|| ((hi - lo) * self.leaf_area(&leaf), k))
             })
             .collect();
+        let over_threshold = over.len();
+        let keep = usize::try_from(options.max_splits).unwrap_or(usize::MAX);
+        if over.len() > keep {
+            // The most light to gain first; ties in leaf order, so the
+            // choice does not depend on the sort.
+            over.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            over.truncate(keep);
+            over.sort_unstable_by_key(|&(_, k)| k);
+        }
+        let marked: Vec<usize> = over.into_iter().map(|(_, k)| k).collect();
         self.refused = None;
         if marked.is_empty() {
             return None;
@@ -349,6 +406,7 @@ impl Refiner {
         }
         let mut report = RefineReport {
             marked: marked.len(),
+            over_threshold,
             ..RefineReport::default()
         };
         // Split from the back so that the indices still to split stay valid

@@ -284,6 +284,11 @@ fn out_of_range_values_are_usage_errors_naming_the_option() {
             "--adaptive-levels must be between 1 and 6, got 0",
         ),
         (
+            &["--adaptive", "--adaptive-max-splits", "0"],
+            UsageError::Refine(refine::OptionsError::MaxSplits(0)),
+            "--adaptive-max-splits must be at least 1, got 0",
+        ),
+        (
             &["--exposure", "40.5"],
             UsageError::Exposure(40.5),
             "--exposure must be a number of stops from -40 to 40 (0 is the automatic exposure, \
@@ -335,6 +340,8 @@ fn adaptive_options_reach_the_config_only_with_adaptive() {
             "0.1",
             "--adaptive-levels",
             "3",
+            "--adaptive-max-splits",
+            "70",
             "--max-elements",
             "900",
         ])
@@ -342,11 +349,13 @@ fn adaptive_options_reach_the_config_only_with_adaptive() {
         Some(RefineOptions {
             threshold: 0.1,
             levels: 3,
+            max_splits: 70,
             max_elements: 900,
         })
     );
     // Without --adaptive they are refused by clap, not ignored.
     assert!(parse(&["--adaptive-levels", "3"]).is_err());
+    assert!(parse(&["--adaptive-max-splits", "3"]).is_err());
     assert!(parse(&["--adaptive", "--checkpoint", "c.bin"]).is_err());
 }
 

@@ -363,3 +363,80 @@ fn a_refined_one_element_polygon_takes_the_inset_of_many() {
         );
     }
 }
+
+/// Two squares apart, `A` of side 1 and `B` of side `side_b`, meshed at
+/// lenmax 0.3 (four elements a side each, so `B`'s are larger when it
+/// is), under a step across `x − x₀ = 0.63` of each: `A` from 0.1 to 1,
+/// `B` from `low_b` to 1. Returns the scene, its mesh and the field.
+fn two_steps(side_b: f32, low_b: f64) -> (Scene, Mesh, Vec<f64>) {
+    let square = |x0: f32, side: f32| {
+        testutil::polygon(
+            0,
+            &[
+                [x0, 0., 0.],
+                [x0 + side, 0., 0.],
+                [x0 + side, side, 0.],
+                [x0, side, 0.],
+            ],
+        )
+    };
+    let scene = testutil::scene(
+        vec![square(0.0, 1.0), square(3.0, side_b)],
+        vec![testutil::grey("m", 0.0, 0.5)],
+    );
+    let mesh = build(&scene, &options()).unwrap();
+    let field = mesh
+        .positions
+        .iter()
+        .map(
+            |p| match (p.x < 2.0, p.x - if p.x < 2.0 { 0.0 } else { 3.0 } < 0.63) {
+                (_, false) => 1.0,
+                (true, true) => 0.1,
+                (false, true) => low_b,
+            },
+        )
+        .collect();
+    (scene, mesh, field)
+}
+
+/// The polygons that got new vertices in a refinement of `mesh` to
+/// `refined`: `(A, B)`.
+fn refined_polygons(mesh: &Mesh, refined: &Mesh) -> (bool, bool) {
+    let new = |p: usize| refined.polygons[p].vertex_count() > mesh.polygons[p].vertex_count();
+    (new(0), new(1))
+}
+
+#[test]
+fn past_max_splits_the_leaves_with_the_most_light_to_gain_split() {
+    let limited = |max_splits| RefineOptions {
+        max_splits,
+        ..RefineOptions::default()
+    };
+    // Equal elements: the steeper step (0.9 against 0.5 of light) first.
+    let (scene, mesh, field) = two_steps(1.0, 0.5);
+    let (_, all) = Refiner::new(&mesh)
+        .refine(&scene, &field, &limited(u64::MAX))
+        .unwrap();
+    assert_eq!(all.marked, all.over_threshold);
+    assert!(all.marked % 2 == 0 && all.marked > 0, "{all:?}");
+    let half = all.marked as u64 / 2;
+    let (refined, report) = Refiner::new(&mesh)
+        .refine(&scene, &field, &limited(half))
+        .unwrap();
+    assert_eq!(
+        (report.marked, report.over_threshold),
+        (half as usize, all.marked)
+    );
+    assert_eq!(refined_polygons(&mesh, &refined), (true, false));
+    assert_conforming(&scene, &refined);
+    // Equal steps: the larger elements (B's, 1.1 a side against 1) first.
+    let (scene, mesh, field) = two_steps(1.1, 0.1);
+    let (refined, report) = Refiner::new(&mesh)
+        .refine(&scene, &field, &limited(half))
+        .unwrap();
+    assert_eq!(report.marked, half as usize);
+    assert_eq!(refined_polygons(&mesh, &refined), (false, true));
+    assert_conforming(&scene, &refined);
+    // Zero is refused by the options' check.
+    assert_eq!(limited(0).validate(), Err(OptionsError::MaxSplits(0)));
+}
