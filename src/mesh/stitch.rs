@@ -10,7 +10,8 @@
 //! refinement, see [`super::refine`]):
 //!
 //! 1. the **boundary edges** of each polygon's mesh are the element edges
-//!    used by one element of it;
+//!    used by one element of it (found from the polygon's edges, or, for
+//!    a polygon thinner than the tolerances, by counting);
 //! 2. **snap**: boundary vertices of different polygons closer than the
 //!    tolerance `ε` ([`STITCH_TOLERANCE`] × the scene's bounding-box
 //!    diagonal) get one position, bit for bit: that of the lowest-numbered
@@ -92,7 +93,7 @@ pub(crate) fn stitch_with_origins(scene: &Scene, mut mesh: Mesh) -> (Mesh, Optio
         return (mesh, None);
     }
     let eps = STITCH_TOLERANCE * extent;
-    let edges = boundary_edges(scene, &mesh);
+    let edges = boundary_edges(scene, &mesh, eps);
     let mut boundary: Vec<u32> = edges.iter().flat_map(|e| [e.a, e.b]).collect();
     boundary.par_sort_unstable();
     boundary.dedup();
@@ -110,12 +111,16 @@ pub(crate) fn stitch_with_origins(scene: &Scene, mut mesh: Mesh) -> (Mesh, Optio
 /// (the polygons are convex, so such an edge runs along it). Found from
 /// the geometry rather than by counting the elements of each edge, so
 /// the cost is linear.
-fn boundary_edges(scene: &Scene, mesh: &Mesh) -> Vec<BoundaryEdge> {
+fn boundary_edges(scene: &Scene, mesh: &Mesh, eps: f32) -> Vec<BoundaryEdge> {
     let mut out = Vec::new();
     let mut mask: Vec<u64> = Vec::new();
     let mut candidates = Vec::new();
     for (polygon, pm) in scene.polygons.iter().zip(&mesh.polygons) {
         let (lines, near) = edge_lines(polygon);
+        if is_thin(polygon, &lines, eps) {
+            thin_boundary(mesh, pm, &mut out);
+            continue;
+        }
         let first = pm.vertices.start;
         mask.clear();
         mask.extend(pm.vertices.clone().map(|v| {
@@ -157,6 +162,50 @@ fn boundary_edges(scene: &Scene, mesh: &Mesh) -> Vec<BoundaryEdge> {
         }
     }
     out
+}
+
+/// Whether `polygon` is so thin that a point can lie within the on-edge
+/// tolerance, or the stitching tolerance `eps`, of two of its edges at
+/// once: its mean width across its longest edge (`2 · area / longest`, a
+/// triangle's height) is at most twice the larger of them. A needle of a real export (80 m long,
+/// 0.6 mm high) is one: found from the geometry, every edge of its
+/// element grid was a boundary edge, each took every neighbour's vertex
+/// beside it, and a refinement of the model's neighbours grew its 3,200
+/// vertices to 84,000.
+fn is_thin(polygon: &crate::scene::Polygon, lines: &[Option<EdgeLine>], eps: f32) -> bool {
+    let v = &polygon.vertices;
+    let longest = (0..v.len())
+        .map(|k| v[k].distance(v[(k + 1) % v.len()]))
+        .fold(0.0f32, f32::max);
+    let tolerance = lines.iter().flatten().map(|l| l.2).fold(eps, f32::max);
+    longest > 0.0 && 2.0 * polygon.area as f32 <= 2.0 * tolerance * longest
+}
+
+/// A thin polygon's boundary element edges (see [`is_thin`]), found by
+/// counting: the element edges that only one of its elements uses.
+fn thin_boundary(mesh: &Mesh, pm: &super::PolygonMesh, out: &mut Vec<BoundaryEdge>) {
+    let mut uses: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    let edges = |e: u32| {
+        let c = mesh.elements[e as usize].corners();
+        (0..c.len()).map(move |k| (k, c[k].0, c[(k + 1) % c.len()].0))
+    };
+    for e in pm.elements.clone() {
+        for (_, a, b) in edges(e) {
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    for e in pm.elements.clone() {
+        for (k, a, b) in edges(e) {
+            if uses[&(a.min(b), a.max(b))] == 1 {
+                out.push(BoundaryEdge {
+                    element: e,
+                    edge: k as u8,
+                    a,
+                    b,
+                });
+            }
+        }
+    }
 }
 
 /// A polygon edge's start, unit direction and on-edge tolerance.

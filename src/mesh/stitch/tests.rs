@@ -46,7 +46,7 @@ fn options(lenmax: f32) -> MeshOptions {
 /// watertight mesh. Brute force.
 fn cracks(scene: &Scene, mesh: &Mesh) -> (usize, usize) {
     let eps = STITCH_TOLERANCE * scene.extent();
-    let edges = boundary_edges(scene, mesh);
+    let edges = boundary_edges(scene, mesh, eps);
     let mut boundary: Vec<u32> = edges.iter().flat_map(|e| [e.a, e.b]).collect();
     boundary.sort_unstable();
     boundary.dedup();
@@ -278,4 +278,42 @@ fn a_large_mesh_is_stitched_quickly() {
     // Generous for a loaded two-core machine in a debug build; a
     // release build takes a fraction of this.
     assert!(seconds < 20.0, "{seconds} s");
+}
+
+/// A needle (10 long, 5·10⁻⁵ high, under half the stitching tolerance
+/// of this 10-unit scene) along the far edge of a 10 × 1 floor. Its
+/// element grid lies within the tolerance of both its long edges, so
+/// found from the geometry every element edge was a boundary edge and
+/// took the floor's vertices beside it: many vertices of the needle at
+/// one position. Counted instead, its boundary takes each once per edge.
+#[test]
+fn a_needle_thinner_than_the_tolerance_takes_each_neighbour_vertex_once() {
+    let h = 5e-5;
+    let s = scene(&[
+        &[[0., 0., 0.], [10., 0., 0.], [10., 1., 0.], [0., 1., 0.]],
+        &[[0., 1., 0.], [10., 1., 0.], [5., 1. + h, 0.]],
+    ]);
+    let eps = STITCH_TOLERANCE * s.extent();
+    assert!(h < 0.5 * eps, "the needle is thinner than the tolerance");
+    let before = build_unstitched_with_limit(&s, &options(0.3), MAX_ELEMENTS).unwrap();
+    let mesh = build(&s, &options(0.3)).unwrap();
+    mesh.validate().unwrap();
+    let needle = &mesh.polygons[1];
+    let mut positions: Vec<[u32; 3]> = needle
+        .vertices
+        .clone()
+        .map(|v| mesh.positions[v as usize].to_array().map(f32::to_bits))
+        .collect();
+    let all = positions.len();
+    positions.sort_unstable();
+    positions.dedup();
+    // The floor's 35 cut points along y = 1, each near both long edges of
+    // the needle: at most twice each, beside its own grid.
+    let own = before.polygons[1].vertex_count() as usize;
+    assert!(all <= own + 2 * 35, "{all} vertices, its own {own}");
+    assert!(
+        positions.len() * 3 >= all,
+        "{all} vertices at {} positions",
+        positions.len()
+    );
 }
