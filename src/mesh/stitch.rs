@@ -110,7 +110,8 @@ pub(crate) fn stitch_with_origins(scene: &Scene, mut mesh: Mesh) -> (Mesh, Optio
 /// order: the element edges whose two ends lie on one edge of the polygon
 /// (the polygons are convex, so such an edge runs along it). Found from
 /// the geometry rather than by counting the elements of each edge, so
-/// the cost is linear.
+/// the cost is linear; a polygon too thin for that ([`is_thin`]) by
+/// counting.
 fn boundary_edges(scene: &Scene, mesh: &Mesh, eps: f32) -> Vec<BoundaryEdge> {
     let mut out = Vec::new();
     let mut mask: Vec<u64> = Vec::new();
@@ -167,18 +168,18 @@ fn boundary_edges(scene: &Scene, mesh: &Mesh, eps: f32) -> Vec<BoundaryEdge> {
 /// Whether `polygon` is so thin that a point can lie within the on-edge
 /// tolerance, or the stitching tolerance `eps`, of two of its edges at
 /// once: its mean width across its longest edge (`2 · area / longest`, a
-/// triangle's height) is at most twice the larger of them. A needle of a real export (80 m long,
-/// 0.6 mm high) is one: found from the geometry, every edge of its
-/// element grid was a boundary edge, each took every neighbour's vertex
-/// beside it, and a refinement of the model's neighbours grew its 3,200
-/// vertices to 84,000.
+/// triangle's height) is at most twice the larger of them. A needle of a
+/// real export (80 m long, 0.6 mm high) is one: found from the geometry,
+/// every edge of its element grid was a boundary edge, each took every
+/// neighbour's vertex beside it, and a refinement of the model's
+/// neighbours grew its 3,200 vertices to 84,000.
 fn is_thin(polygon: &crate::scene::Polygon, lines: &[Option<EdgeLine>], eps: f32) -> bool {
     let v = &polygon.vertices;
     let longest = (0..v.len())
         .map(|k| v[k].distance(v[(k + 1) % v.len()]))
         .fold(0.0f32, f32::max);
     let tolerance = lines.iter().flatten().map(|l| l.2).fold(eps, f32::max);
-    longest > 0.0 && 2.0 * polygon.area as f32 <= 2.0 * tolerance * longest
+    longest > 0.0 && 2.0 * polygon.area as f32 / longest <= 2.0 * tolerance
 }
 
 /// A thin polygon's boundary element edges (see [`is_thin`]), found by
