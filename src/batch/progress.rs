@@ -275,9 +275,7 @@ impl Shown {
             format!("{} · {now_says}", self.base)
         }
     }
-}
 
-impl Shown {
     /// What is under way: `step N`, or the activity named.
     fn doing(&self) -> String {
         match self.activity {
@@ -411,7 +409,6 @@ mod tests {
         );
     }
 
-    /// A step's report is the base of the next one's message.
     /// Once a pass converges, the refinement's gather fills the gauge:
     /// the bar names it in place of a step, and the next step's report
     /// names steps again.
@@ -446,6 +443,7 @@ mod tests {
         );
     }
 
+    /// A step's report is the base of the next one's message.
     #[test]
     fn a_finished_step_starts_the_next_ones_clock() {
         let mut p = Progress::new(false, 0.001, None);

@@ -283,7 +283,7 @@ pub(in crate::solver) fn over_hemisphere(
     }
 }
 
-/// The weight of the particles' answer/// The weight of the particles' answer `particles` (luminance) at a
+/// The weight of the particles' answer `particles` (luminance) at a
 /// vertex against the gather's `gathered`, each weighted by the inverse
 /// of its variance: the particles' from their deposits' squares
 /// (`squares`, over the hat's area squared: the deposits taken as
