@@ -26,7 +26,8 @@ fn office() -> (RunConfig, Prepared) {
 }
 
 fn solve(config: &RunConfig, prepared: &Prepared) -> Vec<Rgb> {
-    let mut session = Session::from_prepared(prepared, SessionOptions::for_run(config, false));
+    let mut session =
+        Session::from_prepared(prepared, SessionOptions::for_run(config, prepared, false));
     session.run_to_end(&AtomicBool::new(false)).expect("solves");
     session.radiosity().to_vec()
 }

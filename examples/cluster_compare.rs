@@ -165,7 +165,8 @@ fn main() {
             }
         }
         let t = Instant::now();
-        let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
+        let mut session =
+            Session::from_prepared(&prepared, SessionOptions::for_run(&c, &prepared, false));
         session
             .run_to_end(&AtomicBool::new(false))
             .expect("an uncancelled solve");

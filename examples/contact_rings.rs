@@ -71,7 +71,8 @@ fn main() {
         let mut c = config.clone();
         c.solver.approximations.clusters = clustering;
         c.solver.approximations.overshoot = clustering;
-        let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&c, false));
+        let mut session =
+            Session::from_prepared(&prepared, SessionOptions::for_run(&c, &prepared, false));
         session
             .run_to_end(&AtomicBool::new(false))
             .expect("an uncancelled solve");

@@ -47,7 +47,8 @@ fn solve(config: &RunConfig) -> (Frame, Frame, u64, f64) {
     let prepared = prepare::prepare(config).expect("the scene prepares");
     let view = prepared.view(config).expect("the scene's camera");
     let t = Instant::now();
-    let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(config, false));
+    let mut session =
+        Session::from_prepared(&prepared, SessionOptions::for_run(config, &prepared, false));
     session
         .run_to_end(&AtomicBool::new(false))
         .expect("an uncancelled solve");

@@ -77,7 +77,10 @@ fn main() {
     let spacing: f64 = args[3].parse().expect("a spacing in metres");
     let samples: usize = args[4].parse().expect("a number of samples");
     let prepared = prepare::prepare(&config).unwrap_or_else(|e| panic!("{e}"));
-    let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&config, false));
+    let mut session = Session::from_prepared(
+        &prepared,
+        SessionOptions::for_run(&config, &prepared, false),
+    );
     session
         .run_to_end(&AtomicBool::new(false))
         .unwrap_or_else(|e| panic!("{e}"));

@@ -79,8 +79,10 @@ fn main() {
             prepare::prepare(&config).expect("the scene prepared once already");
         let view = prepared.view(&config).expect("the camera file's camera");
         let t = Instant::now();
-        let mut session =
-            Session::from_prepared(&prepared, SessionOptions::for_run(&config, false));
+        let mut session = Session::from_prepared(
+            &prepared,
+            SessionOptions::for_run(&config, &prepared, false),
+        );
         session
             .run_to_end(&AtomicBool::new(false))
             .expect("an uncancelled solve");

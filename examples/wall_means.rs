@@ -43,7 +43,10 @@ fn main() {
         }
     };
     let start = std::time::Instant::now();
-    let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(&config, false));
+    let mut session = Session::from_prepared(
+        &prepared,
+        SessionOptions::for_run(&config, &prepared, false),
+    );
     if let Err(e) = session.run_to_end(&AtomicBool::new(false)) {
         eprintln!("{e}");
         std::process::exit(1);

@@ -78,7 +78,7 @@ fn main() {
             std::process::exit(2);
         }
     };
-    let mut options = SessionOptions::for_run(&config, true);
+    let mut options = SessionOptions::for_run(&config, &prepared, true);
     options.solver.part_budget = budget;
     let mut session = Session::from_prepared(&prepared, options);
     let cancel = AtomicBool::new(false);

@@ -7,7 +7,8 @@ print the rows of docs/performance.md's "Real models at real size" table.
 
 Each model (by default every level, room and house listed below) is run
 as `radiosity MODEL --sky 1 --no-window -o DIR/NAME.pfm --stats ...
---log ...` at default options, under /usr/bin/time for the whole
+--log ...` at default options (so a model whose default mesh the vertex
+budget coarsened is refined once, and its row says how), under /usr/bin/time for the whole
 process's wall and CPU seconds and peak memory. With --max-steps a model
 that has not converged by then says so in its row. One model at a time:
 on a shared machine, the CPU seconds are the steadier figure.
@@ -60,9 +61,17 @@ def run(radiosity, model, work, max_steps):
     sky = "step" if sky_steps == 1 else "{} steps".format(sky_steps)
     state = "converged" if s["converged"] else "not converged ({:.2%} unshot)".format(
         s["unshot_fraction"])
-    return "| `{}` | {:,} / {:,} | {}: {:,} steps (the sky's {} in {:.0f} s), {:.0f} s wall, {:.0f} s CPU | {:.0f} MB |".format(
+    # A coarsened default mesh is refined once: say how much it split.
+    passes = s.get("adaptive", [])
+    refined = ""
+    if len(passes) > 1:
+        first = passes[0]
+        refined = ", refined once ({:,} of {:,} elements over the threshold split, +{:,} vertices, {:.0f} s)".format(
+            first["split"], first["over_threshold"],
+            passes[-1]["vertices"] - first["vertices"], first["refine_seconds"])
+    return "| `{}` | {:,} / {:,} | {}: {:,} steps (the sky's {} in {:.0f} s){}, {:.0f} s wall, {:.0f} s CPU | {:.0f} MB |".format(
         model.replace("tests/models/", ""), s["polygons"], s["vertices"], state, s["steps"],
-        sky, sky_seconds, float(wall), float(user) + float(system), int(kb) / 1024)
+        sky, sky_seconds, refined, float(wall), float(user) + float(system), int(kb) / 1024)
 
 
 def main():

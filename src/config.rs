@@ -129,6 +129,10 @@ pub struct RunConfig {
     /// Refine the mesh where the solution changes sharply and solve again
     /// ([`mesh::refine`]), or `None` to solve on the regular mesh only.
     pub adaptive: Option<RefineOptions>,
+    /// Without [`RunConfig::adaptive`], refine once when the vertex budget
+    /// coarsened the default mesh ([`RunConfig::refinement`]); off with
+    /// `--no-adaptive`.
+    pub refine_coarsened: bool,
     /// Draw the element mesh over the picture (8-bit pictures only).
     pub mesh_lines: bool,
     /// Samples per pixel side of written pictures
@@ -304,6 +308,7 @@ impl RunConfig {
             allow_outside_paths: false,
             ambient: None,
             adaptive: None,
+            refine_coarsened: true,
             mesh_lines: false,
             aa: crate::render::antialias::DEFAULT_AA,
             emit: Vec::new(),
@@ -338,6 +343,26 @@ impl RunConfig {
 }
 
 impl RunConfig {
+    /// The refinement this run does, `coarsened` saying whether the vertex
+    /// budget made the default mesh coarser than the default lenmax
+    /// ([`mesh::MeshOptions::within_budget`]): `--adaptive`'s; else, on a
+    /// coarsened mesh and with [`RunConfig::refine_coarsened`], one pass
+    /// of [`RefineOptions::default`]'s threshold and split limit, so that
+    /// the budget's vertices are spent where the light changes; none when
+    /// a checkpoint is written or resumed (it holds one mesh).
+    pub fn refinement(&self, coarsened: bool) -> Option<RefineOptions> {
+        let checkpointed = self.checkpoint.is_some() || self.resume.is_some();
+        match self.adaptive {
+            Some(refine) => Some(refine),
+            None if coarsened && self.refine_coarsened && !checkpointed => Some(RefineOptions {
+                levels: 1,
+                max_elements: self.max_elements,
+                ..RefineOptions::default()
+            }),
+            None => None,
+        }
+    }
+
     /// True when the run asks for results only a batch run writes (the
     /// mesh export, the log, the plot or mesh lines on the picture), so no
     /// window should open.

@@ -120,6 +120,10 @@ pub struct Prepared {
     visibility: OnceLock<(Visibility, f64)>,
     /// The lenmax the mesh was built with, in scene units.
     pub lenmax: f32,
+    /// Whether the vertex budget made the mesh coarser than the default
+    /// lenmax ([`MeshOptions::within_budget`]): such a run refines once
+    /// ([`RunConfig::refinement`]).
+    pub coarsened: bool,
     /// Seconds spent so far on load and mesh; see
     /// [`Prepared::phase_seconds`] for the BVH's.
     pub seconds: PhaseSeconds,
@@ -215,6 +219,8 @@ pub struct ReadyScene {
     /// The mesh options: `--lenmax` or the default within the vertex
     /// budget, and `--inset`.
     pub mesh_options: MeshOptions,
+    /// Whether the vertex budget coarsened the default mesh.
+    pub coarsened: bool,
     /// Every file the run reads (see [`Prepared::inputs`]).
     pub inputs: InputSet,
     /// The BVH the repair passes built, and the seconds it took.
@@ -315,19 +321,30 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
     let load_seconds = t.elapsed().as_secs_f64() - bvh_seconds;
 
     let t = Instant::now();
-    let mut mesh_options = match config.lenmax {
-        Some(lenmax) => MeshOptions {
-            lenmax,
-            ..MeshOptions::for_scene(&scene)
-        },
+    let (mut mesh_options, coarsened) = match config.lenmax {
+        Some(lenmax) => (
+            MeshOptions {
+                lenmax,
+                ..MeshOptions::for_scene(&scene)
+            },
+            false,
+        ),
         None => {
             let (options, coarsened) = MeshOptions::within_budget(&scene, VERTEX_BUDGET);
-            if let Some(coarsened) = coarsened {
-                scene
-                    .warnings
-                    .push(Warning::file(&name, coarsened.to_string()));
+            if let Some(coarsened) = &coarsened {
+                let mut line = coarsened.to_string();
+                if config.adaptive.is_none() {
+                    if let Some(refine) = config.refinement(true) {
+                        line += &format!(
+                            "; once solved, up to {} of its elements where the light changes \
+                             most are split and solved again (--no-adaptive keeps it)",
+                            crate::mesh::budget::about(refine.max_splits)
+                        );
+                    }
+                }
+                scene.warnings.push(Warning::file(&name, line));
             }
-            options
+            (options, coarsened.is_some())
         }
     };
     mesh_options.inset = config.inset;
@@ -336,6 +353,7 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
         split: repaired.split,
         unreached_backs: repaired.unreached_backs,
         mesh_options,
+        coarsened,
         inputs,
         rays: repaired.rays.map(|built| (built, bvh_seconds)),
         load_seconds,
@@ -353,6 +371,7 @@ fn prepare_deferred_cancellable(
         split,
         unreached_backs: _,
         mesh_options,
+        coarsened,
         inputs,
         rays,
         load_seconds,
@@ -389,6 +408,7 @@ fn prepare_deferred_cancellable(
         mesh,
         visibility,
         lenmax: mesh_options.lenmax,
+        coarsened,
         seconds,
         split,
         inputs,
@@ -534,6 +554,10 @@ mod tests {
         let prepared = prepare_deferred(&config).expect("the stack prepares");
         assert_eq!(prepared.lenmax, 0.0186);
         assert!((prepared.mesh.vertex_count() as u64) <= VERTEX_BUDGET);
+        // So the session refines it once.
+        assert!(prepared.coarsened);
+        let refine = crate::session::SessionOptions::for_run(&config, &prepared, false).refine;
+        assert_eq!(refine.map(|r| (r.levels, r.max_splits)), Some((1, 5_000)));
         // The squares share no edge: the estimate is the mesh.
         let n = (1.0 / prepared.lenmax).floor() as usize + 2;
         assert_eq!(prepared.mesh.vertex_count(), STACKED * n * n);
@@ -568,6 +592,9 @@ mod tests {
             config.lenmax = Some(lenmax);
             let prepared = prepare_deferred(&config).expect("the stack prepares");
             assert_eq!(prepared.lenmax, lenmax);
+            assert!(!prepared.coarsened);
+            let options = crate::session::SessionOptions::for_run(&config, &prepared, false);
+            assert_eq!(options.refine, None);
             let n = (1.0 / lenmax).floor() as usize + 2;
             assert_eq!(prepared.mesh.vertex_count(), STACKED * n * n);
             assert!(prepared

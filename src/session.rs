@@ -58,13 +58,18 @@ pub struct SessionOptions {
 }
 
 impl SessionOptions {
-    /// The options a run configured by `config` solves with;
+    /// The options a run configured by `config` solves `prepared` with
+    /// (refined as [`RunConfig::refinement`] says for its mesh);
     /// `ambient_default` is whether the ambient term is shown when the
     /// user did not say (on in the window, off for files).
-    pub fn for_run(config: &RunConfig, ambient_default: bool) -> SessionOptions {
+    pub fn for_run(
+        config: &RunConfig,
+        prepared: &Prepared,
+        ambient_default: bool,
+    ) -> SessionOptions {
         SessionOptions {
             solver: config.solver,
-            refine: config.adaptive,
+            refine: config.refinement(prepared.coarsened),
             // Refinement stops where the memory budget would, too.
             max_elements: config.max_elements.min(config.max_memory.elements_within()),
             ambient: config.ambient.unwrap_or(ambient_default),
@@ -161,7 +166,10 @@ pub struct Session<'p> {
     /// ([`Method::refined_state`]): the next [`Session::advance`] gathers
     /// on it again rather than refine a second time.
     pending: Option<(Mesh, RefineReport)>,
-    solver: Box<dyn Method<'p> + 'p>,
+    /// The current pass's solver: `None` only inside
+    /// [`Session::refine_or_finish`], between dropping one pass's solver
+    /// and building the next's.
+    solver: Option<Box<dyn Method<'p> + 'p>>,
     phase: Phase,
     passes: Vec<PassStats>,
     /// Counts of the finished passes' solvers.
@@ -205,7 +213,7 @@ impl<'p> Session<'p> {
             options,
             refiner,
             pending: None,
-            solver,
+            solver: Some(solver),
             phase: Phase::Solving,
             passes: Vec::new(),
             finished: Totals::default(),
@@ -234,7 +242,7 @@ impl<'p> Session<'p> {
         &mut self,
         state: crate::solver::checkpoint::SolverState,
     ) -> Result<(), SolverError> {
-        self.solver.restore(state)
+        self.solver_mut().restore(state)
     }
 
     /// Does the next thing: one shooting step, the end of a pass, a
@@ -248,14 +256,14 @@ impl<'p> Session<'p> {
             Phase::Finished => Ok(Event::Finished),
             Phase::Stopped(reason) => self.refine_or_finish(reason, cancel),
             Phase::Solving => {
-                if let Some(reason) = self.solver.stop_reason() {
+                if let Some(reason) = self.solver().stop_reason() {
                     self.phase = Phase::Stopped(reason);
                     return Ok(Event::Stopped(reason));
                 }
-                let stepped = self.solver.step_cancellable(cancel);
+                let stepped = self.solver_mut().step_cancellable(cancel);
                 // A step that made a non-finite value ends the solve; its
                 // report, if it finished, is not passed on.
-                if let Some(fault) = self.solver.fault() {
+                if let Some(fault) = self.solver().fault() {
                     return Err(fault.clone());
                 }
                 match stepped {
@@ -301,16 +309,13 @@ impl<'p> Session<'p> {
         let refining = Instant::now();
         let mut next = None;
         let mut refused = None;
+        let held = held(&self.solver);
         if let Some((refiner, options)) = &mut self.refiner {
             let refined = match self.pending.take() {
                 Some(pending) => Some(pending),
                 None if reason == StopReason::Converged && refiner.passes() < options.levels => {
-                    let luminance: Vec<f64> = self
-                        .solver
-                        .radiosity()
-                        .iter()
-                        .map(|b| b.luminance())
-                        .collect();
+                    let luminance: Vec<f64> =
+                        held.radiosity().iter().map(|b| b.luminance()).collect();
                     let refined = refiner.refine(self.scene, &luminance, options);
                     if refined.is_none() {
                         refused = refiner.refused();
@@ -320,10 +325,7 @@ impl<'p> Session<'p> {
                 None => None,
             };
             if let Some((mesh, report)) = refined {
-                match self
-                    .solver
-                    .refined_state(self.scene, &mesh, refiner, cancel)
-                {
+                match held.refined_state(self.scene, &mesh, refiner, cancel) {
                     Ok(start) => next = Some((mesh, report, start)),
                     Err(crate::cancel::Cancelled) => {
                         self.pending = Some((mesh, report));
@@ -345,7 +347,7 @@ impl<'p> Session<'p> {
         };
         // The gather for the new vertices is this pass's work too.
         if let Some(state) = &start {
-            pass.rays += state.rays - self.solver.rays();
+            pass.rays += state.rays - self.solver().rays();
         }
         pass.split = report.marked;
         pass.closure = report.closure;
@@ -353,23 +355,28 @@ impl<'p> Session<'p> {
         pass.refine_seconds = refining.elapsed().as_secs_f64();
         pass.seconds = self.pass_start.time.elapsed().as_secs_f64();
         self.close_pass(pass);
+        // This pass's solver goes before the next one is built: both at
+        // once set a refinement's peak memory (`pandora.obj`: 887 MB,
+        // against 688 MB just before the build). A carried state that
+        // fails to restore leaves the new solver as built, a consistent
+        // start on the refined mesh, and the error is returned.
+        self.solver = None;
         let mut solver = solver::build(
             self.scene,
             Arc::new(mesh),
             self.visibility,
             self.options.solver,
         );
-        if let Some(state) = start {
-            solver.restore(state)?;
-        }
-        self.solver = solver;
-        self.weld = Weld::new(self.scene, self.solver.mesh());
+        let restored = start.map_or(Ok(()), |state| solver.restore(state));
+        self.weld = Weld::new(self.scene, solver.mesh());
         self.pass_start = PassStart {
             time: Instant::now(),
-            steps: self.solver.steps(),
-            rays: self.solver.rays(),
+            steps: solver.steps(),
+            rays: solver.rays(),
         };
+        self.solver = Some(solver);
         self.phase = Phase::Solving;
+        restored?;
         Ok(Event::Refined(report))
     }
 
@@ -380,8 +387,8 @@ impl<'p> Session<'p> {
         PassStats {
             elements: mesh.elements.len(),
             vertices: mesh.vertex_count(),
-            steps: self.solver.steps() - self.pass_start.steps,
-            rays: self.solver.rays() - self.pass_start.rays,
+            steps: self.solver().steps() - self.pass_start.steps,
+            rays: self.solver().rays() - self.pass_start.rays,
             seconds: 0.0,
             refine_seconds: 0.0,
             split: 0,
@@ -392,13 +399,19 @@ impl<'p> Session<'p> {
 
     /// Records a finished pass and its solver's counts.
     fn close_pass(&mut self, pass: PassStats) {
-        let (receivers, clear) = self.solver.receiver_pairs();
+        let (receivers, clear) = self.solver().receiver_pairs();
         self.finished.steps += pass.steps;
         self.finished.rays += pass.rays;
-        self.finished.pairs += self.solver.pairs();
+        self.finished.pairs += self.solver().pairs();
         self.finished.receiver_pairs += receivers;
         self.finished.clear_receiver_pairs += clear;
         self.passes.push(pass);
+    }
+
+    /// Whether the session refines its mesh after a converged pass
+    /// ([`SessionOptions::refine`]).
+    pub fn refines(&self) -> bool {
+        self.refiner.is_some()
     }
 
     /// True once [`Event::Finished`] (or [`Event::Refused`]) was returned.
@@ -408,19 +421,26 @@ impl<'p> Session<'p> {
 
     /// The solver of the current pass.
     pub fn solver(&self) -> &(dyn Method<'p> + 'p) {
-        &*self.solver
+        held(&self.solver)
+    }
+
+    /// The solver of the current pass, to step or restore.
+    fn solver_mut(&mut self) -> &mut (dyn Method<'p> + 'p) {
+        self.solver
+            .as_deref_mut()
+            .expect("a session holds a solver outside refine_or_finish")
     }
 
     /// The mesh of the current pass: the prepared one, or its latest
     /// refinement.
     pub fn mesh(&self) -> &Mesh {
-        self.solver.mesh()
+        self.solver().mesh()
     }
 
     /// The mesh of the current pass as a cheap handle another thread or a
     /// later stage can keep.
     pub fn mesh_ref(&self) -> MeshRef<'p> {
-        self.solver.mesh_ref()
+        self.solver().mesh_ref()
     }
 
     /// The options it was started with.
@@ -449,10 +469,10 @@ impl<'p> Session<'p> {
     pub fn totals(&self) -> Totals {
         let mut totals = self.finished;
         if !self.is_finished() {
-            let (receivers, clear) = self.solver.receiver_pairs();
-            totals.steps += self.solver.steps() - self.pass_start.steps;
-            totals.rays += self.solver.rays() - self.pass_start.rays;
-            totals.pairs += self.solver.pairs();
+            let (receivers, clear) = self.solver().receiver_pairs();
+            totals.steps += self.solver().steps() - self.pass_start.steps;
+            totals.rays += self.solver().rays() - self.pass_start.rays;
+            totals.pairs += self.solver().pairs();
             totals.receiver_pairs += receivers;
             totals.clear_receiver_pairs += clear;
         }
@@ -462,7 +482,7 @@ impl<'p> Session<'p> {
     /// The radiosity per vertex of [`Session::mesh`], in the scene's
     /// emission units.
     pub fn radiosity(&self) -> &[Rgb] {
-        self.solver.radiosity()
+        self.solver().radiosity()
     }
 
     /// The radiosity to draw, written into `out` (resized to the vertex
@@ -472,7 +492,7 @@ impl<'p> Session<'p> {
     /// the window, the pictures and the mesh exports get their values.
     pub fn shown(&self, out: &mut Vec<Rgb>) {
         if self.options.ambient {
-            self.solver.radiosity_with_ambient(out);
+            self.solver().radiosity_with_ambient(out);
             self.weld.apply(out);
         } else {
             self.solution(out);
@@ -484,7 +504,7 @@ impl<'p> Session<'p> {
     /// export carries.
     pub fn solution(&self, out: &mut Vec<Rgb>) {
         out.clear();
-        out.extend_from_slice(self.solver.radiosity());
+        out.extend_from_slice(self.solver().radiosity());
         self.weld.apply(out);
     }
 
@@ -496,19 +516,26 @@ impl<'p> Session<'p> {
     /// Unshot power left as a fraction of the emitted power, on the
     /// current mesh.
     pub fn unshot_fraction(&self) -> f64 {
-        self.solver.unshot_fraction()
+        self.solver().unshot_fraction()
     }
 
     /// True when the last pass reached the threshold (false while solving
     /// or when it stopped at the step limit).
     pub fn converged(&self) -> bool {
-        self.solver.stop_reason() == Some(StopReason::Converged) && self.phase != Phase::Solving
+        self.solver().stop_reason() == Some(StopReason::Converged) && self.phase != Phase::Solving
     }
 
     /// Checks the solver's invariants.
     pub fn validate(&self) -> Result<(), SolverError> {
-        self.solver.validate()
+        self.solver().validate()
     }
+}
+
+/// The solver in a session's slot, which holds one outside
+/// [`Session::refine_or_finish`].
+fn held<'s, 'p>(slot: &'s Option<Box<dyn Method<'p> + 'p>>) -> &'s (dyn Method<'p> + 'p) {
+    slot.as_deref()
+        .expect("a session holds a solver outside refine_or_finish")
 }
 
 #[cfg(test)]

@@ -626,7 +626,9 @@ fn hemicube_runs_end_to_end_and_refuses_a_bad_resolution() {
 
 /// Without `--lenmax`, a scene whose default mesh is over the vertex
 /// budget is cut coarser, and one line before the solve says so (under
-/// `-q` too, as the load warnings); with `--lenmax` the line is not there.
+/// `-q` too, as the load warnings) and that the mesh will be refined once;
+/// with `--no-adaptive` the line says nothing of a refinement, and with
+/// `--lenmax` the line is not there.
 /// The scene: 150 unit squares stacked 0.001 apart, 504,600 vertices at
 /// the default lenmax 0.017776, 453,750 at the budget's 0.0186.
 #[test]
@@ -651,12 +653,23 @@ fn a_default_mesh_over_the_vertex_budget_is_coarsened_with_one_line() {
     let line = format!(
         "{scene}: warning: mesh coarsened to lenmax 0.0186 (an estimated 454,000 vertices, \
          within the budget of 470,000; the default 0.01778 would give 505,000): \
-         give --lenmax for a finer one\n"
+         give --lenmax for a finer one"
     );
-    assert!(said.contains(&line), "{said}");
+    let refined = "; once solved, up to 5,000 of its elements where the light changes most \
+                   are split and solved again (--no-adaptive keeps it)\n";
+    assert!(said.contains(&format!("{line}{refined}")), "{said}");
     let stats = read_json(dir.path(), "a.json");
     assert_eq!(stats["lenmax"].as_f64().unwrap() as f32, 0.0186);
     assert_eq!(stats["vertices"], 453_750);
+
+    let kept = [scene, "--no-adaptive", "--stats", "k.json"];
+    let out = run_in(dir.path(), &[&kept[..], &quick[..]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(&format!("{line}\n")),
+        "{}",
+        stderr(&out)
+    );
 
     let given = [scene, "--lenmax", "0.02", "--stats", "b.json"];
     let out = run_in(dir.path(), &[&given[..], &quick[..]].concat());

@@ -59,7 +59,8 @@ fn exhaust(solver: &mut Progressive, name: &str) -> Option<StopReason> {
 fn exhaust_run(config: &RunConfig) -> u64 {
     let name = config.scene.display_name();
     let prepared = prepare(config).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let mut session = Session::from_prepared(&prepared, SessionOptions::for_run(config, false));
+    let mut session =
+        Session::from_prepared(&prepared, SessionOptions::for_run(config, &prepared, false));
     let cancel = AtomicBool::new(false);
     loop {
         match session.advance(&cancel) {

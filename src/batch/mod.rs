@@ -402,7 +402,8 @@ pub fn run_prepared(
 
     let t = Instant::now();
     // A file shows the solution; the ambient term only when asked for.
-    let mut session = Session::from_prepared(prepared, SessionOptions::for_run(config, false));
+    let mut session =
+        Session::from_prepared(prepared, SessionOptions::for_run(config, prepared, false));
     let solved = solve(config, prepared, &mut session, cancel)?;
     seconds.solve = t.elapsed().as_secs_f64();
     let mesh: &crate::mesh::Mesh = &solved.mesh;
@@ -854,7 +855,7 @@ fn run_stats(
         exposure_stops: config.exposure.stops(auto),
         converged: session.converged() && prepared.scene.emits(),
         nothing_emits: !prepared.scene.emits(),
-        adaptive: if config.adaptive.is_some() {
+        adaptive: if session.refines() {
             session.passes().to_vec()
         } else {
             Vec::new()
@@ -1004,7 +1005,7 @@ fn solve<'p>(
         eprintln!("{}", sky_blocked());
         warnings.push(sky_blocked());
     }
-    if config.progress && config.adaptive.is_some() {
+    if config.progress && session.refines() {
         say_pass(session, None);
     }
     save(session, &records)?;

@@ -256,6 +256,17 @@ pub struct Args {
     #[arg(help_heading = heading::SOLVER)]
     pub(crate) adaptive: bool,
 
+    /// Never refine the mesh, not even once after a coarsened default mesh.
+    ///
+    /// Without --lenmax, a model whose default mesh would pass the vertex
+    /// budget is meshed coarser, solved, then refined once where the light
+    /// changes most (up to 5,000 elements) and solved
+    /// again. This keeps the coarser mesh as it is. A run that writes or
+    /// resumes a checkpoint never refines.
+    #[arg(long, conflicts_with = "adaptive")]
+    #[arg(help_heading = heading::SOLVER)]
+    pub(crate) no_adaptive: bool,
+
     /// Relative luminance difference that splits an element (--adaptive).
     ///
     /// An element is split when its vertex luminances differ by more than

@@ -399,6 +399,7 @@ impl TryFrom<Args> for Invocation {
                 (false, false) => None,
             },
             adaptive: args.adaptive.then_some(refine),
+            refine_coarsened: !args.no_adaptive,
             mesh_lines: args.mesh_lines,
             aa: args.aa,
             emit: args.emit,

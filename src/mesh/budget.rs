@@ -6,7 +6,9 @@
 //! vertices) takes hours where a few minutes were wanted. Such a scene is
 //! cut at the finest lenmax whose mesh stays within the budget, found from
 //! the size estimate ([`Sizes`]) without building a mesh, and a line says
-//! what was chosen and how to get a finer mesh. An explicit lenmax is never
+//! what was chosen and how to get a finer mesh. A run on such a mesh then
+//! refines it once where the light changes most
+//! ([`crate::config::RunConfig::refinement`]). An explicit lenmax is never
 //! changed; nor is the default of a scene within the budget (every bundled
 //! scene, by a factor of 23 or more).
 //!
@@ -186,7 +188,7 @@ fn significant(x: f32, digits: i32) -> f64 {
 /// A count as the message shows it: to the nearest thousand from 10,000
 /// up (the estimate is a few percent short of the stitched mesh anyway),
 /// with thousands separators.
-fn about(n: u64) -> String {
+pub(crate) fn about(n: u64) -> String {
     let n = if n >= 10_000 {
         (n + 500) / 1000 * 1000
     } else {

@@ -341,7 +341,7 @@ fn solve_in_background<'p>(
 ) {
     // Long steps come in parts, so the picture moves at least every
     // tenth of a second or so of solving.
-    let mut options = SessionOptions::for_run(config, true);
+    let mut options = SessionOptions::for_run(config, prepared, true);
     options.solver.part_budget = Some(crate::solver::tuning::WINDOW_PART_BUDGET);
     let mut session = Session::from_prepared(prepared, options);
     let levels = session.max_refinements();

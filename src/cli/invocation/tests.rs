@@ -359,6 +359,36 @@ fn adaptive_options_reach_the_config_only_with_adaptive() {
     assert!(parse(&["--adaptive", "--checkpoint", "c.bin"]).is_err());
 }
 
+/// Without `--adaptive`, a run refines once when the vertex budget
+/// coarsened its default mesh, with the default threshold and split
+/// limit; `--no-adaptive`, a checkpoint written or resumed, or a mesh the
+/// budget left alone refine nothing.
+#[test]
+fn a_coarsened_default_mesh_is_refined_once_unless_told_not_to() {
+    let once = RefineOptions {
+        levels: 1,
+        max_elements: DEFAULT_MAX_ELEMENTS,
+        ..RefineOptions::default()
+    };
+    assert_eq!(config(&[]).refinement(true), Some(once));
+    assert_eq!(config(&[]).refinement(false), None);
+    assert_eq!(config(&["--no-adaptive"]).refinement(true), None);
+    assert_eq!(config(&["--checkpoint", "c.bin"]).refinement(true), None);
+    assert_eq!(config(&["--resume", "c.bin"]).refinement(true), None);
+    // --max-elements bounds the pass as it bounds --adaptive's.
+    assert_eq!(
+        config(&["--max-elements", "900"])
+            .refinement(true)
+            .map(|r| r.max_elements),
+        Some(900)
+    );
+    // --adaptive's own passes, whatever the budget did.
+    let adaptive = config(&["--adaptive", "--adaptive-levels", "3"]);
+    assert_eq!(adaptive.refinement(false), adaptive.adaptive);
+    assert_eq!(adaptive.refinement(true).map(|r| r.levels), Some(3));
+    assert!(parse(&["--adaptive", "--no-adaptive"]).is_err());
+}
+
 /// `--exposure` counts stops from the automatic exposure: 0 is the
 /// automatic one, negative values darken.
 #[test]
