@@ -333,14 +333,14 @@ fn ready_cancellable(config: &RunConfig, cancel: &Cancel) -> Result<ReadyScene, 
             let (options, coarsened) = MeshOptions::within_budget(&scene, VERTEX_BUDGET);
             if let Some(coarsened) = &coarsened {
                 let mut line = coarsened.to_string();
-                if config.adaptive.is_none() {
-                    if let Some(refine) = config.refinement(true) {
-                        line += &format!(
-                            "; once solved, up to {} of its elements where the light changes \
-                             most are split and solved again (--no-adaptive keeps it)",
-                            crate::mesh::budget::about(refine.max_splits)
-                        );
-                    }
+                // Said only of the refinement the budget brings, not of
+                // one `--adaptive` asked for.
+                if let (None, Some(refine)) = (config.adaptive, config.refinement(true)) {
+                    line += &format!(
+                        "; once solved, up to {} of its elements where the light changes \
+                         most are split and solved again (--no-adaptive keeps it)",
+                        crate::budget::fmt_count(refine.max_splits)
+                    );
                 }
                 scene.warnings.push(Warning::file(&name, line));
             }

@@ -188,21 +188,12 @@ fn significant(x: f32, digits: i32) -> f64 {
 /// A count as the message shows it: to the nearest thousand from 10,000
 /// up (the estimate is a few percent short of the stitched mesh anyway),
 /// with thousands separators.
-pub(crate) fn about(n: u64) -> String {
-    let n = if n >= 10_000 {
+fn about(n: u64) -> String {
+    crate::budget::fmt_count(if n >= 10_000 {
         (n + 500) / 1000 * 1000
     } else {
         n
-    };
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (k, c) in digits.chars().enumerate() {
-        if k > 0 && (digits.len() - k) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
+    })
 }
 
 #[cfg(test)]
